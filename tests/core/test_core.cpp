@@ -1,0 +1,91 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "core/camera.hpp"
+#include "core/error.hpp"
+#include "core/scene.hpp"
+#include "support/run.hpp"
+#include "support/shapes.hpp"
+
+using namespace lodstream;
+
+TEST(Bounds, DiagonalAndTransform) {
+  Bounds b;
+  EXPECT_TRUE(b.empty());
+  EXPECT_EQ(b.diagonal(), 0.0f);
+  b.add({0, 0, 0});
+  b.add({3, 4, 0});
+  EXPECT_FLOAT_EQ(b.diagonal(), 5.0f);
+  Bounds t = transform_bounds(b, glm::translate(glm::mat4(1.0f), glm::vec3(10, 0, 0)));
+  EXPECT_FLOAT_EQ(t.min.x, 10.0f);
+  EXPECT_FLOAT_EQ(t.max.x, 13.0f);
+}
+
+TEST(Scene, InstancesCountAsDrawn) {
+  Scene s = make_scene(test::grid(4));
+  s.objects.push_back(Object{"copy", glm::translate(glm::mat4(1.0f), glm::vec3(5, 0, 0)), 0});
+  EXPECT_EQ(s.unique_triangle_count(), 32u);
+  EXPECT_EQ(s.triangle_count(), 64u);
+  EXPECT_FLOAT_EQ(s.bounds().max.x, 6.0f);
+}
+
+TEST(Mesh, SmoothNormalsOfSpherePointOutward) {
+  Mesh m = test::sphere(2.0f, 16, 32);
+  compute_smooth_normals(m);
+  for (size_t i = 0; i < m.positions.size(); ++i)
+    EXPECT_GT(glm::dot(m.normals[i], glm::normalize(m.positions[i])), 0.99f) << "vertex " << i;
+}
+
+TEST(Shapes, CubeHasSeamsAndClosedArea) {
+  Mesh m = test::cube_with_seams(2);
+  EXPECT_EQ(m.vertex_count(), 6u * 9u);
+  EXPECT_EQ(m.triangle_count(), 6u * 8u);
+  double area = 0;
+  for (size_t t = 0; t < m.triangle_count(); ++t) area += 0.5 * triangle_double_area(m, t);
+  EXPECT_NEAR(area, 24.0, 1e-4);
+  // Every face normal agrees with the stored (outward) vertex normal.
+  for (size_t t = 0; t < m.triangle_count(); ++t) {
+    const uint32_t* v = &m.indices[3 * t];
+    glm::vec3 n = glm::cross(m.positions[v[1]] - m.positions[v[0]], m.positions[v[2]] - m.positions[v[0]]);
+    EXPECT_GT(glm::dot(n, m.normals[v[0]]), 0.0f) << "triangle " << t;
+  }
+}
+
+namespace {
+std::filesystem::path write(const std::string& text) {
+  auto p = test::temp_dir() / "camera.json";
+  std::ofstream(p) << text;
+  return p;
+}
+}  // namespace
+
+TEST(Camera, LoadsFileWithDefaults) {
+  Camera c = load_camera(write(R"({"eye": [0, 1, 5], "target": [0, 1, 0], "size": [640, 480]})"));
+  EXPECT_EQ(c.width, 640);
+  EXPECT_EQ(c.height, 480);
+  EXPECT_FLOAT_EQ(c.fov_y_degrees, 60.0f);
+  EXPECT_FLOAT_EQ(c.eye.z, 5.0f);
+  // The view matrix maps the target onto the negative z axis.
+  glm::vec4 t = c.view() * glm::vec4(c.target, 1.0f);
+  EXPECT_NEAR(t.x, 0.0f, 1e-6f);
+  EXPECT_NEAR(t.z, -5.0f, 1e-5f);
+}
+
+TEST(Camera, RejectsBadFilesWithOneLineErrors) {
+  for (const char* text : {"{", "[]", R"({"eye": [0,0,0]})", R"({"eye": [0,0,0], "target": [0,0,0]})",
+                           R"({"eye": [0,0,1], "target": [0,0,0], "up": [0,0,1]})",
+                           R"({"eye": [0,0,1], "target": [0,0,0], "fov": 200})",
+                           R"({"eye": [0,0,1], "target": [0,0,0], "size": [0, 10]})",
+                           R"({"eye": "x", "target": [0,0,0]})"}) {
+    try {
+      load_camera(write(text));
+      ADD_FAILURE() << "accepted " << text;
+    } catch (const Error& e) {
+      std::string msg = e.what();
+      EXPECT_NE(msg.find("camera.json"), std::string::npos) << msg;
+      EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    }
+  }
+}

@@ -1,0 +1,85 @@
+#include "support/run.hpp"
+
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+extern char** environ;
+
+namespace lodstream::test {
+
+namespace {
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+}  // namespace
+
+nlohmann::json RunResult::json() const {
+  try {
+    return nlohmann::json::parse(out);
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "stdout is not one JSON object: " << e.what() << "\nstdout: " << out << "\nstderr: " << err;
+    return {};
+  }
+}
+
+RunResult run_lodstream(const std::vector<std::string>& args) {
+  auto dir = temp_dir();
+  auto out_path = dir / "stdout", err_path = dir / "stderr";
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  std::vector<std::string> argv_s{LODSTREAM_BINARY};
+  argv_s.insert(argv_s.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : argv_s) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  RunResult r;
+  if (posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ) != 0) {
+    ADD_FAILURE() << "cannot start " << argv[0];
+    return r;
+  }
+  posix_spawn_file_actions_destroy(&actions);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.out = slurp(out_path);
+  r.err = slurp(err_path);
+  std::filesystem::remove_all(dir);
+  return r;
+}
+
+std::filesystem::path data_file(const std::string& name) {
+  auto p = std::filesystem::path(LODSTREAM_SOURCE_DIR) / "data" / name;
+  if (!std::filesystem::exists(p)) ADD_FAILURE() << p << " is missing: run scripts/fetch-data (make test does)";
+  return p;
+}
+
+std::filesystem::path temp_dir() {
+  static std::vector<std::filesystem::path> made;
+  static const bool cleanup = [] {
+    std::atexit([] {
+      std::error_code ec;
+      for (auto& d : made) std::filesystem::remove_all(d, ec);
+    });
+    return true;
+  }();
+  (void)cleanup;
+  std::string tmpl = (std::filesystem::temp_directory_path() / "lodstream-test-XXXXXX").string();
+  if (!mkdtemp(tmpl.data())) ADD_FAILURE() << "mkdtemp failed";
+  made.emplace_back(tmpl);
+  return tmpl;
+}
+
+}  // namespace lodstream::test
