@@ -4,6 +4,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/camera.hpp"
+#include "core/image.hpp"
 #include "core/error.hpp"
 #include "core/scene.hpp"
 #include "support/run.hpp"
@@ -88,4 +89,23 @@ TEST(Camera, RejectsBadFilesWithOneLineErrors) {
       EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
     }
   }
+}
+
+TEST(Image, PngRoundTripIsExactAndDeterministic) {
+  Image img(7, 5);
+  for (int y = 0; y < 5; ++y)
+    for (int x = 0; x < 7; ++x) {
+      uint8_t* p = img.pixel(x, y);
+      p[0] = uint8_t(x * 30), p[1] = uint8_t(y * 50), p[2] = uint8_t(x * y), p[3] = 255;
+    }
+  auto dir = test::temp_dir();
+  save_png(img, dir / "a.png");
+  save_png(img, dir / "b.png");
+  Image back = load_image(dir / "a.png");
+  EXPECT_EQ(back.width, 7);
+  EXPECT_EQ(back.height, 5);
+  EXPECT_EQ(back.rgba, img.rgba);
+  EXPECT_EQ(std::filesystem::file_size(dir / "a.png"), std::filesystem::file_size(dir / "b.png"));
+  EXPECT_THROW(load_image(dir / "missing.png"), Error);
+  EXPECT_THROW(save_png(img, dir / "no-such-dir" / "c.png"), Error);
 }
