@@ -1,0 +1,29 @@
+// A whole core Scene onto a Renderer: every mesh once, every material's texture once, one draw item per
+// object.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/scene.hpp"
+#include "render/renderer.hpp"
+
+namespace lodstream::render {
+
+struct SceneUpload {
+  std::vector<MeshHandle> meshes;       // meshes[i] holds Scene::meshes[i]
+  std::vector<TextureHandle> textures;  // every texture uploaded, once per distinct file
+  std::vector<DrawItem> items;          // one per Scene::objects entry, in order
+  size_t triangles = 0;                 // as drawn (instances counted each time)
+  std::vector<std::string> warnings;    // one line each, e.g. a texture file that cannot be read
+};
+
+// Uploads `scene` to `renderer`. A base-colour texture that cannot be read (missing or not an image) gives a
+// warning and the material falls back to its base colour; objects referring to a missing mesh or material are
+// a lodstream::Error (the Scene is malformed). Cost: the meshes' upload plus decoding each texture file once.
+SceneUpload upload_scene(Renderer& renderer, const Scene& scene);
+
+// Releases what upload_scene() uploaded.
+void release_scene(Renderer& renderer, const SceneUpload& upload);
+
+}  // namespace lodstream::render

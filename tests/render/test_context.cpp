@@ -1,0 +1,127 @@
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <string>
+
+#include "core/error.hpp"
+#include "render/context.hpp"
+#include "render/renderer.hpp"
+#include "render_fixture.hpp"
+#include "support/shapes.hpp"
+
+extern char** environ;
+
+using namespace lodstream;
+using namespace lodstream::render;
+
+namespace {
+
+std::pair<int, int> gl_version() {
+  int major = 0, minor = 0;
+  std::string v = test::headless_context().version();
+  std::sscanf(v.c_str(), "%d.%d", &major, &minor);
+  return {major, minor};
+}
+
+Image render_sphere(Context& context) {
+  Renderer renderer(context);
+  DrawItem item{renderer.upload_mesh(test::sphere(1.0f, 24, 48)), glm::mat4(1.0f), {}};
+  renderer.draw(test::camera_at({0.5f, 1, 4}, {0, 0, 0}, 80, 60), std::span(&item, 1));
+  return renderer.read_pixels();
+}
+
+// An X server for the window test: Xvfb picks a free display and writes its number to a pipe (-displayfd).
+class Xvfb {
+ public:
+  Xvfb() {
+    int fds[2];
+    if (pipe(fds) != 0) return;
+    std::string fd = std::to_string(fds[1]);
+    const char* argv[] = {"Xvfb",       "-displayfd", fd.c_str(), "-screen", "0",
+                          "320x240x24", "-nolisten",  "tcp",      nullptr};
+    if (posix_spawnp(&pid_, "Xvfb", nullptr, nullptr, const_cast<char**>(argv), environ) != 0) pid_ = -1;
+    close(fds[1]);
+    char c;
+    while (pid_ > 0 && read(fds[0], &c, 1) == 1 && c != '\n') display_ += c;
+    close(fds[0]);
+  }
+  ~Xvfb() {
+    if (pid_ > 0) {
+      kill(pid_, SIGTERM);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+  std::string display() const { return display_.empty() ? "" : ":" + display_; }
+
+ private:
+  pid_t pid_ = -1;
+  std::string display_;
+};
+
+}  // namespace
+
+TEST(Context, HeadlessGivesOpenGL45Core) {
+  auto [major, minor] = gl_version();
+  EXPECT_GE(major * 10 + minor, 45) << test::headless_context().version();
+  EXPECT_FALSE(test::headless_context().renderer().empty());
+  std::printf("headless context: %s, %s, %s\n", test::headless_context().platform().c_str(),
+              test::headless_context().renderer().c_str(), test::headless_context().version().c_str());
+}
+
+TEST(Context, NeedsNoEglPlatformVariable) {
+  unsetenv("EGL_PLATFORM");
+  auto context = create_headless_context();
+  EXPECT_FALSE(context->renderer().empty());
+}
+
+TEST(Context, EachEglPlatformWorksAndDrawsTheSameImage) {
+  auto device = create_headless_context({EglPlatform::device});
+  EXPECT_EQ(device->platform(), "egl-device");
+  Image a = render_sphere(*device);
+  auto surfaceless = create_headless_context({EglPlatform::surfaceless});
+  EXPECT_EQ(surfaceless->platform(), "egl-surfaceless");
+  Image b = render_sphere(*surfaceless);
+  EXPECT_EQ(a.rgba, b.rgba);
+  EXPECT_GT(test::covered_pixels(a), 100u);
+}
+
+TEST(Context, NoPlatformIsAClearError) {
+  try {
+    create_headless_context({});
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot create an OpenGL 4.5 core context"), std::string::npos);
+  }
+}
+
+TEST(WindowContext, WithoutDisplayIsAClearError) {
+  const char* display = std::getenv("DISPLAY");
+  std::string saved = display ? display : "";
+  unsetenv("DISPLAY");
+  try {
+    create_window_context(64, 64, "test", false);
+    ADD_FAILURE() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("DISPLAY"), std::string::npos) << e.what();
+  }
+  if (display) setenv("DISPLAY", saved.c_str(), 1);
+}
+
+TEST(WindowContext, UnderXvfbDrawsWhatHeadlessDraws) {
+  Xvfb server;
+  ASSERT_FALSE(server.display().empty()) << "Xvfb did not start (scripts/setup installs xvfb)";
+  setenv("DISPLAY", server.display().c_str(), 1);
+  Image windowed;
+  {
+    auto window = create_window_context(80, 60, "lodstream test", false);
+    EXPECT_EQ(window->platform(), "glfw");
+    EXPECT_TRUE(window->poll_events());
+    windowed = render_sphere(*window);
+  }
+  unsetenv("DISPLAY");
+  EXPECT_EQ(windowed.rgba, render_sphere(test::headless_context()).rgba);
+}
