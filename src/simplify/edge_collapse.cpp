@@ -1,0 +1,704 @@
+// Quadric edge collapse: see simplify.hpp for the operator, framework, vertex kinds, validity rules and the
+// two-sided bound. Hand-written: no Debian library offers attribute quadrics with seams, locks and a tracked
+// bound (meshoptimizer 0.18 has positions-only half-edge collapse and no bound; OpenMesh's decimater has
+// neither seams nor a bound).
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "simplify/quadric.hpp"
+#include "simplify/simplify.hpp"
+
+namespace lodstream::simplify {
+namespace {
+
+constexpr uint32_t kNone = UINT32_MAX;
+enum Kind : uint8_t { kManifold, kBorder, kSeam, kLocked };
+
+struct Candidate {
+  float cost;
+  uint32_t a;  // removed
+  uint32_t b;  // kept
+};
+
+// One planned collapse: a -> b and, on a seam, its twin a2 -> b2; x is where b (and b2) end up.
+struct Plan {
+  uint32_t a = kNone, b = kNone, a2 = kNone, b2 = kNone;
+  bool move = false;
+  glm::dvec3 x{0.0};
+  double cost = 0.0;
+};
+
+uint32_t hash_bits(const float* v, size_t n) {
+  uint32_t h = 2166136261u;
+  for (size_t i = 0; i < n; ++i) {
+    uint32_t u;
+    std::memcpy(&u, &v[i], 4);
+    if ((u << 1) == 0) u = 0;  // +0 and -0 hash alike
+    h = (h ^ u) * 16777619u;
+    h ^= h >> 15;
+  }
+  return h;
+}
+
+class Simplifier {
+ public:
+  Simplifier(const Mesh& in, const Options& o) : in_(in), opt_(o) {}
+
+  Result run() {
+    Result result;
+    result.input_triangles = in_.triangle_count();
+    weld();
+    result.weld_remap = weld_remap_;
+    build_adjacency();
+    classify();
+    build_quadrics();
+    const size_t target = opt_.target_triangles;
+    const size_t start_tris = alive_triangles_;
+    bool stalled = false;
+    uint32_t pass = 0;
+    while (alive_triangles_ > target) {
+      if (pass++ > 0) {
+        compact_faces();
+        build_adjacency();
+      }
+      update_open_edges();
+      size_t collapsed = run_pass(target);
+      if (opt_.progress && start_tris > target)
+        opt_.progress(float(start_tris - alive_triangles_) / float(start_tris - target));
+      if (collapsed == 0) {
+        stalled = true;
+        break;
+      }
+    }
+    // Reached: within 1 % of the triangle target, or stopped by the error bound before it.
+    result.target_reached = !stalled || alive_triangles_ <= target + target / 100 || error_limited_;
+    output(result);
+    return result;
+  }
+
+ private:
+  const Mesh& in_;
+  const Options& opt_;
+
+  // Welded vertices (input vertex -> welded) and their working data (normalized positions).
+  std::vector<uint32_t> weld_remap_, source_;  // source_: welded vertex -> first input vertex
+  std::vector<glm::vec3> pos_;
+  std::vector<glm::vec3> nrm_;
+  std::vector<glm::vec2> uv_;
+  std::vector<glm::vec4> col_;
+  std::vector<uint32_t> wedge_, pid_;  // wedge ring (same position) and its representative
+  std::vector<uint8_t> kind_, touched_, moved_;
+  std::vector<float> radius_;
+  std::vector<Quadric> quadric_;
+  std::vector<AttributeTerm> attr_;  // channels_ per vertex
+  std::vector<float> channel_weight_;
+  int channels_ = 0;
+  std::vector<uint32_t> open_out_, open_in_;
+  glm::vec3 origin_{0.0f};
+  float scale_ = 1.0f;
+  double bound_ = 0.0;  // normalized units
+  double max_error_ = 0.0;
+  bool error_limited_ = false;  // a collapse was refused because of Options::max_error
+
+  std::vector<uint32_t> indices_;  // alive faces; dead ones have indices_[3f] == kNone during a pass
+  size_t alive_triangles_ = 0;
+  std::vector<uint32_t> offsets_, faces_;  // vertex -> faces (CSR), rebuilt each pass
+  std::vector<Candidate> slots_, order_;
+  uint32_t step_ = 0;
+  std::vector<Collapse>* record_ = nullptr;
+
+  // ---- set-up ------------------------------------------------------------------------------------------
+
+  // Welds exact duplicates (same position and attributes) and links vertices that share a position into
+  // wedge rings. Hash table with linear probing over positions.
+  void weld() {
+    const size_t n = in_.vertex_count();
+    Bounds box = in_.bounds();
+    origin_ = box.empty() ? glm::vec3(0.0f) : box.min;
+    float extent = box.empty() ? 0.0f : std::max({box.extent().x, box.extent().y, box.extent().z});
+    scale_ = extent > 0 ? extent : 1.0f;
+    max_error_ = opt_.max_error / scale_;
+
+    size_t cap = 1;
+    while (cap < 2 * n + 2) cap <<= 1;
+    std::vector<uint32_t> table(cap, kNone);
+    weld_remap_.assign(n, kNone);
+    const bool hn = in_.has_normals(), hu = in_.has_uvs(), hc = in_.has_colors();
+    auto same_attributes = [&](uint32_t i, uint32_t j) {
+      return (!hn || in_.normals[i] == in_.normals[j]) && (!hu || in_.uvs[i] == in_.uvs[j]) &&
+             (!hc || in_.colors[i] == in_.colors[j]);
+    };
+    for (uint32_t v = 0; v < n; ++v) {
+      const glm::vec3& p = in_.positions[v];
+      size_t h = hash_bits(&p.x, 3) & (cap - 1);
+      while (table[h] != kNone && in_.positions[source_[table[h]]] != p) h = (h + 1) & (cap - 1);
+      if (table[h] == kNone) {
+        table[h] = add_vertex(v, kNone);
+        weld_remap_[v] = table[h];
+        continue;
+      }
+      uint32_t first = table[h], w = first;
+      do {
+        if (same_attributes(source_[w], v)) break;
+        w = wedge_[w];
+      } while (w != first);
+      weld_remap_[v] = same_attributes(source_[w], v) ? w : add_vertex(v, first);
+    }
+    const size_t m = source_.size();
+    kind_.assign(m, kManifold);
+    touched_.assign(m, 0);
+    moved_.assign(m, 0);
+    radius_.assign(m, 0.0f);
+    for (uint32_t v = 0; v < n; ++v)
+      if (v < opt_.locked.size() && opt_.locked[v]) kind_[weld_remap_[v]] = kLocked;
+
+    indices_.clear();
+    indices_.reserve(in_.indices.size());
+    for (size_t t = 0; t + 2 < in_.indices.size(); t += 3) {
+      uint32_t a = in_.indices[t], b = in_.indices[t + 1], c = in_.indices[t + 2];
+      if (a >= n || b >= n || c >= n) continue;
+      a = weld_remap_[a], b = weld_remap_[b], c = weld_remap_[c];
+      if (a == b || b == c || a == c) continue;
+      indices_.insert(indices_.end(), {a, b, c});
+    }
+    alive_triangles_ = indices_.size() / 3;
+  }
+
+  uint32_t add_vertex(uint32_t input, uint32_t ring) {
+    uint32_t v = uint32_t(source_.size());
+    source_.push_back(input);
+    pos_.push_back((in_.positions[input] - origin_) / scale_);
+    if (in_.has_normals()) nrm_.push_back(in_.normals[input]);
+    if (in_.has_uvs()) uv_.push_back(in_.uvs[input]);
+    if (in_.has_colors()) col_.push_back(in_.colors[input]);
+    if (ring == kNone) {
+      wedge_.push_back(v);
+      pid_.push_back(v);
+    } else {
+      wedge_.push_back(wedge_[ring]);
+      wedge_[ring] = v;
+      pid_.push_back(ring);
+    }
+    return v;
+  }
+
+  void compact_faces() {
+    size_t w = 0;
+    for (size_t f = 0; f < indices_.size(); f += 3)
+      if (indices_[f] != kNone) {
+        indices_[w] = indices_[f], indices_[w + 1] = indices_[f + 1], indices_[w + 2] = indices_[f + 2];
+        w += 3;
+      }
+    indices_.resize(w);
+  }
+
+  void build_adjacency() {
+    const size_t m = source_.size();
+    offsets_.assign(m + 1, 0);
+    for (uint32_t v : indices_) ++offsets_[v + 1];
+    for (size_t v = 0; v < m; ++v) offsets_[v + 1] += offsets_[v];
+    faces_.resize(indices_.size());
+    std::vector<uint32_t> fill(offsets_.begin(), offsets_.end() - 1);
+    for (size_t c = 0; c < indices_.size(); ++c) faces_[fill[indices_[c]]++] = uint32_t(c / 3);
+  }
+
+  // Out- and in-neighbours of v over its alive faces: face (v, out, in) in counter-clockwise order.
+  void fan(uint32_t v, std::vector<uint32_t>& outs, std::vector<uint32_t>& ins) const {
+    outs.clear(), ins.clear();
+    for (uint32_t s = offsets_[v]; s < offsets_[v + 1]; ++s) {
+      const uint32_t* t = &indices_[3 * size_t(faces_[s])];
+      if (t[0] == kNone) continue;
+      int k = t[0] == v ? 0 : (t[1] == v ? 1 : 2);
+      outs.push_back(t[(k + 1) % 3]);
+      ins.push_back(t[(k + 2) % 3]);
+    }
+  }
+
+  // Vertex kinds (simplify.hpp): open edges, non-manifold edges (a directed edge twice) and fans (a vertex
+  // whose faces do not form one disc or one open fan), then wedge rings.
+  void classify() {
+    const size_t m = source_.size();
+    open_out_.assign(m, kNone), open_in_.assign(m, kNone);
+    std::vector<uint8_t> open_count(m, 0), complex(m, 0);
+    std::vector<uint32_t> outs, ins;
+    for (uint32_t v = 0; v < m; ++v) {
+      fan(v, outs, ins);
+      const size_t deg = outs.size();
+      if (deg == 0) continue;
+      if (deg > 256) {
+        complex[v] = 1;
+        continue;
+      }
+      uint32_t n_open_out = 0, n_open_in = 0, start = 0;
+      for (size_t i = 0; i < deg; ++i) {
+        if (std::count(outs.begin(), outs.end(), outs[i]) > 1) complex[v] = 1;
+        if (std::find(ins.begin(), ins.end(), outs[i]) == ins.end())
+          ++n_open_out, open_out_[v] = outs[i], start = uint32_t(i);
+        if (std::find(outs.begin(), outs.end(), ins[i]) == outs.end()) ++n_open_in, open_in_[v] = ins[i];
+      }
+      if (n_open_out > 1 || n_open_in > 1 || n_open_out != n_open_in) complex[v] = 1;
+      open_count[v] = uint8_t(std::min<uint32_t>(n_open_out, 2));
+      if (complex[v]) continue;
+      // Walk the fan from the face after the open edge (or any face): face g follows f when g.out == f.in.
+      size_t visited = 1, cur = start;
+      while (visited < deg) {
+        size_t next = deg;
+        for (size_t i = 0; i < deg; ++i)
+          if (outs[i] == ins[cur]) next = i;
+        if (next == deg || next == start) break;
+        cur = next, ++visited;
+      }
+      if (visited != deg) complex[v] = 1;
+    }
+    for (uint32_t v = 0; v < m; ++v) {
+      if (kind_[v] == kLocked || complex[v]) {
+        kind_[v] = kLocked;
+        continue;
+      }
+      uint32_t w = wedge_[v];
+      if (w == v) {
+        kind_[v] = open_count[v] == 0 ? kManifold : kBorder;
+      } else if (wedge_[w] == v && open_count[v] == 1 && open_count[w] == 1 && !complex[w] &&
+                 pid_[open_out_[v]] == pid_[open_in_[w]] && pid_[open_in_[v]] == pid_[open_out_[w]]) {
+        kind_[v] = kSeam;
+      } else {
+        kind_[v] = kLocked;
+      }
+    }
+    // A seam vertex whose partner was locked by the user is locked too.
+    for (uint32_t v = 0; v < m; ++v)
+      if (kind_[v] == kSeam && kind_[wedge_[v]] != kSeam) kind_[v] = kLocked;
+  }
+
+  // Border and seam vertices: their single open edge out and in, this pass (kNone when not single).
+  void update_open_edges() {
+    const size_t m = source_.size();
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 4096), [&](const auto& r) {
+      thread_local std::vector<uint32_t> outs, ins;
+      for (uint32_t v = r.begin(); v < r.end(); ++v) {
+        open_out_[v] = open_in_[v] = kNone;
+        touched_[v] = 0;
+        if (kind_[v] != kBorder && kind_[v] != kSeam) continue;
+        fan(v, outs, ins);
+        uint32_t no = 0, ni = 0;
+        for (size_t i = 0; i < outs.size(); ++i) {
+          if (std::find(ins.begin(), ins.end(), outs[i]) == ins.end()) ++no, open_out_[v] = outs[i];
+          if (std::find(outs.begin(), outs.end(), ins[i]) == outs.end()) ++ni, open_in_[v] = ins[i];
+        }
+        if (no != 1 || ni != 1) open_out_[v] = open_in_[v] = kNone;
+      }
+    });
+  }
+
+  // Face plane quadrics (area-weighted), attribute gradients (Hoppe 99) and boundary/seam penalty planes.
+  void build_quadrics() {
+    const size_t m = source_.size();
+    if (nrm_.size() == m && opt_.normal_weight > 0)
+      for (int i = 0; i < 3; ++i) channel_weight_.push_back(opt_.normal_weight);
+    if (uv_.size() == m && opt_.uv_weight > 0)
+      for (int i = 0; i < 2; ++i) channel_weight_.push_back(opt_.uv_weight);
+    if (col_.size() == m && opt_.color_weight > 0)
+      for (int i = 0; i < 4; ++i) channel_weight_.push_back(opt_.color_weight);
+    channels_ = int(channel_weight_.size());
+    quadric_.assign(m, Quadric{});
+    attr_.assign(m * size_t(channels_), AttributeTerm{});
+    std::vector<float> s0(channels_), s1(channels_), s2(channels_);
+    for (size_t f = 0; f < indices_.size(); f += 3) {
+      uint32_t v0 = indices_[f], v1 = indices_[f + 1], v2 = indices_[f + 2];
+      glm::vec3 p0 = pos_[v0], e1 = pos_[v1] - p0, e2 = pos_[v2] - p0;
+      glm::vec3 n = glm::cross(e1, e2);
+      float len = glm::length(n);
+      if (!(len > 0)) continue;
+      float area = 0.5f * len;
+      glm::vec3 nu = n / len;
+      Quadric q;
+      q.add_plane(nu, -glm::dot(nu, p0), area);
+      q.w = area;
+      if (channels_ > 0) {
+        channel_values(v0, s0.data()), channel_values(v1, s1.data()), channel_values(v2, s2.data());
+        glm::vec3 ge1 = glm::cross(e2, n) / (len * len), ge2 = glm::cross(n, e1) / (len * len);
+        for (int j = 0; j < channels_; ++j) {
+          glm::vec3 g = (s1[j] - s0[j]) * ge1 + (s2[j] - s0[j]) * ge2;
+          float d = s0[j] - glm::dot(g, p0);
+          q.add_plane(g, d, area);
+          for (uint32_t v : {v0, v1, v2}) {
+            attr_[v * size_t(channels_) + j].g += area * g;
+            attr_[v * size_t(channels_) + j].d += area * d;
+          }
+        }
+      }
+      quadric_[v0].add(q), quadric_[v1].add(q), quadric_[v2].add(q);
+    }
+    // Penalty planes through open edges (borders and both sides of seams), perpendicular to their face.
+    std::vector<uint32_t> outs, ins;
+    for (uint32_t v = 0; v < m; ++v) {
+      fan(v, outs, ins);
+      for (size_t i = 0; i < outs.size(); ++i) {
+        if (std::find(ins.begin(), ins.end(), outs[i]) != ins.end()) continue;
+        glm::vec3 pa = pos_[v], pb = pos_[outs[i]], pc = pos_[ins[i]];
+        glm::vec3 e = pb - pa, n = glm::cross(e, pc - pa);
+        glm::vec3 pn = glm::cross(e, n);
+        float l = glm::length(pn);
+        if (!(l > 0)) continue;
+        pn /= l;
+        Quadric q;
+        q.add_plane(pn, -glm::dot(pn, pa), opt_.boundary_weight * glm::dot(e, e));
+        quadric_[v].add(q), quadric_[outs[i]].add(q);
+      }
+    }
+  }
+
+  void channel_values(uint32_t v, float* s) const {
+    int j = 0;
+    if (nrm_.size() && opt_.normal_weight > 0)
+      for (int i = 0; i < 3; ++i) s[j++] = nrm_[v][i] * opt_.normal_weight;
+    if (uv_.size() && opt_.uv_weight > 0)
+      for (int i = 0; i < 2; ++i) s[j++] = uv_[v][i] * opt_.uv_weight;
+    if (col_.size() && opt_.color_weight > 0)
+      for (int i = 0; i < 4; ++i) s[j++] = col_[v][i] * opt_.color_weight;
+  }
+
+  // ---- planning ----------------------------------------------------------------------------------------
+
+  // Kind rules: may a be removed into b? Finds the seam twin a2 -> b2.
+  bool can_remove(uint32_t a, uint32_t b, Plan& p) const {
+    p.a = a, p.b = b, p.a2 = p.b2 = kNone;
+    switch (kind_[a]) {
+      case kManifold:
+        return true;
+      case kBorder:
+        return b == open_out_[a] || b == open_in_[a];
+      case kSeam: {
+        if (b != open_out_[a] && b != open_in_[a]) return false;
+        uint32_t a2 = wedge_[a];
+        for (uint32_t c : {open_out_[a2], open_in_[a2]})
+          if (c != kNone && c != b && pid_[c] == pid_[b]) p.a2 = a2, p.b2 = c;
+        return p.b2 != kNone;
+      }
+      default:
+        return false;
+    }
+  }
+
+  // Placement and cost of a planned collapse: the summed quadric of both positions (all wedges), attribute
+  // channels eliminated per merged wedge pair; optimal x when both ends may move, else x = b.
+  void place(Plan& p) const {
+    Reduced r;
+    double w = 0;
+    for (uint32_t end : {p.a, p.b}) {
+      uint32_t v = end;
+      do {
+        r.add(quadric_[v]);
+        w += quadric_[v].w;
+        v = wedge_[v];
+      } while (v != end);
+    }
+    for (int pair = 0; pair < 2 && channels_ > 0; ++pair) {
+      uint32_t a = pair ? p.a2 : p.a, b = pair ? p.b2 : p.b;
+      if (a == kNone) continue;
+      double ww = double(quadric_[a].w) + quadric_[b].w;
+      if (!(ww > 0)) continue;
+      for (int j = 0; j < channels_; ++j) {
+        const AttributeTerm &ta = attr_[a * size_t(channels_) + j], &tb = attr_[b * size_t(channels_) + j];
+        r.eliminate(glm::dvec3(ta.g) + glm::dvec3(tb.g), double(ta.d) + tb.d, ww);
+      }
+    }
+    const glm::dvec3 pa(pos_[p.a]), pb(pos_[p.b]);
+    const uint8_t ka = kind_[p.a], kb = kind_[p.b];
+    p.move = !opt_.half_edge && ka == kb && ka != kLocked;
+    if (!p.move) {
+      p.x = pb;
+    } else {
+      glm::dvec3 x, e = pa - pb, mid = 0.5 * (pa + pb);
+      // Border and seam vertices stay on their polyline: x on the edge (the minimum along it).
+      // An end is preferred unless the interior point halves the cost (keeps corners exactly).
+      if (ka != kManifold) {
+        double ca = r.eval(pa), cb = r.eval(pb);
+        x = ca < cb ? pa : pb;
+        glm::dvec3 opt = pb + r.segment_parameter(pb, e) * e;
+        if (r.eval(opt) < 0.5 * std::min(ca, cb)) x = opt;
+      } else if (!r.solve(x) || glm::dot(x - mid, x - mid) > glm::dot(e, e)) {
+        // Ill-conditioned (or far away): the best of both ends, the midpoint and the minimum along the edge.
+        x = pb;
+        double best = r.eval(pb);
+        glm::dvec3 cands[3] = {pa, mid, pb + r.segment_parameter(pb, e) * e};
+        for (const auto& c : cands)
+          if (double v = r.eval(c); v < best) best = v, x = c;
+      }
+      p.x = x;
+    }
+    p.cost = r.eval(p.x) / (w + 1e-20);
+  }
+
+  // The cheaper allowed direction of edge (i, j), as a candidate; cost = +inf when neither is allowed.
+  Candidate evaluate(uint32_t i, uint32_t j) const {
+    Candidate best{std::numeric_limits<float>::infinity(), kNone, kNone};
+    Plan p;
+    if (can_remove(i, j, p)) {
+      place(p);
+      best = {float(p.cost), i, j};
+      if (p.move) return best;  // symmetric: the other direction is the same collapse
+    }
+    if (can_remove(j, i, p)) {
+      place(p);
+      if (float(p.cost) < best.cost) best = {float(p.cost), j, i};
+    }
+    return best;
+  }
+
+  // ---- one pass --------------------------------------------------------------------------------------
+
+  size_t run_pass(size_t target) {
+    const size_t m = source_.size();
+    slots_.resize(faces_.size());
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 1024), [&](const auto& r) {
+      thread_local std::vector<uint32_t> outs, ins;
+      for (uint32_t i = r.begin(); i < r.end(); ++i) {
+        fan(i, outs, ins);
+        for (uint32_t s = offsets_[i], k = 0; s < offsets_[i + 1]; ++s, ++k) {
+          uint32_t j = outs[k];
+          bool twin = std::find(ins.begin(), ins.end(), j) != ins.end();
+          slots_[s] = (twin && i > j) ? Candidate{std::numeric_limits<float>::infinity(), kNone, kNone}
+                                      : evaluate(i, j);
+        }
+      }
+    });
+    order_.clear();
+    for (const Candidate& c : slots_)
+      if (c.a != kNone && std::isfinite(c.cost)) order_.push_back(c);
+    tbb::parallel_sort(order_.begin(), order_.end(),
+                       [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; });
+
+    // Pass limit (as meshoptimizer does): most collapses remove two triangles; allow costs up to 1.5x the one
+    // that would reach the target, so that the pass order stays close to the greedy order.
+    size_t goal = (alive_triangles_ - target + 1) / 2;
+    float limit = goal < order_.size() ? 1.5f * order_[goal].cost : std::numeric_limits<float>::infinity();
+    size_t collapsed = 0;
+    for (const Candidate& c : order_) {
+      if (c.cost > limit || alive_triangles_ <= target) break;
+      Plan p;
+      if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
+      if (p.a2 != kNone && (touched_[p.a2] || touched_[p.b2])) continue;
+      place(p);
+      if (try_collapse(p)) ++collapsed;
+    }
+    return collapsed;
+  }
+
+  template <class F>
+  void for_faces(uint32_t v, F&& f) const {
+    uint32_t w = v;
+    do {
+      for (uint32_t s = offsets_[w]; s < offsets_[w + 1]; ++s) {
+        uint32_t face = faces_[s];
+        if (indices_[3 * size_t(face)] != kNone) f(face);
+      }
+      w = wedge_[w];
+    } while (w != v);
+  }
+
+  std::vector<uint32_t> na_, nb_, apex_, removed_;
+
+  // Validity (link condition, boundary pinch, lost surface, normal change), bound, then the collapse.
+  bool try_collapse(const Plan& p) {
+    const uint32_t pa = pid_[p.a], pb = pid_[p.b];
+    const double ra = radius_[p.a] + glm::length(glm::dvec3(pos_[p.a]) - p.x);
+    const double rb = radius_[p.b] + glm::length(glm::dvec3(pos_[p.b]) - p.x);
+    const double r_new = std::max(ra, rb);
+    if (r_new > max_error_) {
+      error_limited_ = true;
+      return false;
+    }
+
+    na_.clear(), nb_.clear(), apex_.clear(), removed_.clear();
+    size_t kept_faces = 0;
+    for_faces(p.a, [&](uint32_t f) {
+      const uint32_t* t = &indices_[3 * size_t(f)];
+      uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
+      if (q[0] == pb || q[1] == pb || q[2] == pb) {
+        removed_.push_back(f);
+        for (uint32_t x : q)
+          if (x != pa && x != pb) apex_.push_back(x);
+      } else {
+        ++kept_faces;
+        for (uint32_t x : q)
+          if (x != pa) na_.push_back(x);
+      }
+    });
+    for_faces(p.b, [&](uint32_t f) {
+      const uint32_t* t = &indices_[3 * size_t(f)];
+      uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
+      if (q[0] == pa || q[1] == pa || q[2] == pa) return;
+      ++kept_faces;
+      for (uint32_t x : q)
+        if (x != pb) nb_.push_back(x);
+    });
+    const size_t expected = p.a2 == kNone ? (kind_[p.a] == kManifold ? 2 : 1) : 2;
+    if (removed_.size() == 0 || removed_.size() > expected || apex_.size() != removed_.size()) return false;
+    if (apex_.size() == 2 && apex_[0] == apex_[1]) return false;
+    const bool interior = kind_[p.a] == kManifold && kind_[p.b] == kManifold;
+    if (kept_faces < (interior ? 3u : 1u)) return false;
+    std::sort(na_.begin(), na_.end()), na_.erase(std::unique(na_.begin(), na_.end()), na_.end());
+    std::sort(nb_.begin(), nb_.end()), nb_.erase(std::unique(nb_.begin(), nb_.end()), nb_.end());
+    // Link condition: the neighbours a and b share are exactly the apexes of the removed faces; each apex
+    // keeps an edge to x (else a removed face's image would be a dangling edge and the bound would fail).
+    for (size_t i = 0, j = 0; i < na_.size() && j < nb_.size();) {
+      if (na_[i] < nb_[j])
+        ++i;
+      else if (nb_[j] < na_[i])
+        ++j;
+      else {
+        if (std::find(apex_.begin(), apex_.end(), na_[i]) == apex_.end()) return false;
+        ++i, ++j;
+      }
+    }
+    for (uint32_t c : apex_)
+      if (!std::binary_search(na_.begin(), na_.end(), c) && !std::binary_search(nb_.begin(), nb_.end(), c))
+        return false;
+
+    // Normal change of every face that stays and moves.
+    const glm::vec3 x(p.x);
+    const float cos_max = std::cos(glm::radians(opt_.max_normal_change_deg));
+    bool ok = true;
+    auto check = [&](uint32_t f) {
+      if (!ok) return;
+      const uint32_t* t = &indices_[3 * size_t(f)];
+      uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
+      if ((q[0] == pa || q[1] == pa || q[2] == pa) && (q[0] == pb || q[1] == pb || q[2] == pb)) return;
+      glm::vec3 p0 = pos_[t[0]], p1 = pos_[t[1]], p2 = pos_[t[2]];
+      glm::vec3 n0 = glm::cross(p1 - p0, p2 - p0);
+      glm::vec3 c[3] = {p0, p1, p2};
+      for (int k = 0; k < 3; ++k)
+        if (q[k] == pa || q[k] == pb) c[k] = x;
+      glm::vec3 n1 = glm::cross(c[1] - c[0], c[2] - c[0]);
+      float l0 = glm::length(n0), l1 = glm::length(n1);
+      if (!(l0 > 1e-30f)) return;  // already degenerate in the input: nothing to flip
+      if (!(l1 > 1e-6f * l0) || glm::dot(n0, n1) <= cos_max * l0 * l1) ok = false;
+    };
+    for_faces(p.a, check);
+    if (p.move) for_faces(p.b, check);
+    if (!ok) return false;
+
+    // Apply.
+    for (uint32_t f : removed_) indices_[3 * size_t(f)] = kNone;
+    for_faces(p.a, [&](uint32_t f) {
+      uint32_t* t = &indices_[3 * size_t(f)];
+      for (int k = 0; k < 3; ++k) {
+        if (t[k] == p.a) t[k] = p.b;
+        if (p.a2 != kNone && t[k] == p.a2) t[k] = p.b2;
+      }
+    });
+    alive_triangles_ -= removed_.size();
+    merge(p.a, p.b, p);
+    if (p.a2 != kNone) merge(p.a2, p.b2, p);
+    uint32_t v = p.b;
+    do {
+      radius_[v] = float(r_new);
+      if (p.move) pos_[v] = x, moved_[v] = 1;
+      touched_[v] = 1;
+      v = wedge_[v];
+    } while (v != p.b);
+    touched_[p.a] = 1;
+    if (p.a2 != kNone) touched_[p.a2] = 1;
+    bound_ = std::max(bound_, r_new);
+    if (record_) {
+      record_->push_back({p.a, p.b, step_, float(r_new)});
+      if (p.a2 != kNone) record_->push_back({p.a2, p.b2, step_, float(r_new)});
+      ++step_;
+    }
+    return true;
+  }
+
+  // Merges quadrics and sets b's attributes: the attribute quadric's optimum s* = (G.x + D)/W for weighted
+  // channels, linear interpolation along the edge for the others; half-edge collapses keep b's.
+  void merge(uint32_t a, uint32_t b, const Plan& p) {
+    if (p.move) {
+      glm::dvec3 pa(pos_[a]), pb(pos_[b]), e = pa - pb;
+      double ee = glm::dot(e, e);
+      float t = ee > 0 ? float(std::clamp(glm::dot(p.x - pb, e) / ee, 0.0, 1.0)) : 0.5f;
+      if (!nrm_.empty()) nrm_[b] = glm::mix(nrm_[b], nrm_[a], t);
+      if (!uv_.empty()) uv_[b] = glm::mix(uv_[b], uv_[a], t);
+      if (!col_.empty()) col_[b] = glm::mix(col_[b], col_[a], t);
+      double w = double(quadric_[a].w) + quadric_[b].w;
+      if (channels_ > 0 && w > 0) {
+        int j = 0;
+        auto solved = [&](float weight) {
+          const AttributeTerm &ta = attr_[a * size_t(channels_) + j], &tb = attr_[b * size_t(channels_) + j];
+          ++j;
+          return float((glm::dot(glm::dvec3(ta.g) + glm::dvec3(tb.g), p.x) + ta.d + tb.d) / w / weight);
+        };
+        if (!nrm_.empty() && opt_.normal_weight > 0)
+          for (int i = 0; i < 3; ++i) nrm_[b][i] = solved(opt_.normal_weight);
+        if (!uv_.empty() && opt_.uv_weight > 0)
+          for (int i = 0; i < 2; ++i) uv_[b][i] = solved(opt_.uv_weight);
+        if (!col_.empty() && opt_.color_weight > 0)
+          for (int i = 0; i < 4; ++i) col_[b][i] = solved(opt_.color_weight);
+      }
+      if (!nrm_.empty()) {
+        float l = glm::length(nrm_[b]);
+        nrm_[b] = l > 0 ? nrm_[b] / l : nrm_[a];
+      }
+      if (!col_.empty()) col_[b] = glm::clamp(col_[b], 0.0f, 1.0f);
+    }
+    quadric_[b].add(quadric_[a]);
+    for (int j = 0; j < channels_; ++j) {
+      attr_[b * size_t(channels_) + j].g += attr_[a * size_t(channels_) + j].g;
+      attr_[b * size_t(channels_) + j].d += attr_[a * size_t(channels_) + j].d;
+    }
+  }
+
+  // ---- output ------------------------------------------------------------------------------------------
+
+  void output(Result& result) {
+    compact_faces();
+    Mesh& out = result.mesh;
+    out.material = in_.material;
+    std::vector<uint32_t> remap(source_.size(), kNone);
+    const double slack = 1e-6 * double(scale_);  // float rounding of moved positions
+    for (uint32_t& v : indices_) {
+      if (remap[v] == kNone) {
+        remap[v] = uint32_t(out.positions.size());
+        out.positions.push_back(moved_[v] ? pos_[v] * scale_ + origin_ : in_.positions[source_[v]]);
+        if (!nrm_.empty()) out.normals.push_back(nrm_[v]);
+        if (!uv_.empty()) out.uvs.push_back(uv_[v]);
+        if (!col_.empty()) out.colors.push_back(col_[v]);
+        result.vertex_error.push_back(radius_[v] > 0 ? float(radius_[v] * scale_ * (1 + 1e-5) + slack)
+                                                     : 0.0f);
+      }
+      v = remap[v];
+    }
+    // Both surfaces lie in the union of their boxes, so its diagonal also bounds the Hausdorff distance.
+    Bounds both = in_.bounds();
+    both.add(out.bounds());
+    for (float& e : result.vertex_error) e = std::min(e, both.diagonal() * (1 + 1e-6f));
+    out.indices = std::move(indices_);
+    result.error_bound = 0.0;
+    for (float e : result.vertex_error) result.error_bound = std::max(result.error_bound, double(e));
+  }
+
+ public:
+  void set_record(std::vector<Collapse>* r) { record_ = r; }
+};
+
+}  // namespace
+
+Result simplify_mesh(const Mesh& mesh, const Options& options) {
+  Simplifier s(mesh, options);
+  Result result;
+  if (options.record_collapses) {
+    std::vector<Collapse> record;
+    s.set_record(&record);
+    result = s.run();
+    result.collapses = std::move(record);
+  } else {
+    result = s.run();
+  }
+  return result;
+}
+
+}  // namespace lodstream::simplify

@@ -1,0 +1,90 @@
+// Garland-Heckbert quadrics with Hoppe's (1999) sparse attribute terms. Internal to src/simplify.
+//
+// A plane quadric accumulates w * (n.p + d)^2 as Q = (A, b, c): A = sum w n n^T, b = sum w d n, c = sum w
+// d^2, so that Q(p) = p^T A p + 2 b.p + c (the book's Δ(x), digest §7.6.2). An attribute s interpolated
+// linearly over a face as s(p) = g.p + d adds (g.p + d - s)^2 per unit area; minimising over s gives s* =
+// (G.p + D) / W with G = sum area g, D = sum area d, W = sum area, and leaves the reduced position quadric A
+// - G G^T / W, b - G D / W, c - D^2 / W (Hoppe 99, eq. 3 eliminated in closed form).
+#pragma once
+
+#include <cmath>
+#include <glm/glm.hpp>
+
+namespace lodstream::simplify {
+
+struct Quadric {
+  float a00 = 0, a01 = 0, a02 = 0, a11 = 0, a12 = 0, a22 = 0;
+  float b0 = 0, b1 = 0, b2 = 0;
+  float c = 0;
+  float w = 0;  // area (attribute weight W); boundary penalties do not add to it
+
+  void add(const Quadric& q) {
+    a00 += q.a00, a01 += q.a01, a02 += q.a02, a11 += q.a11, a12 += q.a12, a22 += q.a22;
+    b0 += q.b0, b1 += q.b1, b2 += q.b2, c += q.c, w += q.w;
+  }
+  // Adds weight * (n.p + d)^2 (n need not be unit: a gradient g with offset d adds (g.p + d)^2).
+  void add_plane(const glm::vec3& n, float d, float weight) {
+    a00 += weight * n.x * n.x, a01 += weight * n.x * n.y, a02 += weight * n.x * n.z;
+    a11 += weight * n.y * n.y, a12 += weight * n.y * n.z, a22 += weight * n.z * n.z;
+    b0 += weight * d * n.x, b1 += weight * d * n.y, b2 += weight * d * n.z;
+    c += weight * d * d;
+  }
+};
+
+// Attribute part of one vertex's quadric: G (3) and D (1) per attribute channel, W shared (Quadric::w).
+struct AttributeTerm {
+  glm::vec3 g{0.0f};
+  float d = 0.0f;
+};
+
+// Symmetric 3x3 system in double precision, accumulated from quadrics and attribute reductions.
+struct Reduced {
+  double a00 = 0, a01 = 0, a02 = 0, a11 = 0, a12 = 0, a22 = 0;
+  double b0 = 0, b1 = 0, b2 = 0;
+  double c = 0;
+
+  void add(const Quadric& q) {
+    a00 += q.a00, a01 += q.a01, a02 += q.a02, a11 += q.a11, a12 += q.a12, a22 += q.a22;
+    b0 += q.b0, b1 += q.b1, b2 += q.b2, c += q.c;
+  }
+  // Subtracts G G^T / W, G D / W, D^2 / W for one attribute channel (the closed-form minimum over s).
+  void eliminate(const glm::dvec3& g, double d, double w) {
+    double iw = 1.0 / w;
+    a00 -= g.x * g.x * iw, a01 -= g.x * g.y * iw, a02 -= g.x * g.z * iw;
+    a11 -= g.y * g.y * iw, a12 -= g.y * g.z * iw, a22 -= g.z * g.z * iw;
+    b0 -= g.x * d * iw, b1 -= g.y * d * iw, b2 -= g.z * d * iw;
+    c -= d * d * iw;
+  }
+  // Q(p) = p^T A p + 2 b.p + c, clamped at 0 (rounding).
+  double eval(const glm::dvec3& p) const {
+    double r = a00 * p.x * p.x + a11 * p.y * p.y + a22 * p.z * p.z +
+               2 * (a01 * p.x * p.y + a02 * p.x * p.z + a12 * p.y * p.z) +
+               2 * (b0 * p.x + b1 * p.y + b2 * p.z) + c;
+    return r > 0 ? r : 0;
+  }
+  // Optimal placement: solves A x = -b by Cramer's rule; false when A is ill-conditioned
+  // (|det| below 1e-6 of the cube of its mean diagonal).
+  bool solve(glm::dvec3& x) const {
+    double c00 = a11 * a22 - a12 * a12, c01 = a02 * a12 - a01 * a22, c02 = a01 * a12 - a02 * a11;
+    double det = a00 * c00 + a01 * c01 + a02 * c02;
+    double s = (a00 + a11 + a22) / 3.0;
+    if (!(std::fabs(det) > 1e-6 * s * s * s) || s <= 0) return false;
+    double c11 = a00 * a22 - a02 * a02, c12 = a01 * a02 - a00 * a12, c22 = a00 * a11 - a01 * a01;
+    double inv = -1.0 / det;
+    x.x = (c00 * b0 + c01 * b1 + c02 * b2) * inv;
+    x.y = (c01 * b0 + c11 * b1 + c12 * b2) * inv;
+    x.z = (c02 * b0 + c12 * b1 + c22 * b2) * inv;
+    return std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z);
+  }
+  // Minimum along the segment p + t e, t in [0,1] (digest §7.6.2: t* = -(e^T A p + b.e) / (e^T A e)).
+  double segment_parameter(const glm::dvec3& p, const glm::dvec3& e) const {
+    glm::dvec3 ae{a00 * e.x + a01 * e.y + a02 * e.z, a01 * e.x + a11 * e.y + a12 * e.z,
+                  a02 * e.x + a12 * e.y + a22 * e.z};
+    double den = glm::dot(e, ae);
+    if (!(den > 0)) return 0.5;
+    double t = -(glm::dot(p, ae) + b0 * e.x + b1 * e.y + b2 * e.z) / den;
+    return t < 0 ? 0 : (t > 1 ? 1 : t);
+  }
+};
+
+}  // namespace lodstream::simplify

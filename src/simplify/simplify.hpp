@@ -1,0 +1,81 @@
+// Quadric edge-collapse simplification (Garland & Heckbert 97, attributes after Hoppe 99) with a tracked,
+// conservative two-sided error bound (the vertex-radius construction of the LOD book digest, §7.5: the
+// natural mapping of a vertex merge moves every surface point by at most the barycentric interpolation of its
+// triangle's vertex displacements, so r_new = max(r_a + |a - x|, r_b + |b - x|) bounds both one-sided
+// Hausdorff distances).
+//
+// Operator: edge collapse a -> b with optimal placement x (full edge) or x = b (half edge). Framework: passes
+// of independent collapses in quadric-cost order (a lazy queue that re-evaluates every edge once per pass, in
+// parallel), each pass limited to 1.5x the cost of the collapse that would reach the target, which keeps the
+// order close to greedy.
+//
+// Vertices are classified once (meshoptimizer's vertex kinds, extended): Manifold (interior), Border (one
+// open edge in and out), Seam (two vertices share the position and their open edges pair up: a UV, normal
+// or colour seam), Locked (user lock, non-manifold edge or fan, seam junctions, more than two wedges).
+// Border and seam vertices only collapse along their border / seam (a seam collapse moves both sides
+// together); locked vertices never move or disappear; anything may collapse into a locked vertex.
+// Validity of every collapse: link condition (no non-manifold edge or vertex, no boundary pinch, no lost
+// surface), no triangle normal turning by more than `max_normal_change_deg`, no new degenerate triangle.
+// Input with exact duplicate vertices is welded first; triangles that repeat a vertex are dropped.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "core/mesh.hpp"
+
+namespace lodstream::simplify {
+
+struct Options {
+  // Stop conditions: the first one met ends simplification. A triangle target is met within 1 % when the
+  // mesh can be reduced that far; `max_error` (model units) is never exceeded by the returned error bound.
+  size_t target_triangles = 0;
+  double max_error = std::numeric_limits<double>::infinity();
+
+  // Attribute weights in the collapse cost (attribute units per unit of the bounding-box extent): 0 drops the
+  // attribute from the cost (it is still interpolated). All 0 gives the positions-only metric.
+  float normal_weight = 0.5f;
+  float uv_weight = 1.0f;
+  float color_weight = 0.5f;
+  // Weight of the boundary / seam penalty planes (Garland & Heckbert's perpendicular planes), times |e|^2.
+  float boundary_weight = 20.0f;
+  // A collapse is rejected when any remaining triangle's normal turns by more than this (degrees).
+  float max_normal_change_deg = 80.0f;
+  // Half-edge collapses only: the kept vertex keeps its position and attributes (progressive meshes).
+  bool half_edge = false;
+  // Per input vertex, non-zero = locked (never moves, never removed). Empty = none locked.
+  std::vector<uint8_t> locked;
+  // Record the collapse sequence in Result::collapses (used by progressive meshes).
+  bool record_collapses = false;
+  // Called now and then with the fraction of the requested reduction done (0..1).
+  std::function<void(float)> progress;
+};
+
+// One half-edge collapse (record_collapses): vertex `removed` merged into vertex `kept` (input numbering,
+// after welding). A seam collapse is two records with the same `step`; `error_bound` is the mesh bound after
+// it.
+struct Collapse {
+  uint32_t removed;
+  uint32_t kept;
+  uint32_t step;
+  float error_bound;
+};
+
+struct Result {
+  Mesh mesh;                        // the simplified mesh; unused vertices are removed
+  double error_bound = 0.0;         // >= symmetric Hausdorff distance(result, input), model units
+  std::vector<float> vertex_error;  // per output vertex: the bound radius r_v (model units)
+  size_t input_triangles = 0;
+  bool target_reached = true;        // false when no valid collapse was left before the triangle target
+  std::vector<Collapse> collapses;   // with Options::record_collapses
+  std::vector<uint32_t> weld_remap;  // input vertex -> welded vertex (Collapse numbering)
+};
+
+// Simplifies `mesh`. Cost: O(T log T) time over a few passes, using both cores for cost evaluation; memory
+// about 100 bytes per input triangle. Never throws on odd input (non-manifold, degenerate, empty).
+Result simplify_mesh(const Mesh& mesh, const Options& options);
+
+}  // namespace lodstream::simplify

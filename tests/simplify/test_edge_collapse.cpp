@@ -1,0 +1,179 @@
+// Quadric edge collapse: topology, boundaries, seams, locks, flips, odd input, targets, and the two-sided
+// error bound against a brute-force sampled Hausdorff distance.
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "mesh_checks.hpp"
+#include "simplify/simplify.hpp"
+#include "support/shapes.hpp"
+
+using namespace lodstream;
+using namespace lodstream::test;
+using simplify::Options;
+using simplify::simplify_mesh;
+
+namespace {
+
+Options with_target(size_t triangles) {
+  Options o;
+  o.target_triangles = triangles;
+  return o;
+}
+
+TEST(EdgeCollapse, ClosedManifoldStaysClosedAndManifold) {
+  Mesh in = lumpy(sphere(1.0f, 24, 48), 1);
+  for (double ratio : {0.5, 0.1, 0.02}) {
+    size_t target = size_t(in.triangle_count() * ratio);
+    auto r = simplify_mesh(in, with_target(target));
+    EXPECT_TRUE(r.target_reached);
+    EXPECT_LE(r.mesh.triangle_count(), target);
+    EXPECT_GE(r.mesh.triangle_count() + target / 100 + 1, target);
+    EXPECT_TRUE(is_edge_manifold(r.mesh)) << ratio;
+    EXPECT_TRUE(boundary_edges(r.mesh).empty()) << ratio;
+  }
+}
+
+TEST(EdgeCollapse, TwoSidedBoundHoldsOnManyMeshesAndRatios) {
+  std::vector<Mesh> meshes = {lumpy(sphere(1.0f, 12, 24), 2), lumpy(uv_sphere(1.0f, 12, 24), 3),
+                              cube_with_seams(4), grid(12)};
+  for (auto& p : meshes[3].positions) p.z = 0.2f * std::sin(6 * p.x) * std::cos(5 * p.y);
+  for (size_t i = 0; i < meshes.size(); ++i)
+    for (double ratio : {0.5, 0.2, 0.05})
+      for (int mode = 0; mode < 3; ++mode) {
+        Options o = with_target(size_t(meshes[i].triangle_count() * ratio));
+        if (mode == 1) o.half_edge = true;
+        if (mode == 2) o.normal_weight = o.uv_weight = o.color_weight = 0;
+        auto r = simplify_mesh(meshes[i], o);
+        float measured = sampled_hausdorff(meshes[i], r.mesh);
+        EXPECT_LE(measured, r.error_bound) << "mesh " << i << " ratio " << ratio << " mode " << mode;
+        EXPECT_LE(r.error_bound, meshes[i].bounds().diagonal() * 1.01) << "mesh " << i << " ratio " << ratio;
+        for (float e : r.vertex_error) EXPECT_LE(e, r.error_bound);
+      }
+}
+
+TEST(EdgeCollapse, BoundaryIsKept) {
+  Mesh in = grid(16);
+  for (auto& p : in.positions) p.z = 0.1f * std::sin(5 * p.x + 2 * p.y);
+  auto r = simplify_mesh(in, with_target(60));
+  EXPECT_TRUE(is_edge_manifold(r.mesh));
+  // Every boundary edge stays on the square's border, and the corners stay.
+  auto open = boundary_edges(r.mesh);
+  ASSERT_FALSE(open.empty());
+  for (const auto& [a, b] : open) {
+    auto on_border = [](const Key& k) {
+      auto [x, y, z] = k;
+      return std::abs(x) < 1e-6f || std::abs(x - 1) < 1e-6f || std::abs(y) < 1e-6f || std::abs(y - 1) < 1e-6f;
+    };
+    EXPECT_TRUE(on_border(a) && on_border(b));
+  }
+  std::set<Key> corners;
+  for (const auto& p : r.mesh.positions)
+    if ((p.x == 0 || p.x == 1) && (p.y == 0 || p.y == 1)) corners.insert(key(p));
+  EXPECT_EQ(corners.size(), 4u);
+}
+
+TEST(EdgeCollapse, UvSeamIsKept) {
+  Mesh in = uv_sphere(1.0f, 16, 32);
+  auto r = simplify_mesh(in, with_target(in.triangle_count() / 8));
+  ASSERT_TRUE(r.mesh.has_uvs());
+  EXPECT_TRUE(is_edge_manifold(r.mesh));
+  // No triangle spans the seam in UV space, and the seam is still there (positions with two UVs).
+  size_t seam_vertices = 0;
+  std::map<Key, std::set<std::pair<float, float>>> uvs_at;
+  for (size_t v = 0; v < r.mesh.vertex_count(); ++v)
+    uvs_at[key(r.mesh.positions[v])].insert({r.mesh.uvs[v].x, r.mesh.uvs[v].y});
+  for (const auto& [k, set] : uvs_at) seam_vertices += set.size() > 1;
+  EXPECT_GE(seam_vertices, 2u);
+  for (size_t t = 0; t < r.mesh.triangle_count(); ++t) {
+    float u0 = r.mesh.uvs[r.mesh.indices[3 * t]].x, u1 = r.mesh.uvs[r.mesh.indices[3 * t + 1]].x,
+          u2 = r.mesh.uvs[r.mesh.indices[3 * t + 2]].x;
+    EXPECT_LT(std::max({u0, u1, u2}) - std::min({u0, u1, u2}), 0.9f);
+  }
+}
+
+TEST(EdgeCollapse, LockedVerticesNeverMoveOrDisappear) {
+  Mesh in = lumpy(sphere(1.0f, 16, 32), 4);
+  Options o = with_target(100);
+  o.locked.assign(in.vertex_count(), 0);
+  std::set<Key> locked;
+  for (size_t v = 0; v < in.vertex_count(); v += 7) o.locked[v] = 1, locked.insert(key(in.positions[v]));
+  auto r = simplify_mesh(in, o);
+  std::set<Key> out;
+  for (const auto& p : r.mesh.positions) out.insert(key(p));
+  for (const auto& k : locked) EXPECT_TRUE(out.count(k));
+  EXPECT_LT(r.mesh.triangle_count(), in.triangle_count() / 2);
+}
+
+TEST(EdgeCollapse, NoTriangleFlips) {
+  // On a star-shaped surface a flipped triangle faces the centre.
+  Mesh in = lumpy(sphere(1.0f, 24, 48), 5);
+  auto r = simplify_mesh(in, with_target(80));
+  for (size_t t = 0; t < r.mesh.triangle_count(); ++t) {
+    glm::vec3 a = r.mesh.positions[r.mesh.indices[3 * t]], b = r.mesh.positions[r.mesh.indices[3 * t + 1]],
+              c = r.mesh.positions[r.mesh.indices[3 * t + 2]];
+    EXPECT_GT(glm::dot(glm::cross(b - a, c - a), a + b + c), 0.0f) << t;
+  }
+}
+
+TEST(EdgeCollapse, OddInputIsHandled) {
+  // Non-manifold pieces, a second component, an unwelded copy (duplicate vertices) and degenerate triangles.
+  Mesh in = non_manifold();
+  Mesh s = lumpy(sphere(0.5f, 8, 16), 6);
+  auto append_unwelded = [&](const Mesh& m, glm::vec3 offset) {
+    for (size_t t = 0; t < m.indices.size(); ++t) {
+      uint32_t v = m.indices[t];
+      in.indices.push_back(uint32_t(in.positions.size()));
+      in.positions.push_back(m.positions[v] + offset);
+      if (in.has_normals()) in.normals.push_back(m.normals[v]);
+    }
+  };
+  in.normals.clear();
+  append_unwelded(s, {3, 0, 0});
+  append_unwelded(s, {0, 3, 0});
+  in.indices.insert(in.indices.end(), {0, 0, 1, 2, 2, 2});  // repeated vertices
+  in.positions.push_back(in.positions[0]);                  // zero-area triangle with a duplicate
+  in.indices.insert(in.indices.end(), {0, uint32_t(in.positions.size() - 1), 1});
+  auto r = simplify_mesh(in, with_target(in.triangle_count() / 4));
+  EXPECT_LT(r.mesh.triangle_count(), in.triangle_count() / 2);
+  for (uint32_t i : r.mesh.indices) ASSERT_LT(i, r.mesh.vertex_count());
+  EXPECT_LE(sampled_hausdorff(in, r.mesh), r.error_bound);
+  // Empty input.
+  auto e = simplify_mesh(Mesh{}, with_target(0));
+  EXPECT_EQ(e.mesh.triangle_count(), 0u);
+}
+
+TEST(EdgeCollapse, ErrorTargetIsNeverExceeded) {
+  Mesh in = lumpy(sphere(1.0f, 16, 32), 7);
+  for (double e : {0.05, 0.2, 0.5}) {
+    Options o;
+    o.max_error = e;
+    auto r = simplify_mesh(in, o);
+    EXPECT_LE(r.error_bound, e);
+    EXPECT_TRUE(r.target_reached);
+    EXPECT_LT(r.mesh.triangle_count(), in.triangle_count());
+    EXPECT_LE(sampled_hausdorff(in, r.mesh), r.error_bound);
+  }
+  // Below the first collapse's bound nothing changes, and the bound is 0.
+  Options o;
+  o.max_error = 1e-4;
+  auto r = simplify_mesh(in, o);
+  EXPECT_EQ(r.mesh.triangle_count(), in.triangle_count());
+  EXPECT_EQ(r.error_bound, 0.0);
+}
+
+TEST(EdgeCollapse, ShortfallIsReported) {
+  // A cube with flat-shaded faces: every corner is a seam junction (locked), so it cannot go below 12.
+  auto r = simplify_mesh(cube_with_seams(6), with_target(4));
+  EXPECT_FALSE(r.target_reached);
+  EXPECT_GE(r.mesh.triangle_count(), 12u);
+  EXPECT_LT(r.mesh.triangle_count(), 6u * 72u);
+}
+
+TEST(EdgeCollapse, FlatRegionsCollapseWithoutError) {
+  auto r = simplify_mesh(cube_with_seams(6), with_target(12));
+  EXPECT_EQ(r.mesh.triangle_count(), 12u);
+  EXPECT_LT(sampled_hausdorff(cube_with_seams(6), r.mesh), 1e-5f);
+}
+
+}  // namespace
