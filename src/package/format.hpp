@@ -1,0 +1,81 @@
+// The fixed parts of the .lods format: header/trailer, limits, checksums, content hash and page compression.
+//
+// File layout (all integers little-endian):
+//   [header 64 B][data pages and blobs][index pages][root index][trailer 64 B]
+// The trailer is a byte-for-byte copy of the header, so a client gets the trailer and (usually) the whole
+// root index with ONE suffix range request (`bytes=-65536`), or reads the header at offset 0 first. Header
+// fields:
+//   0  magic "\x89LODS\r\n\x1a"        8  u32 format version          12 u32 header size (64)
+//   16 u64 file size                    24 u64 root index offset       32 u32 root index size (zstd)
+//   36 u32 root index size raw          40 u64 XXH3-64 of the root index bytes
+//   48 16 B content hash: XXH3-128 of every byte between header and trailer (low 64 bits, then high)
+// The content hash names a package's content (HTTP ETag, client cache key); it is checked on demand
+// (PackageReader::verify) because that reads the whole file. Each page, index page, blob and the root index
+// carry their own XXH3-64 of their stored bytes, checked on every read (about 20 GB/s, free next to zstd).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace lodstream::package {
+
+inline constexpr std::array<uint8_t, 8> kMagic = {0x89, 'L', 'O', 'D', 'S', '\r', '\n', 0x1a};
+inline constexpr uint32_t kFormatVersion = 1;
+inline constexpr size_t kHeaderSize = 64;
+
+// Hard limits a reader enforces before allocating: no valid writer output exceeds them.
+inline constexpr uint32_t kMaxRootRawBytes = 64u << 20;
+inline constexpr uint32_t kMaxIndexPageRawBytes = 16u << 20;
+inline constexpr uint32_t kMaxPageRawBytes = 16u << 20;
+
+struct ContentHash {
+  uint64_t low = 0, high = 0;
+  bool operator==(const ContentHash&) const = default;
+  // 32 lowercase hex digits (high then low), usable as an HTTP ETag or a cache directory name.
+  std::string hex() const;
+};
+
+struct Header {
+  uint32_t version = kFormatVersion;
+  uint64_t file_size = 0;
+  uint64_t root_offset = 0;
+  uint32_t root_size = 0;
+  uint32_t root_raw_size = 0;
+  uint64_t root_checksum = 0;
+  ContentHash content_hash;
+};
+
+std::array<uint8_t, kHeaderSize> encode_header(const Header& header);
+// Parses and checks magic, version and header size, and that the root index lies between the header and the
+// trailer of a file of `file_size` bytes. `context` names the file and which copy (header or trailer).
+Header decode_header(std::span<const uint8_t, kHeaderSize> bytes, uint64_t file_size,
+                     const std::string& context);
+
+// XXH3-64 of `bytes` (the per-page checksum).
+uint64_t checksum64(std::span<const uint8_t> bytes);
+
+// Streaming XXH3-128 (the content hash). Cost: about 20 GB/s.
+class ContentHasher {
+ public:
+  ContentHasher();
+  ~ContentHasher();
+  ContentHasher(const ContentHasher&) = delete;
+  ContentHasher& operator=(const ContentHasher&) = delete;
+  void update(std::span<const uint8_t> bytes);
+  ContentHash digest() const;
+
+ private:
+  void* state_;
+};
+
+// zstd frame of `raw` at `level` (1..22). Throws lodstream::Error if zstd fails.
+std::vector<uint8_t> zstd_compress(std::span<const uint8_t> raw, int level);
+// Decompresses one zstd frame that must hold exactly `raw_size` bytes (checked against the frame header
+// before allocating, and after). `context` names the file and part for the error message.
+std::vector<uint8_t> zstd_decompress(std::span<const uint8_t> frame, uint32_t raw_size,
+                                     const std::string& context);
+
+}  // namespace lodstream::package

@@ -1,0 +1,112 @@
+// The package index: what a client reads before any geometry. The root index holds the scene (materials,
+// representations, objects), the page / index-page / blob tables and the node records of ids [0, root_nodes);
+// the other node records live in index pages of consecutive ids, fetched on demand. Serialized with varints
+// and zstd-compressed; parse_* validates every count, index and float against the tables it refers to.
+#pragma once
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/bounds.hpp"
+#include "core/scene.hpp"
+#include "package/node_codec.hpp"
+
+namespace lodstream::package {
+
+inline constexpr uint32_t kNone = UINT32_MAX;
+
+// What a node stands for.
+enum class NodeKind : uint8_t { cluster = 0, progressive_step = 1, hlod_proxy = 2, imposter = 3 };
+// How its bytes are stored: through the package's node codec, or raw caller bytes (imposter images, ...).
+enum class NodeEncoding : uint8_t { codec = 0, raw = 1 };
+enum class RepresentationKind : uint8_t { cluster_dag = 0, progressive_mesh = 1, hlod = 2, imposter_set = 3 };
+
+// One node (the unit of selection). Errors are totals in object units (DESIGN.md, Data model); parent_error
+// is +infinity for a node nobody replaces (a root). Links are node ids: `children` = the nodes this one was
+// simplified from (the group it came from), `parents` = the nodes it was simplified into (the group that
+// replaces it); `objects` = objects this node stands for (HLOD proxies), empty for a representation's own
+// nodes.
+struct NodeRecord {
+  NodeKind kind = NodeKind::cluster;
+  NodeEncoding encoding = NodeEncoding::codec;
+  uint32_t representation = 0;
+  uint32_t material = 0;
+  uint32_t level = 0;  // 0 = finest
+  // Where its bytes are: [offset, offset + size) of the decompressed page `page`. Filled in by the writer.
+  uint32_t page = 0, offset = 0, size = 0;
+  uint32_t triangles = 0, vertices = 0;
+  float error = 0.0f;
+  Sphere sphere;
+  float parent_error = std::numeric_limits<float>::infinity();
+  Sphere parent_sphere;
+  std::vector<uint32_t> children, parents, objects;
+};
+
+struct PackageMaterial {
+  Material material;  // material.base_color_texture: a path (relative to the package) when not embedded
+  uint32_t texture_blob = kNone;  // the embedded image file's blob, or kNone
+};
+
+// A multiresolution representation (shared by every object that instances it).
+struct Representation {
+  RepresentationKind kind = RepresentationKind::cluster_dag;
+  std::string name;
+  Bounds bounds;      // object space
+  PositionGrid grid;  // quantization grid of its nodes
+  uint32_t levels = 1;
+  std::vector<uint32_t> roots;  // its coarsest nodes: where traversal starts
+};
+
+struct ObjectRecord {
+  std::string name;
+  glm::mat4 transform{1.0f};  // object to world
+  uint32_t representation = 0;
+};
+
+// A stored byte range: [offset, offset + size) of the file, XXH3-64 `checksum` of those bytes, `raw_size`
+// bytes after zstd (0 for a blob, stored as is).
+struct Range {
+  uint64_t offset = 0;
+  uint32_t size = 0;
+  uint32_t raw_size = 0;
+  uint64_t checksum = 0;
+};
+
+struct IndexPage {
+  Range range;
+  uint32_t first_node = 0, node_count = 0;
+};
+
+// The scene part of the root index, as the caller of the writer describes it.
+struct PackageScene {
+  uint64_t input_triangles = 0;  // of the model(s) the package was baked from
+  std::string metadata;          // free text for the baker (e.g. JSON build options)
+  std::vector<PackageMaterial> materials;
+  std::vector<Representation> representations;
+  std::vector<ObjectRecord> objects;
+};
+
+struct RootIndex {
+  uint32_t codec = 0;
+  PackageScene scene;
+  std::vector<Range> pages;
+  std::vector<Range> blobs;
+  std::vector<IndexPage> index_pages;
+  uint32_t node_count = 0;             // all nodes
+  std::vector<NodeRecord> root_nodes;  // ids [0, root_nodes.size())
+};
+
+std::vector<uint8_t> serialize_root(const RootIndex& root);
+// Parses and validates (tables, index page coverage of [root_nodes, node_count), every node record).
+RootIndex parse_root(std::span<const uint8_t> raw, const std::string& context);
+
+std::vector<uint8_t> serialize_nodes(std::span<const NodeRecord> nodes, uint32_t first_id);
+// Parses exactly `count` records of ids first_id.. and validates each against `root`.
+std::vector<NodeRecord> parse_nodes(std::span<const uint8_t> raw, const RootIndex& root, uint32_t first_id,
+                                    uint32_t count, const std::string& context);
+
+}  // namespace lodstream::package

@@ -1,0 +1,41 @@
+// The first node codec (id 1): quantization + meshoptimizer 0.18's vertex and index codecs; zstd is applied
+// later, per page, by the writer.
+//
+// Bytes of a node:
+//   u8 format (1), u8 flags (1 normals, 2 uvs, 4 colors, 8 vertex_data, 16 wide positions), u8 position_shift
+//   k, u8 normal_bits; varint vertex count V (≤ 65536), varint triangle count T, varint first_vertex; svarint
+//   cmin[3]; [uvs: f32 uv_min[2], f32 uv_extent[2]]; varint size of the vertex, locked and index streams; the
+//   streams.
+// Vertex stream: meshopt_encodeVertexBuffer over ONE interleaved record per vertex (meshopt codes each byte
+//   column on its own, so interleaving costs nothing and saves a per-stream tail): position c - cmin as u16x3
+//   (u32x3 when the node spans more than 65536 coarse steps), octahedral normal s8x2 (bits ≤ 8) or s16x2, UV
+//   u16x2 unorm over the node's UV box, colour RGBA8 unorm, vertex_data u32; zero padding to a multiple of 4.
+// Locked stream (only when k > 0): a bit per vertex (locked or not), then the k low bits of x, y, z of each
+//   locked vertex, packed LSB first.
+// Index stream: meshopt_encodeIndexBuffer (format version 1) of the triangles.
+//
+// How precision is spent. q = round((p - origin) / step) on the representation's grid (finest step, error per
+// axis ≤ step/2). A free vertex stores c = round(q / 2^k) and decodes to c * 2^k (error per axis ≤ step/2 +
+// 2^k step/2); a locked vertex stores c = floor(q / 2^k) plus its k low bits and decodes to q exactly. Each
+// unused low bit of a free vertex saves about one bit per coordinate before zstd; the bits of locked vertices
+// (shared with nodes at other shifts) are never dropped, so their decoded positions agree bit for bit
+// everywhere. Normals: octahedral at normal_bits per component (max angular error about 2^(2 - normal_bits)
+// radians); UVs: 16 bits over the node's own UV box; colours: 8 bits.
+#pragma once
+
+#include "package/node_codec.hpp"
+
+namespace lodstream::package {
+
+class MeshoptCodec final : public NodeCodec {
+ public:
+  static constexpr uint32_t kId = 1;
+  MeshoptCodec();
+  uint32_t id() const override { return kId; }
+  std::vector<uint8_t> encode(const NodeGeometry& geometry, const PositionGrid& grid) const override;
+  DecodedNode decode(std::span<const uint8_t> bytes, const PositionGrid& grid,
+                     const std::string& where) const override;
+  NodeSizeBreakdown breakdown(std::span<const uint8_t> bytes, const std::string& where) const override;
+};
+
+}  // namespace lodstream::package

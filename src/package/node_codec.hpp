@@ -1,0 +1,93 @@
+// The node codec: turns one node's geometry (a chunk of a lodstream::Mesh, at most 65536 vertices) into bytes
+// and back. Everything else in the package treats a node's bytes as opaque and reaches the codec only through
+// this interface, so a better codec replaces this one by adding a class and an id (the root index records
+// which codec wrote the package).
+//
+// Positions live on a per-representation integer grid (PositionGrid): q = round((p - origin) / step), decoded
+// as origin + q * step. A node may spend fewer bits (position_shift k: free vertices are rounded to multiples
+// of 2^k grid steps), EXCEPT vertices flagged `locked`, which always decode to the exact finest-grid value.
+// Because the grid is shared by every node of a representation and the decode is one deterministic formula, a
+// vertex that two nodes store as locked (or with the same shift) decodes bit-identically in both: that keeps
+// cuts crack-free. See MeshoptCodec for how the remaining precision is spent.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/bounds.hpp"
+#include "core/mesh.hpp"
+
+namespace lodstream::package {
+
+// The quantization grid of one representation (object space). step is the finest step.
+struct PositionGrid {
+  glm::vec3 origin{0.0f};
+  float step = 1.0f;
+
+  // The grid with origin at the box minimum and step = diagonal * 2^-bits (bits = 14 gives the ≤ 2^-14 of the
+  // diagonal that DESIGN.md requires of the finest level; the error per axis is at most step / 2).
+  static PositionGrid for_bounds(const Bounds& bounds, int bits = 14);
+};
+
+// One node's geometry as the caller hands it to a codec.
+struct NodeGeometry {
+  const Mesh* mesh = nullptr;  // positions required; normals, uvs, colors optional; material is not stored
+  // Per vertex, nonzero = locked: decoded exactly on the finest grid whatever the shift. Empty = none locked.
+  // Flag every vertex that another node stores with a different position_shift (group borders of a cluster
+  // DAG).
+  std::span<const uint8_t> locked;
+  // Free vertices are rounded to multiples of 2^position_shift finest-grid steps (0 = finest). A coarse node
+  // whose error is e may use a shift with 2^k * step well below e.
+  uint32_t position_shift = 0;
+  // Octahedral normal precision, bits per component (4..16).
+  uint32_t normal_bits = 10;
+  // Progressive-mesh chunks: this chunk's vertex i is vertex first_vertex + i of the representation, and
+  // indices may refer to any vertex below first_vertex + vertex_count (earlier chunks). With first_vertex > 0
+  // or preserve_order, the codec keeps vertex and triangle order; otherwise it reorders both for compression.
+  uint32_t first_vertex = 0;
+  bool preserve_order = false;
+  // Optional 32-bit value per vertex, stored losslessly and opaque to the codec (e.g. a collapse parent).
+  std::span<const uint32_t> vertex_data;
+};
+
+// A decoded node: `mesh.indices` number vertices as the representation does (chunk vertex i is first_vertex +
+// i; for ordinary nodes first_vertex = 0 and indices < vertex_count). The same triangles with the same
+// winding as encoded, possibly reordered, each possibly rotated; attributes within the quantization error.
+struct DecodedNode {
+  Mesh mesh;
+  uint32_t first_vertex = 0;
+  std::vector<uint32_t> vertex_data;
+};
+
+// Bytes of each part of one encoded node (before zstd), for size reports.
+// (Attributes share one vertex stream; measure one attribute's cost by encoding with and without it.)
+struct NodeSizeBreakdown {
+  size_t header = 0, vertices = 0, locked = 0, indices = 0;
+  size_t total() const { return header + vertices + locked + indices; }
+};
+
+class NodeCodec {
+ public:
+  virtual ~NodeCodec() = default;
+  // The id recorded in the package; unique per codec and per incompatible revision of its byte format.
+  virtual uint32_t id() const = 0;
+  // Encodes; throws lodstream::Error on invalid input (sizes, > 65536 vertices, indices out of range,
+  // positions off the grid's range). Thread-safe: callers may encode many nodes in parallel.
+  virtual std::vector<uint8_t> encode(const NodeGeometry& geometry, const PositionGrid& grid) const = 0;
+  // Decodes bytes from any source: every size, count and index is checked, so a corrupted node gives a
+  // lodstream::Error starting with `where`, never a crash or an allocation larger than a small multiple of
+  // bytes.size() + 65536 vertices. Thread-safe.
+  virtual DecodedNode decode(std::span<const uint8_t> bytes, const PositionGrid& grid,
+                             const std::string& where) const = 0;
+  // Where an encoded node's bytes go (parses only its header). Throws like decode.
+  virtual NodeSizeBreakdown breakdown(std::span<const uint8_t> bytes, const std::string& where) const = 0;
+};
+
+// The codec that new packages are written with.
+const NodeCodec& default_node_codec();
+// The codec a package names; throws lodstream::Error for an unknown id.
+const NodeCodec& node_codec(uint32_t id);
+
+}  // namespace lodstream::package

@@ -1,0 +1,218 @@
+#include "package/reader.hpp"
+
+#include <algorithm>
+
+#include "core/error.hpp"
+
+namespace lodstream::package {
+
+namespace {
+constexpr uint64_t kOpenReadBytes = 64 * 1024;
+}
+
+PackageReader PackageReader::open(const std::filesystem::path& file) {
+  return PackageReader(std::make_shared<FileSource>(file));
+}
+
+PackageReader::PackageReader(std::shared_ptr<const ByteSource> source) : source_(std::move(source)) {
+  const uint64_t size = source_->size();
+  if (size < 2 * kHeaderSize) {
+    throw Error(where("too small to be a .lods package (" + std::to_string(size) + " bytes)"));
+  }
+  // One read of the tail: the trailer and usually the whole root index.
+  const uint64_t tail_size = std::min(size, kOpenReadBytes);
+  const uint64_t tail_offset = size - tail_size;
+  std::vector<uint8_t> tail(tail_size);
+  source_->read(tail_offset, tail);
+  std::copy(tail.end() - kHeaderSize, tail.end(), trailer_.begin());
+  header_ = decode_header(std::span<const uint8_t, kHeaderSize>(trailer_), size, where("trailer"));
+
+  const Range root_range{header_.root_offset, header_.root_size, header_.root_raw_size,
+                         header_.root_checksum};
+  std::vector<uint8_t> raw_root;
+  if (root_range.offset >= tail_offset) {
+    auto first = tail.begin() + std::ptrdiff_t(root_range.offset - tail_offset);
+    raw_root = unpack(root_range, std::span<const uint8_t>(&*first, root_range.size), "root index");
+  } else {
+    raw_root = unpack(root_range, read_range(root_range, "root index"), "root index");
+  }
+  root_ = parse_root(raw_root, where("root index"));
+  codec_ = &node_codec(root_.codec);
+  check_layout();
+  index_pages_.resize(root_.index_pages.size());
+}
+
+// Every stored range lies between the header and the root index, and no two overlap.
+void PackageReader::check_layout() const {
+  struct Span {
+    uint64_t offset, size;
+    std::string what;
+  };
+  std::vector<Span> spans;
+  spans.reserve(root_.pages.size() + root_.blobs.size() + root_.index_pages.size());
+  for (size_t i = 0; i < root_.pages.size(); ++i) {
+    spans.push_back({root_.pages[i].offset, root_.pages[i].size, "page " + std::to_string(i)});
+  }
+  for (size_t i = 0; i < root_.blobs.size(); ++i) {
+    if (root_.blobs[i].raw_size != root_.blobs[i].size)
+      throw Error(where("blob " + std::to_string(i) + " has inconsistent sizes"));
+    spans.push_back({root_.blobs[i].offset, root_.blobs[i].size, "blob " + std::to_string(i)});
+  }
+  for (size_t i = 0; i < root_.index_pages.size(); ++i) {
+    spans.push_back({root_.index_pages[i].range.offset, root_.index_pages[i].range.size,
+                     "index page " + std::to_string(i)});
+  }
+  std::sort(spans.begin(), spans.end(), [](const Span& a, const Span& b) { return a.offset < b.offset; });
+  uint64_t end = kHeaderSize;
+  for (const Span& s : spans) {
+    if (s.offset < end)
+      throw Error(
+          where(s.what + " at offset " + std::to_string(s.offset) + " overlaps the header or another range"));
+    if (s.size > header_.root_offset || s.offset > header_.root_offset - s.size) {
+      throw Error(where(s.what + " [" + std::to_string(s.offset) + ", +" + std::to_string(s.size) +
+                        ") extends past the start of the root index"));
+    }
+    end = s.offset + s.size;
+  }
+}
+
+std::vector<uint8_t> PackageReader::read_range(const Range& range, const std::string& what) const {
+  // Ranges were checked against the layout at open (the root index's against the header), so this allocation
+  // is bounded by the file size.
+  std::vector<uint8_t> stored(range.size);
+  source_->read(range.offset, stored);
+  (void)what;
+  return stored;
+}
+
+std::vector<uint8_t> PackageReader::unpack(const Range& range, std::span<const uint8_t> stored,
+                                           const std::string& what) const {
+  if (stored.size() != range.size) {
+    throw Error(where(what + ": " + std::to_string(stored.size()) + " bytes given, " +
+                      std::to_string(range.size) + " expected"));
+  }
+  if (checksum64(stored) != range.checksum) {
+    throw Error(
+        where(what + " at offset " + std::to_string(range.offset) + ": checksum mismatch (corrupted)"));
+  }
+  return zstd_decompress(stored, range.raw_size, where(what));
+}
+
+uint32_t PackageReader::index_page_of(uint32_t id) const {
+  if (id >= root_.node_count) {
+    throw Error(where("node " + std::to_string(id) + " does not exist (" + std::to_string(root_.node_count) +
+                      " nodes)"));
+  }
+  if (id < root_.root_nodes.size()) return kNone;
+  auto it = std::upper_bound(root_.index_pages.begin(), root_.index_pages.end(), id,
+                             [](uint32_t v, const IndexPage& p) { return v < p.first_node; });
+  return uint32_t(it - root_.index_pages.begin()) - 1;
+}
+
+bool PackageReader::has_node(uint32_t id) const {
+  uint32_t page = index_page_of(id);
+  return page == kNone || !index_pages_[page].empty();
+}
+
+void PackageReader::add_index_page(uint32_t page, std::span<const uint8_t> stored) {
+  if (page >= root_.index_pages.size())
+    throw Error(where("index page " + std::to_string(page) + " does not exist"));
+  const IndexPage& p = root_.index_pages[page];
+  const std::string what = "index page " + std::to_string(page);
+  std::vector<uint8_t> raw = unpack(p.range, stored, what);
+  index_pages_[page] = parse_nodes(raw, root_, p.first_node, p.node_count, where(what));
+}
+
+const NodeRecord& PackageReader::node(uint32_t id) {
+  uint32_t page = index_page_of(id);
+  if (page == kNone) return root_.root_nodes[id];
+  if (index_pages_[page].empty()) {
+    add_index_page(page, read_range(root_.index_pages[page].range, "index page"));
+  }
+  return index_pages_[page][id - root_.index_pages[page].first_node];
+}
+
+std::vector<uint8_t> PackageReader::unpack_page(uint32_t page, std::span<const uint8_t> stored) const {
+  if (page >= root_.pages.size()) throw Error(where("page " + std::to_string(page) + " does not exist"));
+  return unpack(root_.pages[page], stored, "page " + std::to_string(page));
+}
+
+std::vector<uint8_t> PackageReader::read_page(uint32_t page) const {
+  if (page >= root_.pages.size()) throw Error(where("page " + std::to_string(page) + " does not exist"));
+  return unpack_page(page, read_range(root_.pages[page], "page"));
+}
+
+std::span<const uint8_t> PackageReader::node_bytes(uint32_t id, std::span<const uint8_t> page) {
+  const NodeRecord& n = node(id);
+  if (page.size() != root_.pages[n.page].raw_size) {
+    throw Error(where("node " + std::to_string(id) + ": given page is not page " + std::to_string(n.page)));
+  }
+  return page.subspan(n.offset, n.size);  // offset + size <= raw_size was checked when the record was parsed
+}
+
+DecodedNode PackageReader::decode_node(uint32_t id, std::span<const uint8_t> page) {
+  const NodeRecord& n = node(id);
+  const std::string what = where("node " + std::to_string(id) + " (page " + std::to_string(n.page) + ")");
+  if (n.encoding != NodeEncoding::codec) throw Error(what + ": holds raw bytes, not codec geometry");
+  std::span<const uint8_t> bytes = node_bytes(id, page);
+  DecodedNode decoded = codec_->decode(bytes, root_.scene.representations[n.representation].grid, what);
+  if (decoded.mesh.triangle_count() != n.triangles || decoded.mesh.vertex_count() != n.vertices) {
+    throw Error(what + ": record says " + std::to_string(n.triangles) + " triangles / " +
+                std::to_string(n.vertices) + " vertices, its bytes hold " +
+                std::to_string(decoded.mesh.triangle_count()) + " / " +
+                std::to_string(decoded.mesh.vertex_count()));
+  }
+  decoded.mesh.material = n.material;
+  return decoded;
+}
+
+DecodedNode PackageReader::load_node(uint32_t id) {
+  return decode_node(id, read_page(node(id).page));
+}
+
+std::vector<uint8_t> PackageReader::read_blob(uint32_t blob) const {
+  if (blob >= root_.blobs.size()) throw Error(where("blob " + std::to_string(blob) + " does not exist"));
+  const Range& r = root_.blobs[blob];
+  std::vector<uint8_t> bytes = read_range(r, "blob");
+  if (checksum64(bytes) != r.checksum) {
+    throw Error(where("blob " + std::to_string(blob) + " at offset " + std::to_string(r.offset) +
+                      ": checksum mismatch (corrupted)"));
+  }
+  return bytes;
+}
+
+void PackageReader::verify() const {
+  std::array<uint8_t, kHeaderSize> header_bytes{};
+  source_->read(0, header_bytes);
+  if (header_bytes != trailer_) throw Error(where("header and trailer differ (corrupted)"));
+  ContentHasher hasher;
+  std::vector<uint8_t> chunk(1 << 20);
+  const uint64_t end = header_.file_size - kHeaderSize;
+  for (uint64_t at = kHeaderSize; at < end;) {
+    size_t n = size_t(std::min<uint64_t>(chunk.size(), end - at));
+    source_->read(at, std::span(chunk).first(n));
+    hasher.update(std::span(chunk).first(n));
+    at += n;
+  }
+  if (hasher.digest() != header_.content_hash) {
+    throw Error(where("content hash mismatch: the file was modified or corrupted"));
+  }
+}
+
+void PackageReader::verify_contents() {
+  verify();
+  for (uint32_t page = 0; page < root_.index_pages.size(); ++page) {
+    if (index_pages_[page].empty())
+      add_index_page(page, read_range(root_.index_pages[page].range, "index page"));
+  }
+  std::vector<std::vector<uint32_t>> nodes_of_page(root_.pages.size());
+  for (uint32_t id = 0; id < root_.node_count; ++id) nodes_of_page[node(id).page].push_back(id);
+  for (uint32_t page = 0; page < root_.pages.size(); ++page) {
+    std::vector<uint8_t> raw = read_page(page);
+    for (uint32_t id : nodes_of_page[page]) {
+      if (node(id).encoding == NodeEncoding::codec) decode_node(id, raw);
+    }
+  }
+}
+
+}  // namespace lodstream::package

@@ -1,0 +1,80 @@
+// PackageReader: reads a .lods package through a ByteSource, fetching only what is asked for. Opening costs
+// one read (the file's last 64 KiB: trailer and, for any root index that fits, the root index) and validates
+// the whole root index; index pages and data pages are fetched on demand. Every offset, size, count and index
+// is checked before use and every stored range's checksum before decompression, so a truncated, corrupted or
+// hostile file gives a one-line lodstream::Error naming the source and what is wrong, never a crash or an
+// allocation beyond the format's limits (format.hpp).
+//
+// Thread safety: const member functions may run concurrently (read_page, unpack_page, decode); node() and
+// decode_node() load index pages into the reader and need external synchronisation.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "package/byte_source.hpp"
+#include "package/format.hpp"
+#include "package/index.hpp"
+
+namespace lodstream::package {
+
+class PackageReader {
+ public:
+  explicit PackageReader(std::shared_ptr<const ByteSource> source);
+  // A reader over a local file.
+  static PackageReader open(const std::filesystem::path& file);
+
+  const ByteSource& source() const { return *source_; }
+  const Header& header() const { return header_; }
+  const RootIndex& root() const { return root_; }
+  const PackageScene& scene() const { return root_.scene; }
+  const NodeCodec& codec() const { return *codec_; }
+  uint32_t node_count() const { return root_.node_count; }
+
+  // The index page that holds node `id`'s record, or kNone when the root index holds it.
+  uint32_t index_page_of(uint32_t id) const;
+  // Whether node `id`'s record is available without a read.
+  bool has_node(uint32_t id) const;
+  // Node `id`'s record, reading its index page first if needed (one read of that page).
+  const NodeRecord& node(uint32_t id);
+  // Installs index page `page` from bytes received some other way (a push stream): checked like a read.
+  void add_index_page(uint32_t page, std::span<const uint8_t> stored);
+
+  // Data page `page`, read, checked and decompressed.
+  std::vector<uint8_t> read_page(uint32_t page) const;
+  // Checks and decompresses data page `page`'s stored bytes received some other way.
+  std::vector<uint8_t> unpack_page(uint32_t page, std::span<const uint8_t> stored) const;
+  // Node `id`'s bytes inside its decompressed page.
+  std::span<const uint8_t> node_bytes(uint32_t id, std::span<const uint8_t> page);
+  // Decodes codec node `id` from its decompressed page and checks the result against the node's record
+  // (counts, and every index within the representation's vertices).
+  DecodedNode decode_node(uint32_t id, std::span<const uint8_t> page);
+  // read_page + decode_node.
+  DecodedNode load_node(uint32_t id);
+  // Blob `blob` (an embedded texture file), read and checked.
+  std::vector<uint8_t> read_blob(uint32_t blob) const;
+
+  // Reads the whole file: the header at offset 0 must equal the trailer and the content hash must match.
+  void verify() const;
+  // verify(), then loads every index page, unpacks every data page and decodes every codec node. Cost: a full
+  // read and decode of the package.
+  void verify_contents();
+
+ private:
+  std::vector<uint8_t> read_range(const Range& range, const std::string& what) const;
+  std::vector<uint8_t> unpack(const Range& range, std::span<const uint8_t> stored,
+                              const std::string& what) const;
+  void check_layout() const;
+  std::string where(const std::string& what) const { return source_->name() + ": " + what; }
+
+  std::shared_ptr<const ByteSource> source_;
+  std::array<uint8_t, kHeaderSize> trailer_{};
+  Header header_;
+  RootIndex root_;
+  const NodeCodec* codec_ = nullptr;
+  std::vector<std::vector<NodeRecord>> index_pages_;  // loaded records, by index page (empty until loaded)
+};
+
+}  // namespace lodstream::package

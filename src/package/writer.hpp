@@ -1,0 +1,96 @@
+// PackageWriter: streams nodes' encoded bytes into zstd-compressed data pages of a new .lods file, then
+// writes the index pages, the root index and the header, and renames the file into place. Until finish()
+// returns, only a temporary file next to the target exists (removed by the destructor if finish() was not
+// reached), so an interrupted bake never leaves a broken package.
+//
+// Page packing follows the caller: nodes added between two end_group() calls form a group (a DAG group's
+// clusters, a subtree's coarse levels); groups are appended in call order and a page is closed before a group
+// that would overflow it, so a group is split only when it alone exceeds the page size. Memory: one page and
+// one group of encoded bytes, plus the node records given to finish() — never the whole geometry.
+//
+// Typical use (encoding may run in parallel; adding is serial):
+//   PackageWriter w("scene.lods");
+//   for each group in page order: for each node: w.add_node(id, codec.encode(geometry, grid)); w.end_group();
+//   w.finish(scene, records, root_node_count);
+#pragma once
+
+#include <cstdio>
+#include <filesystem>
+#include <span>
+#include <vector>
+
+#include "package/format.hpp"
+#include "package/index.hpp"
+
+namespace lodstream::package {
+
+struct WriterOptions {
+  // Target decompressed size of a data page; stored pages come out at roughly 60-90 % of it (DESIGN.md asks
+  // for 16-64 KB transfers).
+  size_t page_bytes = 48 * 1024;
+  int zstd_level = 15;
+  // Node records per index page (ids beyond the root index's).
+  uint32_t nodes_per_index_page = 1024;
+};
+
+struct WrittenPackage {
+  uint64_t bytes = 0;        // file size
+  uint64_t page_bytes = 0;   // stored (compressed) bytes of all data pages
+  uint64_t index_bytes = 0;  // stored bytes of the index pages
+  uint64_t root_index_bytes =
+      0;  // stored bytes of the root index (what a first frame needs, with the trailer)
+  uint32_t pages = 0, index_pages = 0, nodes = 0;
+  ContentHash content_hash;
+};
+
+class PackageWriter {
+ public:
+  // Creates the temporary file; throws lodstream::Error naming it if that fails.
+  explicit PackageWriter(std::filesystem::path file, WriterOptions options = {});
+  ~PackageWriter();
+  PackageWriter(const PackageWriter&) = delete;
+  PackageWriter& operator=(const PackageWriter&) = delete;
+
+  // Appends node `id`'s bytes (from the package's codec, or raw bytes for NodeEncoding::raw) to the current
+  // group. Each id once.
+  void add_node(uint32_t id, std::span<const uint8_t> bytes);
+  // Closes the current group (see the packing rule above).
+  void end_group();
+  // Stores an opaque byte string (an embedded texture file) uncompressed in its own range; returns its blob
+  // id.
+  uint32_t add_blob(std::span<const uint8_t> bytes);
+
+  // `nodes[i]` is node i; each must have been added (its page, offset and size are filled in here). Node ids
+  // [0, root_nodes) go into the root index: number the coarse nodes a first frame needs first. The index is
+  // validated by the reader's own parser before the file is renamed into place. Throws lodstream::Error.
+  WrittenPackage finish(PackageScene scene, std::vector<NodeRecord> nodes, uint32_t root_nodes);
+
+ private:
+  void place(size_t first, size_t end);  // moves group entries [first, end) into the current page
+  void flush_page();
+  Range write_stored(std::span<const uint8_t> bytes, uint32_t raw_size);
+  void write(std::span<const uint8_t> bytes, bool hashed);
+
+  struct Entry {
+    uint32_t id;
+    size_t offset, size;  // in group_bytes_
+  };
+  struct Location {
+    uint32_t page = kNone, offset = 0, size = 0;
+    bool added = false;
+  };
+
+  std::filesystem::path file_, temp_;
+  WriterOptions options_;
+  std::FILE* out_ = nullptr;
+  uint64_t position_ = 0;
+  ContentHasher hasher_;
+  std::vector<uint8_t> group_bytes_;
+  std::vector<Entry> group_;
+  std::vector<uint8_t> page_;
+  std::vector<Location> locations_;  // by node id
+  std::vector<Range> pages_, blobs_;
+  uint64_t page_bytes_ = 0;
+};
+
+}  // namespace lodstream::package

@@ -1,0 +1,33 @@
+// A small multi-object package built in code for the package tests: two representations (a UV sphere with
+// normals and UVs, a cube with seams and colours) cut into chunks of a few dozen triangles, one node per
+// chunk, each chunk at its own position shift, with every vertex that two chunks share flagged as locked;
+// three objects (two instances of the sphere). Written with small pages so that it has several data and index
+// pages.
+#pragma once
+
+#include <filesystem>
+#include <vector>
+
+#include "core/mesh.hpp"
+#include "package/writer.hpp"
+
+namespace lodstream::test {
+
+struct TestPackage {
+  package::PackageScene scene;
+  std::vector<package::NodeRecord> records;  // as given to the writer (page fields unset)
+  std::vector<Mesh> meshes;                  // original geometry, one per node
+  std::vector<std::vector<uint8_t>> locked;  // per node, per vertex
+  std::vector<uint32_t> shifts;              // position shift per node
+  uint32_t root_nodes = 0;
+  package::WrittenPackage written;
+};
+
+TestPackage write_test_package(const std::filesystem::path& file);
+
+// Splits `mesh` into chunks of `triangles` consecutive triangles (compacted vertices); `locked` gets, per
+// chunk vertex, whether another chunk holds a vertex at the same position.
+std::vector<Mesh> split_into_chunks(const Mesh& mesh, size_t triangles,
+                                    std::vector<std::vector<uint8_t>>& locked);
+
+}  // namespace lodstream::test
