@@ -1,0 +1,46 @@
+#include "simplify/scene_simplify.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace lodstream::simplify {
+namespace {
+// Largest factor by which the transform stretches a length.
+double max_scale(const glm::mat4& m) {
+  return std::max({glm::length(glm::vec3(m[0])), glm::length(glm::vec3(m[1])), glm::length(glm::vec3(m[2]))});
+}
+}  // namespace
+
+SceneResult simplify_scene(const Scene& scene, size_t target_triangles, double max_error,
+                           const Options& options) {
+  SceneResult out;
+  out.input_triangles = scene.triangle_count();
+  out.scene.materials = scene.materials;
+  out.scene.objects = scene.objects;
+  std::vector<double> scale(scene.meshes.size(), 0.0);
+  for (const Object& o : scene.objects)
+    if (o.mesh < scale.size()) scale[o.mesh] = std::max(scale[o.mesh], max_scale(o.transform));
+  const double ratio = target_triangles > 0 && out.input_triangles > 0
+                           ? double(target_triangles) / double(out.input_triangles)
+                           : (std::isfinite(max_error) ? 0.0 : 1.0);
+  Options o = options;
+  size_t done = 0, total = scene.unique_triangle_count();
+  for (size_t i = 0; i < scene.meshes.size(); ++i) {
+    const Mesh& mesh = scene.meshes[i];
+    o.target_triangles = size_t(std::llround(double(mesh.triangle_count()) * ratio));
+    o.max_error = scale[i] > 0 ? max_error / scale[i] : max_error;
+    if (options.progress && total > 0)
+      o.progress = [&, base = done, n = mesh.triangle_count()](float f) {
+        options.progress(float((double(base) + f * double(n)) / double(total)));
+      };
+    Result r = simplify_mesh(mesh, o);
+    done += mesh.triangle_count();
+    out.target_reached = out.target_reached && r.target_reached;
+    out.error_bound = std::max(out.error_bound, r.error_bound * scale[i]);
+    out.scene.meshes.push_back(std::move(r.mesh));
+  }
+  out.output_triangles = out.scene.triangle_count();
+  return out;
+}
+
+}  // namespace lodstream::simplify
