@@ -155,7 +155,11 @@ RootIndex parse_root(std::span<const uint8_t> raw, const std::string& context) {
   ByteReader r(raw, context);
   RootIndex root;
   root.codec = r.u32();
-  node_codec(root.codec);  // throws for a codec this reader does not know
+  try {
+    node_codec(root.codec);
+  } catch (const Error& e) {
+    throw Error(context + ": " + e.what());
+  }
   root.node_count = r.u32();
   root.scene.input_triangles = r.u64();
   root.scene.metadata = r.string("metadata");
