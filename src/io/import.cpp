@@ -1,0 +1,97 @@
+#include "io/import.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+
+#include "core/error.hpp"
+#include "io/import_worker.hpp"
+#include "io/obj_reader.hpp"
+#include "io/off_reader.hpp"
+#include "io/ply_reader.hpp"
+#include "io/validate.hpp"
+#include "io/weld.hpp"
+
+namespace lodstream {
+
+namespace {
+
+// Validates and welds every mesh, drops objects whose mesh has no triangles left, and meshes and materials no
+// object uses; prints one warning line per kind of repair.
+void prepare_scene(Scene& scene, const ImportOptions& options, const std::string& file) {
+  size_t degenerate = 0, dropped_normals = 0;
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    Mesh& mesh = scene.meshes[m];
+    std::string what = file;
+    if (scene.meshes.size() > 1) {
+      for (const auto& o : scene.objects)
+        if (o.mesh == m) {
+          what += " (object '" + o.name + "')";
+          break;
+        }
+    }
+    if (mesh.material >= scene.materials.size())
+      throw Error(what + ": material index " + std::to_string(mesh.material) + " out of range");
+    ValidationCounts counts = validate_mesh(mesh, what);
+    degenerate += counts.degenerate_triangles;
+    dropped_normals += counts.dropped_normals;
+    if (mesh.indices.empty()) continue;
+    weld(mesh, options.crease_angle_degrees);
+  }
+  if (degenerate > 0)
+    std::fprintf(stderr, "lodstream: warning: %s: dropped %zu degenerate (zero-area) triangles\n",
+                 file.c_str(), degenerate);
+  if (dropped_normals > 0)
+    std::fprintf(stderr, "lodstream: warning: %s: %zu meshes had invalid normals; recomputed them\n",
+                 file.c_str(), dropped_normals);
+
+  // Drop empty objects, then renumber the meshes and materials that are still used.
+  for (const auto& o : scene.objects)
+    if (o.mesh >= scene.meshes.size())
+      throw Error(file + ": object '" + o.name + "' references a missing mesh");
+  std::erase_if(scene.objects, [&](const Object& o) { return scene.meshes[o.mesh].indices.empty(); });
+  if (scene.objects.empty()) throw Error(file + ": no triangles (the model is empty)");
+  std::vector<uint32_t> mesh_index(scene.meshes.size(), UINT32_MAX),
+      material_index(scene.materials.size(), UINT32_MAX);
+  std::vector<Mesh> meshes;
+  std::vector<Material> materials;
+  for (auto& o : scene.objects) {
+    if (mesh_index[o.mesh] == UINT32_MAX) {
+      mesh_index[o.mesh] = static_cast<uint32_t>(meshes.size());
+      Mesh& mesh = scene.meshes[o.mesh];
+      if (material_index[mesh.material] == UINT32_MAX) {
+        material_index[mesh.material] = static_cast<uint32_t>(materials.size());
+        materials.push_back(std::move(scene.materials[mesh.material]));
+      }
+      mesh.material = material_index[mesh.material];
+      meshes.push_back(std::move(mesh));
+    }
+    o.mesh = mesh_index[o.mesh];
+  }
+  scene.meshes = std::move(meshes);
+  scene.materials = std::move(materials);
+}
+
+}  // namespace
+
+Scene import_model(const std::filesystem::path& file, const ImportOptions& options) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec))
+    throw Error(file.string() + ": cannot open: " +
+                (std::filesystem::exists(file, ec) ? "not a regular file" : "no such file"));
+  Scene scene;
+  if (ext == ".ply")
+    scene = read_ply(file);
+  else if (ext == ".off")
+    scene = read_off(file);
+  else if (ext == ".obj")
+    scene = read_obj(file);
+  else
+    scene = import_in_worker(file, options);
+  prepare_scene(scene, options, file.string());
+  return scene;
+}
+
+}  // namespace lodstream
