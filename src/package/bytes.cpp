@@ -34,11 +34,11 @@ void ByteWriter::string(std::string_view s) {
   bytes.insert(bytes.end(), s.begin(), s.end());
 }
 
-ByteReader::ByteReader(std::span<const uint8_t> data, std::string context, uint64_t base)
-    : data_(data), context_(std::move(context)), base_(base) {}
+ByteReader::ByteReader(std::span<const uint8_t> data, std::string_view context, uint64_t base)
+    : data_(data), context_(context), base_(base) {}
 
 void ByteReader::fail(const std::string& what) const {
-  throw Error(context_ + " at byte " + std::to_string(base_ + pos_) + ": " + what);
+  throw Error(std::string(context_) + " at byte " + std::to_string(base_ + pos_) + ": " + what);
 }
 
 const uint8_t* ByteReader::take(size_t n, const char* what) {

@@ -31,8 +31,9 @@ class ByteWriter {
 
 class ByteReader {
  public:
-  // `context` names the file and part for error messages; `base` is the position of data[0] in that part.
-  ByteReader(std::span<const uint8_t> data, std::string context, uint64_t base = 0);
+  // `context` names the file and part for error messages (it must outlive the reader); `base` is the position
+  // of data[0] in that part.
+  ByteReader(std::span<const uint8_t> data, std::string_view context, uint64_t base = 0);
 
   uint8_t u8();
   uint16_t u16();
@@ -62,7 +63,7 @@ class ByteReader {
   const uint8_t* take(size_t n, const char* what);
 
   std::span<const uint8_t> data_;
-  std::string context_;
+  std::string_view context_;
   uint64_t base_;
   size_t pos_ = 0;
 };

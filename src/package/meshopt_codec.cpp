@@ -305,9 +305,10 @@ DecodedNode MeshoptCodec::decode(std::span<const uint8_t> bytes, const PositionG
     throw Error(where + ": corrupted index stream");
   }
   const uint32_t vertex_end = p.first_vertex + p.vertices;
-  for (uint32_t i : m.indices) {
-    if (i >= vertex_end) throw Error(where + ": index " + std::to_string(i) + " out of range");
-  }
+  uint32_t max_index = 0;
+  for (uint32_t i : m.indices) max_index = std::max(max_index, i);
+  if (T > 0 && max_index >= vertex_end)
+    throw Error(where + ": index " + std::to_string(max_index) + " out of range");
 
   // Locked stream: a bit per vertex, then 3k residual bits per locked vertex.
   const uint32_t k = p.shift;
@@ -326,24 +327,33 @@ DecodedNode MeshoptCodec::decode(std::span<const uint8_t> bytes, const PositionG
   }
 
   // Positions: p = origin + q * step with q = (cmin + stored) * 2^k (+ the k low bits of a locked vertex).
+  // One expression for every path, so that equal q give bit-identical positions.
   m.positions.resize(V);
-  const float step = grid.step;
-  size_t residual_bit = 0;
-  for (size_t v = 0; v < V; ++v) {
+  const bool wide = p.flags & kWidePositions;
+  auto stored = [&](size_t v, int a) -> int64_t {
     const uint8_t* r = records.data() + v * L.stride;
-    const bool locked = k > 0 && ((locked_bits[v / 8] >> (v % 8)) & 1);
-    for (int a = 0; a < 3; ++a) {
-      int64_t s =
-          (p.flags & kWidePositions) ? int64_t(get<uint32_t>(r + 4 * a)) : int64_t(get<uint16_t>(r + 2 * a));
-      int64_t qa = (p.cmin[a] + s) * (int64_t(1) << k);
-      if (locked) {
-        uint32_t low = 0;
-        for (uint32_t b = 0; b < k; ++b, ++residual_bit) {
-          low |= uint32_t((residuals[residual_bit / 8] >> (residual_bit % 8)) & 1) << b;
+    return wide ? int64_t(get<uint32_t>(r + 4 * a)) : int64_t(get<uint16_t>(r + 2 * a));
+  };
+  auto position = [&](int a, int64_t q) { return grid.origin[a] + static_cast<float>(q) * grid.step; };
+  if (k == 0) {
+    for (size_t v = 0; v < V; ++v) {
+      for (int a = 0; a < 3; ++a) m.positions[v][a] = position(a, p.cmin[a] + stored(v, a));
+    }
+  } else {
+    size_t residual_bit = 0;
+    for (size_t v = 0; v < V; ++v) {
+      const bool locked = (locked_bits[v / 8] >> (v % 8)) & 1;
+      for (int a = 0; a < 3; ++a) {
+        int64_t q = (p.cmin[a] + stored(v, a)) * (int64_t(1) << k);
+        if (locked) {
+          uint32_t low = 0;
+          for (uint32_t b = 0; b < k; ++b, ++residual_bit) {
+            low |= uint32_t((residuals[residual_bit / 8] >> (residual_bit % 8)) & 1) << b;
+          }
+          q += low;
         }
-        qa += low;
+        m.positions[v][a] = position(a, q);
       }
-      m.positions[v][a] = grid.origin[a] + static_cast<float>(qa) * step;
     }
   }
   if (p.flags & kNormals) {

@@ -29,18 +29,17 @@ inline glm::ivec2 oct_encode(glm::vec3 n, int bits) {
           static_cast<int>(std::lround(std::clamp(p.y, -1.0f, 1.0f) * scale))};
 }
 
-// Inverse of oct_encode for any integer pair (garbage in gives some unit vector, never NaN).
+// Inverse of oct_encode for any integer pair (garbage in gives some unit vector, never NaN). The fold of the
+// lower half is written branch-free: with t = max(-z, 0), x += (x >= 0 ? -t : t) equals (1 - |y|) sign(x).
 inline glm::vec3 oct_decode(int x, int y, float inv_scale) {
-  glm::vec3 v(static_cast<float>(x) * inv_scale, static_cast<float>(y) * inv_scale, 0.0f);
-  v.x = std::clamp(v.x, -1.0f, 1.0f);
-  v.y = std::clamp(v.y, -1.0f, 1.0f);
-  v.z = 1.0f - std::abs(v.x) - std::abs(v.y);
-  if (v.z < 0.0f) {
-    float x0 = v.x;
-    v.x = (1.0f - std::abs(v.y)) * sign_not_zero(x0);
-    v.y = (1.0f - std::abs(x0)) * sign_not_zero(v.y);
-  }
-  return v * (1.0f / std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z));
+  float fx = std::clamp(static_cast<float>(x) * inv_scale, -1.0f, 1.0f);
+  float fy = std::clamp(static_cast<float>(y) * inv_scale, -1.0f, 1.0f);
+  float fz = 1.0f - std::abs(fx) - std::abs(fy);
+  float t = std::max(-fz, 0.0f);
+  fx += fx >= 0.0f ? -t : t;
+  fy += fy >= 0.0f ? -t : t;
+  float inv_length = 1.0f / std::sqrt(fx * fx + fy * fy + fz * fz);
+  return {fx * inv_length, fy * inv_length, fz * inv_length};
 }
 
 }  // namespace lodstream::package

@@ -28,7 +28,9 @@ struct WriterOptions {
   // Target decompressed size of a data page; stored pages come out at roughly 60-90 % of it (DESIGN.md asks
   // for 16-64 KB transfers).
   size_t page_bytes = 48 * 1024;
-  int zstd_level = 15;
+  // zstd level of data and index pages: measured on refined_elephant (bench_package), level 9 is 0.3 % larger
+  // than 15 and 4x faster to write (8 vs 2 M triangles per second per core); 19 saves another 0.2 % at 0.7 M.
+  int zstd_level = 9;
   // Node records per index page (ids beyond the root index's).
   uint32_t nodes_per_index_page = 1024;
 };

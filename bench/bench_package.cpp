@@ -1,0 +1,307 @@
+// bench_package: size and speed of the .lods package on a real mesh cut into meshlets (the finest level of a
+// cluster DAG: 64 vertices / 124 triangles, positions on a 2^-14 grid of the diagonal, octahedral normals).
+//
+//   bench_package [--mesh=FILE] [--normal-bits=N] [--zstd-level=L] [google benchmark flags]
+//
+// Before the timings it prints the size table: bytes per triangle of the whole package and where they go
+// (positions, normals, UVs, connectivity, index), each measured after zstd by encoding with and without the
+// attribute. Timings report triangles per second on one core: encode (codec), write (codec + zstd + file),
+// decode (checksum + zstd + codec, from pages in memory) and decode of the codec alone.
+#include <benchmark/benchmark.h>
+#include <meshoptimizer.h>
+
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <string>
+
+#include "core/error.hpp"
+#include "io/import.hpp"
+#include "package/reader.hpp"
+#include "package/writer.hpp"
+
+namespace {
+
+using namespace lodstream;
+using namespace lodstream::package;
+
+std::filesystem::path g_mesh_file = LODSTREAM_SOURCE_DIR "/data/refined_elephant.off";
+uint32_t g_normal_bits = 10;
+int g_zstd_level = WriterOptions{}.zstd_level;
+
+struct Meshlets {
+  Mesh mesh;  // the whole input mesh (all objects' meshes merged)
+  PositionGrid grid;
+  std::vector<Mesh> chunks;
+  std::vector<std::vector<uint8_t>> locked;  // vertices shared with another meshlet
+  size_t triangles = 0;
+};
+
+Mesh merged(const Scene& scene) {
+  Mesh out;
+  for (const Object& o : scene.objects) {
+    const Mesh& m = scene.meshes[o.mesh];
+    const uint32_t base = uint32_t(out.positions.size());
+    for (const glm::vec3& p : m.positions)
+      out.positions.push_back(glm::vec3(o.transform * glm::vec4(p, 1.0f)));
+    if (m.has_normals()) out.normals.insert(out.normals.end(), m.normals.begin(), m.normals.end());
+    if (m.has_uvs()) out.uvs.insert(out.uvs.end(), m.uvs.begin(), m.uvs.end());
+    for (uint32_t i : m.indices) out.indices.push_back(base + i);
+  }
+  if (out.normals.size() != out.positions.size()) out.normals.clear();
+  if (out.uvs.size() != out.positions.size()) out.uvs.clear();
+  return out;
+}
+
+const Meshlets& meshlets() {
+  static const Meshlets m = [] {
+    Meshlets r;
+    r.mesh = merged(import_model(g_mesh_file));
+    r.grid = PositionGrid::for_bounds(r.mesh.bounds(), 14);
+    const size_t max_v = 64, max_t = 124;
+    std::vector<meshopt_Meshlet> ml(meshopt_buildMeshletsBound(r.mesh.indices.size(), max_v, max_t));
+    std::vector<unsigned> mv(ml.size() * max_v);
+    std::vector<unsigned char> mt(ml.size() * max_t * 3);
+    ml.resize(meshopt_buildMeshlets(ml.data(), mv.data(), mt.data(), r.mesh.indices.data(),
+                                    r.mesh.indices.size(), &r.mesh.positions[0].x, r.mesh.vertex_count(),
+                                    sizeof(glm::vec3), max_v, max_t, 0.0f));
+    std::vector<uint32_t> owners(r.mesh.vertex_count(), 0);
+    for (const meshopt_Meshlet& l : ml) {
+      for (unsigned v = 0; v < l.vertex_count; ++v) ++owners[mv[l.vertex_offset + v]];
+    }
+    for (const meshopt_Meshlet& l : ml) {
+      Mesh c;
+      std::vector<uint8_t> locked;
+      for (unsigned v = 0; v < l.vertex_count; ++v) {
+        const uint32_t src = mv[l.vertex_offset + v];
+        c.positions.push_back(r.mesh.positions[src]);
+        if (r.mesh.has_normals()) c.normals.push_back(r.mesh.normals[src]);
+        if (r.mesh.has_uvs()) c.uvs.push_back(r.mesh.uvs[src]);
+        locked.push_back(owners[src] > 1);
+      }
+      for (unsigned i = 0; i < l.triangle_count * 3; ++i) c.indices.push_back(mt[l.triangle_offset + i]);
+      r.triangles += l.triangle_count;
+      r.chunks.push_back(std::move(c));
+      r.locked.push_back(std::move(locked));
+    }
+    return r;
+  }();
+  return m;
+}
+
+enum Attributes { kPositions = 0, kNormals = 1, kUvs = 2, kAll = 3 };
+
+std::vector<std::vector<uint8_t>> encode_all(const Meshlets& m, int attributes) {
+  std::vector<std::vector<uint8_t>> out;
+  out.reserve(m.chunks.size());
+  for (size_t i = 0; i < m.chunks.size(); ++i) {
+    Mesh stripped;
+    const Mesh* mesh = &m.chunks[i];
+    if (attributes != kAll) {
+      stripped = m.chunks[i];
+      if (!(attributes & kNormals)) stripped.normals.clear();
+      if (!(attributes & kUvs)) stripped.uvs.clear();
+      mesh = &stripped;
+    }
+    NodeGeometry g;
+    g.mesh = mesh;
+    g.locked = m.locked[i];
+    g.normal_bits = g_normal_bits;
+    out.push_back(default_node_codec().encode(g, m.grid));
+  }
+  return out;
+}
+
+WrittenPackage write_package(const Meshlets& m, const std::vector<std::vector<uint8_t>>& nodes,
+                             const std::filesystem::path& file, int zstd_level) {
+  WriterOptions options;
+  options.zstd_level = zstd_level;
+  PackageWriter writer(file, options);
+  PackageScene scene;
+  scene.input_triangles = m.triangles;
+  scene.materials.resize(1);
+  Representation rep;
+  rep.bounds = m.mesh.bounds();
+  rep.grid = m.grid;
+  scene.representations.push_back(rep);
+  scene.objects.push_back({"mesh", glm::mat4(1.0f), 0});
+  std::vector<NodeRecord> records(nodes.size());
+  for (uint32_t id = 0; id < nodes.size(); ++id) {
+    writer.add_node(id, nodes[id]);
+    if (id % 8 == 7) writer.end_group();  // groups of 8 clusters, as a DAG group
+    records[id].triangles = uint32_t(m.chunks[id].triangle_count());
+    records[id].vertices = uint32_t(m.chunks[id].vertex_count());
+  }
+  return writer.finish(scene, records, 0);
+}
+
+// CPU time of this thread: the machines are shared, so wall time measures the neighbours too.
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+std::filesystem::path temp_file(const char* name) {
+  return std::filesystem::temp_directory_path() / name;
+}
+
+// zstd-compressed bytes of the index streams alone, paged like the package (connectivity after zstd).
+size_t connectivity_bytes(const std::vector<std::vector<uint8_t>>& nodes, int level) {
+  size_t total = 0;
+  std::vector<uint8_t> page;
+  auto flush = [&] {
+    if (!page.empty()) total += zstd_compress(page, level).size();
+    page.clear();
+  };
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    NodeSizeBreakdown b = default_node_codec().breakdown(nodes[i], "node");
+    auto first = nodes[i].begin() + std::ptrdiff_t(b.header + b.vertices + b.locked);
+    page.insert(page.end(), first, first + std::ptrdiff_t(b.indices));
+    if (i % 8 == 7 && page.size() > 36 * 1024) flush();
+  }
+  flush();
+  return total;
+}
+
+void print_sizes() {
+  const Meshlets& m = meshlets();
+  const double T = double(m.triangles);
+  std::printf("mesh %s: %zu triangles, %zu vertices, %zu meshlets (64 v / 124 t), normals %s, uvs %s\n",
+              g_mesh_file.filename().c_str(), m.triangles, m.mesh.vertex_count(), m.chunks.size(),
+              m.mesh.has_normals() ? "yes" : "no", m.mesh.has_uvs() ? "yes" : "no");
+  std::printf(
+      "grid step %.3g = 2^-14 of the diagonal; normals %u bits octahedral; zstd level %d; 48 KiB pages\n",
+      double(m.grid.step), g_normal_bits, g_zstd_level);
+  const auto all = encode_all(m, kAll);
+  size_t pre_zstd = 0, index_pre = 0, vertex_pre = 0, locked_pre = 0, header_pre = 0;
+  for (const auto& n : all) {
+    NodeSizeBreakdown b = default_node_codec().breakdown(n, "node");
+    pre_zstd += n.size(), index_pre += b.indices, vertex_pre += b.vertices, locked_pre += b.locked,
+        header_pre += b.header;
+  }
+  WrittenPackage full = write_package(m, all, temp_file("bench_all.lods"), g_zstd_level);
+  WrittenPackage pos = write_package(m, encode_all(m, kPositions), temp_file("bench_pos.lods"), g_zstd_level);
+  WrittenPackage pos_n =
+      write_package(m, encode_all(m, kNormals), temp_file("bench_posn.lods"), g_zstd_level);
+  const size_t conn = connectivity_bytes(all, g_zstd_level);
+  std::printf("before zstd: %.3f B/tri (vertex stream %.3f, index stream %.3f, node headers %.3f)\n",
+              pre_zstd / T, vertex_pre / T, index_pre / T, header_pre / T);
+  std::printf(
+      "package: %.3f B/tri = %llu bytes (pages %.3f, index pages %.3f, root index %llu B, trailer+header 128 "
+      "B), %u pages\n",
+      full.bytes / T, (unsigned long long)full.bytes, full.page_bytes / T, full.index_bytes / T,
+      (unsigned long long)full.root_index_bytes, full.pages);
+  std::printf(
+      "  connectivity %.3f B/tri | positions (+node headers) %.3f | normals %.3f | uvs %.3f | index %.3f\n",
+      conn / T, (double(pos.page_bytes) - conn) / T, (double(pos_n.page_bytes) - pos.page_bytes) / T,
+      (double(full.page_bytes) - pos_n.page_bytes) / T, (full.bytes - full.page_bytes) / T);
+  for (int level : {3, 9, 15, 19}) {
+    const double t0 = thread_cpu_seconds();
+    WrittenPackage w = write_package(m, all, temp_file("bench_level.lods"), level);
+    const double s = thread_cpu_seconds() - t0;
+    std::printf(
+        "  zstd level %2d: %.3f B/tri, pages written at %.2f M tri/s (zstd + file, CPU time, one core)\n",
+        level, w.bytes / T, T / s * 1e-6);
+  }
+  std::fflush(stdout);
+  for (const char* f : {"bench_all.lods", "bench_pos.lods", "bench_posn.lods", "bench_level.lods"}) {
+    std::filesystem::remove(temp_file(f));
+  }
+}
+
+void BM_Encode(benchmark::State& state) {
+  const Meshlets& m = meshlets();
+  for (auto _ : state) benchmark::DoNotOptimize(encode_all(m, kAll));
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(m.triangles));
+}
+
+void BM_EncodeAndWrite(benchmark::State& state) {
+  const Meshlets& m = meshlets();
+  for (auto _ : state) write_package(m, encode_all(m, kAll), temp_file("bench_write.lods"), g_zstd_level);
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(m.triangles));
+  std::filesystem::remove(temp_file("bench_write.lods"));
+}
+
+struct Loaded {
+  std::unique_ptr<PackageReader> reader;
+  std::vector<std::vector<uint8_t>> stored;  // every page as received from a link
+  std::vector<std::vector<uint32_t>> nodes_of_page;
+};
+
+const Loaded& loaded() {
+  static const Loaded l = [] {
+    Loaded r;
+    write_package(meshlets(), encode_all(meshlets(), kAll), temp_file("bench_read.lods"), g_zstd_level);
+    r.reader = std::make_unique<PackageReader>(PackageReader::open(temp_file("bench_read.lods")));
+    for (uint32_t p = 0; p < r.reader->root().pages.size(); ++p) {
+      const Range& range = r.reader->root().pages[p];
+      std::vector<uint8_t> bytes(range.size);
+      r.reader->source().read(range.offset, bytes);
+      r.stored.push_back(std::move(bytes));
+    }
+    r.nodes_of_page.resize(r.stored.size());
+    for (uint32_t id = 0; id < r.reader->node_count(); ++id)
+      r.nodes_of_page[r.reader->node(id).page].push_back(id);
+    return r;
+  }();
+  return l;
+}
+
+void BM_Decode(benchmark::State& state) {
+  const Loaded& l = loaded();
+  for (auto _ : state) {
+    for (size_t p = 0; p < l.stored.size(); ++p) {
+      std::vector<uint8_t> raw = l.reader->unpack_page(uint32_t(p), l.stored[p]);
+      for (uint32_t id : l.nodes_of_page[p]) benchmark::DoNotOptimize(l.reader->decode_node(id, raw));
+    }
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(meshlets().triangles));
+}
+
+void BM_DecodeCodecOnly(benchmark::State& state) {
+  const Loaded& l = loaded();
+  std::vector<std::vector<uint8_t>> raw;
+  for (size_t p = 0; p < l.stored.size(); ++p) raw.push_back(l.reader->unpack_page(uint32_t(p), l.stored[p]));
+  for (auto _ : state) {
+    for (size_t p = 0; p < raw.size(); ++p) {
+      for (uint32_t id : l.nodes_of_page[p]) benchmark::DoNotOptimize(l.reader->decode_node(id, raw[p]));
+    }
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(meshlets().triangles));
+}
+
+BENCHMARK(BM_Encode)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EncodeAndWrite)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Decode)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DecodeCodecOnly)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<char*> rest;
+  for (int i = 0; i < argc; ++i) {
+    std::string a = argv[i];
+    if (a.rfind("--mesh=", 0) == 0) {
+      g_mesh_file = a.substr(7);
+    } else if (a.rfind("--normal-bits=", 0) == 0) {
+      g_normal_bits = uint32_t(std::stoi(a.substr(14)));
+    } else if (a.rfind("--zstd-level=", 0) == 0) {
+      g_zstd_level = std::stoi(a.substr(13));
+    } else {
+      rest.push_back(argv[i]);
+    }
+  }
+  int n = int(rest.size());
+  benchmark::Initialize(&n, rest.data());
+  try {
+    print_sizes();
+  } catch (const lodstream::Error& e) {
+    std::fprintf(stderr, "bench_package: error: %s\n", e.what());
+    return 1;
+  }
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
