@@ -1,11 +1,12 @@
 // A reference surface prepared for closest-point queries: build it once, then measure the distance from many
 // points or many other surfaces to it (the simplifier's tests check their error bound this way).
 //
-// The BVH is Embree 3's (Debian's libembree, rtcPointQuery): its builder is parallel (TBB) and its 4-wide
-// SIMD box tests and near-first traversal beat a compact hand-written binary BVH, while the only code of ours
-// is the exact point-to-triangle distance in the query callback (closest_point.hpp). The surface is flattened
-// to world space first (no Embree instances: their point queries need similarity transforms, and one flat BVH
-// is faster).
+// The BVH is Embree 3's (Debian's libembree, rtcPointQuery) rather than one written here: its builder is
+// parallel (TBB, about 0.2 s for 1M triangles on 2 cores) and its SIMD traversal answers a query in about 0.7
+// µs per core when the surfaces are close (1M triangles, measured), so the only code of ours is the exact
+// point-to-triangle distance in the query callback (closest_point.hpp) — simpler than a hand-written BVH, and
+// as fast as we would expect one to be. Surfaces are flattened to world space first: Embree's point queries
+// through instances need similarity transforms, and one flat BVH is faster to query.
 #pragma once
 
 #include <cstddef>
