@@ -48,12 +48,12 @@ void write_ids(ByteWriter& w, const std::vector<uint32_t>& ids, uint32_t self) {
 std::vector<uint32_t> read_ids(ByteReader& r, uint32_t self, uint64_t limit, const char* what) {
   std::vector<uint32_t> ids(r.count(1, what));
   for (uint32_t& id : ids) {
-    int64_t v = r.svarint() + int64_t(self);
-    if (v < 0 || uint64_t(v) >= limit) {
-      r.fail(std::string(what) + " id " + std::to_string(v) + " out of range (" + std::to_string(limit) +
-             ")");
+    const int64_t delta = r.svarint();  // id - self; checked before adding so that nothing overflows
+    if (delta < -int64_t(self) || delta >= int64_t(limit) - int64_t(self)) {
+      r.fail(std::string(what) + " id " + std::to_string(self) + " + (" + std::to_string(delta) +
+             ") out of range (" + std::to_string(limit) + ")");
     }
-    id = static_cast<uint32_t>(v);
+    id = static_cast<uint32_t>(int64_t(self) + delta);
   }
   return ids;
 }

@@ -67,7 +67,7 @@ Parsed parse(std::span<const uint8_t> bytes, const std::string& where) {
   if (t > bytes.size()) r.fail("triangle count " + std::to_string(t) + " impossible for a node of this size");
   p.triangles = static_cast<uint32_t>(t);
   uint64_t first = r.varint();
-  if (first + p.vertices > UINT32_MAX) r.fail("first vertex out of range");
+  if (first > UINT32_MAX - p.vertices) r.fail("first vertex out of range");
   p.first_vertex = static_cast<uint32_t>(first);
   for (int64_t& c : p.cmin) {
     c = r.svarint();
