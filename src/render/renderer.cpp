@@ -16,45 +16,62 @@ namespace {
 // Attribute locations shared by the vertex layout and the shader.
 enum : GLuint { kPosition = 0, kNormal = 1, kUv = 2, kColor = 3 };
 // Uniform locations.
-enum : GLint { kModelViewProjection = 0, kNormalMatrix = 1, kBaseColor = 2, kTextured = 3 };
+enum : GLint { kModelViewProjection = 0, kNormalMatrix = 1, kBaseColor = 2 };
+// Shader variants: only what a draw uses is interpolated (llvmpipe's cost grows with every varying).
+constexpr unsigned kTexturedVariant = 1, kColoredVariant = 2;
 
-const char* const kVertexShader = R"(#version 450 core
+const char* const kVertexShader = R"(
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
-layout(location = 2) in vec2 a_uv;
-layout(location = 3) in vec4 a_color;
 layout(location = 0) uniform mat4 u_model_view_projection;
 layout(location = 1) uniform mat3 u_normal_matrix;  // object to view space, inverse transpose
 out vec3 v_normal;
+#ifdef TEXTURED
+layout(location = 2) in vec2 a_uv;
 out vec2 v_uv;
+#endif
+#ifdef COLORED
+layout(location = 3) in vec4 a_color;
 out vec4 v_color;
+#endif
 void main() {
   gl_Position = u_model_view_projection * vec4(a_position, 1.0);
   v_normal = u_normal_matrix * a_normal;
+#ifdef TEXTURED
   v_uv = a_uv;
+#endif
+#ifdef COLORED
   v_color = a_color;
+#endif
 }
 )";
 
 // Headlight Lambert (see renderer.hpp), then the sRGB transfer function (IEC 61966-2-1).
-const char* const kFragmentShader = R"(#version 450 core
+const char* const kFragmentShader = R"(
 in vec3 v_normal;
+#ifdef TEXTURED
 in vec2 v_uv;
-in vec4 v_color;
-layout(location = 2) uniform vec4 u_base_color;
-layout(location = 3) uniform bool u_textured;
 layout(binding = 0) uniform sampler2D u_base_color_texture;
+#endif
+#ifdef COLORED
+in vec4 v_color;
+#endif
+layout(location = 2) uniform vec4 u_base_color;
 layout(location = 0) out vec4 frag_color;
-const float kAmbient = AMBIENT;
 vec3 encode_srgb(vec3 c) {
   return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
 }
 void main() {
-  vec4 albedo = u_base_color * v_color;
-  if (u_textured) albedo *= texture(u_base_color_texture, v_uv);
+  vec4 albedo = u_base_color;
+#ifdef TEXTURED
+  albedo *= texture(u_base_color_texture, v_uv);
+#endif
+#ifdef COLORED
+  albedo *= v_color;
+#endif
   float len = length(v_normal);
   float lambert = len > 0.0 ? abs(v_normal.z) / len : 1.0;
-  vec3 c = albedo.rgb * (kAmbient + (1.0 - kAmbient) * lambert);
+  vec3 c = albedo.rgb * (AMBIENT + (1.0 - AMBIENT) * lambert);
   frag_color = vec4(encode_srgb(clamp(c, 0.0, 1.0)), 1.0);
 }
 )";
@@ -99,19 +116,22 @@ Renderer::Renderer(Context& context, const RendererOptions& options) : options_(
       throw Error("msaa " + std::to_string(options_.msaa) + " exceeds this GL's maximum of " +
                   std::to_string(max_samples) + " samples");
   }
-  std::string fragment = kFragmentShader;
-  fragment.replace(fragment.find("AMBIENT"), 7, std::to_string(kAmbient));
-  GLuint vs = compile(GL_VERTEX_SHADER, kVertexShader);
-  GLuint fs = compile(GL_FRAGMENT_SHADER, fragment);
-  program_ = glCreateProgram();
-  glAttachShader(program_, vs);
-  glAttachShader(program_, fs);
-  glLinkProgram(program_);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
-  GLint ok = 0;
-  glGetProgramiv(program_, GL_LINK_STATUS, &ok);
-  if (!ok) throw Error("renderer: shader program does not link");
+  for (unsigned variant = 0; variant < programs_.size(); ++variant) {
+    std::string header = "#version 450 core\n#define AMBIENT " + std::to_string(kAmbient) + "\n";
+    if (variant & kTexturedVariant) header += "#define TEXTURED\n";
+    if (variant & kColoredVariant) header += "#define COLORED\n";
+    GLuint vs = compile(GL_VERTEX_SHADER, header + kVertexShader);
+    GLuint fs = compile(GL_FRAGMENT_SHADER, header + kFragmentShader);
+    GLuint program = programs_[variant] = glCreateProgram();
+    glAttachShader(program, vs);
+    glAttachShader(program, fs);
+    glLinkProgram(program);
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    GLint ok = 0;
+    glGetProgramiv(program, GL_LINK_STATUS, &ok);
+    if (!ok) throw Error("renderer: shader program does not link");
+  }
   check_gl("shader setup");
 }
 
@@ -119,7 +139,7 @@ Renderer::~Renderer() {
   for (MeshHandle h = 1; h <= meshes_.size(); ++h) release_mesh(h);
   for (TextureHandle h = 1; h <= textures_.size(); ++h) release_texture(h);
   release_frame();
-  glDeleteProgram(program_);
+  for (GLuint program : programs_) glDeleteProgram(program);
 }
 
 MeshHandle Renderer::upload_mesh(const Mesh& mesh) {
@@ -146,6 +166,7 @@ MeshHandle Renderer::upload_mesh(const Mesh& mesh) {
   GpuMesh gpu;
   gpu.index_count = uint32_t(mesh.indices.size());
   gpu.has_uvs = uvs;
+  gpu.has_colors = colors;
   gpu.bounds = mesh.bounds();
   glCreateBuffers(1, &gpu.vertex_buffer);
   glCreateBuffers(1, &gpu.index_buffer);
@@ -277,8 +298,7 @@ double Renderer::draw(const Camera& camera, std::span<const DrawItem> items) {
   glClearNamedFramebufferfv(frame_.framebuffer, GL_COLOR, 0, background);
   glClearNamedFramebufferfv(frame_.framebuffer, GL_DEPTH, 0, &far_depth);
   if (!range.empty()) {
-    glUseProgram(program_);
-    glVertexAttrib4f(kColor, 1.0f, 1.0f, 1.0f, 1.0f);  // meshes without colours read white
+    GLuint current = 0;
     for (const DrawItem& item : items) {
       const GpuMesh& gpu = meshes_.at(item.mesh - 1);
       if (!gpu.vertex_array) throw Error("renderer: drawing a released mesh");
@@ -287,10 +307,12 @@ double Renderer::draw(const Camera& camera, std::span<const DrawItem> items) {
       const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(view * item.transform)));
       GLuint texture = item.material.texture ? textures_.at(item.material.texture - 1) : 0;
       const bool textured = texture && gpu.has_uvs;
-      glProgramUniformMatrix4fv(program_, kModelViewProjection, 1, GL_FALSE, &mvp[0][0]);
-      glProgramUniformMatrix3fv(program_, kNormalMatrix, 1, GL_FALSE, &normal_matrix[0][0]);
-      glProgramUniform4fv(program_, kBaseColor, 1, &item.material.base_color[0]);
-      glProgramUniform1i(program_, kTextured, textured ? 1 : 0);
+      const GLuint program =
+          programs_[(textured ? kTexturedVariant : 0) | (gpu.has_colors ? kColoredVariant : 0)];
+      if (program != current) glUseProgram(current = program);
+      glProgramUniformMatrix4fv(program, kModelViewProjection, 1, GL_FALSE, &mvp[0][0]);
+      glProgramUniformMatrix3fv(program, kNormalMatrix, 1, GL_FALSE, &normal_matrix[0][0]);
+      glProgramUniform4fv(program, kBaseColor, 1, &item.material.base_color[0]);
       if (textured) glBindTextureUnit(0, texture);
       glBindVertexArray(gpu.vertex_array);
       glDrawElements(GL_TRIANGLES, GLsizei(gpu.index_count), GL_UNSIGNED_INT, nullptr);

@@ -84,16 +84,17 @@ class Renderer {
     uint32_t vertex_array = 0, vertex_buffer = 0, index_buffer = 0;  // 0 once released
     uint32_t index_count = 0;
     bool has_uvs = false;
+    bool has_colors = false;
     Bounds bounds;  // object space
   };
   void ensure_frame(int width, int height);
   void release_frame();
 
   RendererOptions options_;
-  uint32_t program_ = 0;
-  std::vector<GpuMesh> meshes_;      // handle h is meshes_[h - 1]
-  std::vector<uint32_t> textures_;   // handle h is textures_[h - 1]; 0 once released
-  std::vector<Bounds> world_boxes_;  // scratch for draw()
+  std::array<uint32_t, 4> programs_{};  // shader variants: textured (1) | coloured (2)
+  std::vector<GpuMesh> meshes_;         // handle h is meshes_[h - 1]
+  std::vector<uint32_t> textures_;      // handle h is textures_[h - 1]; 0 once released
+  std::vector<Bounds> world_boxes_;     // scratch for draw()
   struct FrameBuffers {
     int width = 0, height = 0;
     uint32_t framebuffer = 0, color = 0, depth = 0;  // multisampled when msaa > 1
