@@ -1,5 +1,4 @@
 // `lodstream link`: the link emulator (DESIGN.md, Link emulation), a shaping TCP proxy on loopback.
-#include <csignal>
 #include <cstdio>
 #include <memory>
 
@@ -22,19 +21,13 @@ int run_link(const LinkOptions& opt) {
   settings.rtt_s = parse_duration(opt.rtt, "--rtt");
   settings.jitter_s = parse_duration(opt.jitter, "--jitter");
   settings.seed = opt.seed;
-  // Block the stop signals before the proxy's thread starts (it inherits the mask), then wait for one here.
-  sigset_t stop;
-  sigemptyset(&stop);
-  sigaddset(&stop, SIGINT);
-  sigaddset(&stop, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &stop, nullptr);
+  StopSignals stop;  // before the worker threads start
   LinkProxy proxy(listen_host, listen_port, to_host, to_port, settings);
   std::printf("link: listening on %s:%u, forwarding to %s:%u at %.6g Mbit/s, RTT %.6g ms, jitter %.6g ms\n",
               listen_host.c_str(), proxy.port(), to_host.c_str(), to_port, settings.bandwidth_bps / 1e6,
               settings.rtt_s * 1e3, settings.jitter_s * 1e3);
   std::fflush(stdout);
-  int signal = 0;
-  sigwait(&stop, &signal);
+  int signal = stop.wait();
   std::fprintf(stderr, "link: stopped by signal %d\n", signal);
   return 0;
 }

@@ -26,7 +26,9 @@ bool register_command(Command command) {
   return true;
 }
 
-const std::vector<Command>& registered_commands() { return registry(); }
+const std::vector<Command>& registered_commands() {
+  return registry();
+}
 
 void print_json(const nlohmann::json& value) {
   std::string text = value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
@@ -64,6 +66,19 @@ std::pair<int, int> parse_size(const std::string& text, const std::string& optio
       !parse(std::string_view(text).substr(x + 1), h) || w < 1 || h < 1 || w > 16384 || h > 16384)
     throw Error(option + " must be WIDTHxHEIGHT with each side in 1..16384, got '" + text + "'");
   return {w, h};
+}
+
+StopSignals::StopSignals() {
+  sigemptyset(&set_);
+  sigaddset(&set_, SIGINT);
+  sigaddset(&set_, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &set_, nullptr);
+}
+
+int StopSignals::wait() {
+  int signal = 0;
+  sigwait(&set_, &signal);
+  return signal;
 }
 
 }  // namespace lodstream::cli

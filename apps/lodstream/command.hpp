@@ -2,6 +2,8 @@
 // with a namespace-scope `const bool registered = register_command({...});`, so main.cpp never lists them.
 #pragma once
 
+#include <signal.h>
+
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -35,5 +37,17 @@ glm::vec3 parse_vec3(const std::string& text, const std::string& option);
 
 // Parses "WxH" (an image size in pixels, each 1..16384); throws lodstream::Error naming `option`.
 std::pair<int, int> parse_size(const std::string& text, const std::string& option);
+
+// For long-running subcommands (serve, link): blocks SIGINT and SIGTERM in the calling thread and in every
+// thread it starts afterwards (threads inherit the mask), so that wait() in the main thread receives them.
+class StopSignals {
+ public:
+  StopSignals();
+  // Blocks until SIGINT or SIGTERM arrives; returns the signal number.
+  int wait();
+
+ private:
+  sigset_t set_;
+};
 
 }  // namespace lodstream::cli

@@ -2,10 +2,13 @@
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <poll.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -27,7 +30,8 @@ nlohmann::json RunResult::json() const {
   try {
     return nlohmann::json::parse(out);
   } catch (const std::exception& e) {
-    ADD_FAILURE() << "stdout is not one JSON object: " << e.what() << "\nstdout: " << out << "\nstderr: " << err;
+    ADD_FAILURE() << "stdout is not one JSON object: " << e.what() << "\nstdout: " << out
+                  << "\nstderr: " << err;
     return {};
   }
 }
@@ -60,9 +64,68 @@ RunResult run_lodstream(const std::vector<std::string>& args) {
   return r;
 }
 
+BackgroundProcess::BackgroundProcess(const std::vector<std::string>& args) {
+  int pipe_fds[2];
+  if (pipe(pipe_fds) != 0) {
+    ADD_FAILURE() << "pipe failed";
+    return;
+  }
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], 1);
+  posix_spawn_file_actions_addclose(&actions, pipe_fds[0]);
+  std::vector<std::string> argv_s{LODSTREAM_BINARY};
+  argv_s.insert(argv_s.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : argv_s) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ) != 0)
+    ADD_FAILURE() << "cannot start " << argv[0];
+  posix_spawn_file_actions_destroy(&actions);
+  close(pipe_fds[1]);
+  pid_ = pid;
+  out_ = pipe_fds[0];
+}
+
+BackgroundProcess::~BackgroundProcess() {
+  stop();
+}
+
+std::string BackgroundProcess::read_line(double timeout_s) {
+  auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  for (;;) {
+    size_t newline = pending_.find('\n');
+    if (newline != std::string::npos) {
+      std::string line = pending_.substr(0, newline);
+      pending_.erase(0, newline + 1);
+      return line;
+    }
+    auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    pollfd p{out_, POLLIN, 0};
+    if (left.count() <= 0 || poll(&p, 1, int(left.count())) <= 0) return {};
+    char buf[4096];
+    ssize_t n = read(out_, buf, sizeof buf);
+    if (n <= 0) return {};
+    pending_.append(buf, size_t(n));
+  }
+}
+
+int BackgroundProcess::stop() {
+  if (pid_ < 0) return -1;
+  kill(pid_, SIGTERM);
+  int status = 0;
+  waitpid(pid_, &status, 0);
+  pid_ = -1;
+  close(out_);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
 std::filesystem::path data_file(const std::string& name) {
   auto p = std::filesystem::path(LODSTREAM_SOURCE_DIR) / "data" / name;
-  if (!std::filesystem::exists(p)) ADD_FAILURE() << p << " is missing: run scripts/fetch-data (make test does)";
+  if (!std::filesystem::exists(p))
+    ADD_FAILURE() << p << " is missing: run scripts/fetch-data (make test does)";
   return p;
 }
 

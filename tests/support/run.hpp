@@ -9,14 +9,32 @@
 namespace lodstream::test {
 
 struct RunResult {
-  int status = -1;  // exit status, or 128 + signal number when it was killed by a signal
-  std::string out;  // standard output
-  std::string err;  // standard error
+  int status = -1;              // exit status, or 128 + signal number when it was killed by a signal
+  std::string out;              // standard output
+  std::string err;              // standard error
   nlohmann::json json() const;  // standard output parsed as JSON (fails the test when it is not)
 };
 
 // Runs build/bin/lodstream with `args` (no shell), waits, returns its exit status and output.
 RunResult run_lodstream(const std::vector<std::string>& args);
+
+// A `lodstream` process left running (a server, a link): its standard output is read line by line; standard
+// error goes to the test's. stop() (or the destructor) sends SIGTERM and returns the exit status.
+class BackgroundProcess {
+ public:
+  explicit BackgroundProcess(const std::vector<std::string>& args);
+  ~BackgroundProcess();
+  BackgroundProcess(const BackgroundProcess&) = delete;
+  BackgroundProcess& operator=(const BackgroundProcess&) = delete;
+  // The next line of standard output without its newline; empty after `timeout_s` or at end of output.
+  std::string read_line(double timeout_s = 10.0);
+  int stop();
+
+ private:
+  int pid_ = -1;
+  int out_ = -1;
+  std::string pending_;
+};
 
 // Path of a file fetched by scripts/fetch-data into data/; fails the calling test (ADD_FAILURE) with the
 // command to run when the file is missing. `make test` fetches everything before the tests run.
