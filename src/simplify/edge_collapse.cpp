@@ -471,13 +471,20 @@ class Simplifier {
     order_.clear();
     for (const Candidate& c : slots_)
       if (c.a != kNone && std::isfinite(c.cost)) order_.push_back(c);
-    tbb::parallel_sort(order_.begin(), order_.end(),
-                       [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; });
-
     // Pass limit (as meshoptimizer does): most collapses remove two triangles; allow costs up to 1.5x the one
-    // that would reach the target, so that the pass order stays close to the greedy order.
+    // that would reach the target, so that the pass order stays close to the greedy order. Only candidates
+    // under the limit are sorted.
+    auto cheaper = [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; };
     size_t goal = (alive_triangles_ - target + 1) / 2;
-    float limit = goal < order_.size() ? 1.5f * order_[goal].cost : std::numeric_limits<float>::infinity();
+    float limit = std::numeric_limits<float>::infinity();
+    if (goal < order_.size()) {
+      std::nth_element(order_.begin(), order_.begin() + goal, order_.end(), cheaper);
+      limit = 1.5f * order_[goal].cost;
+      order_.erase(
+          std::partition(order_.begin(), order_.end(), [&](const Candidate& c) { return c.cost <= limit; }),
+          order_.end());
+    }
+    tbb::parallel_sort(order_.begin(), order_.end(), cheaper);
     size_t collapsed = 0;
     for (const Candidate& c : order_) {
       if (c.cost > limit || alive_triangles_ <= target) break;

@@ -37,9 +37,9 @@ struct Options {
 
   // Attribute weights in the collapse cost (attribute units per unit of the bounding-box extent): 0 drops the
   // attribute from the cost (it is still interpolated). All 0 gives the positions-only metric.
-  float normal_weight = 0.5f;
-  float uv_weight = 1.0f;
-  float color_weight = 0.5f;
+  float normal_weight = 0.01f;
+  float uv_weight = 0.05f;
+  float color_weight = 0.05f;
   // Weight of the boundary / seam penalty planes (Garland & Heckbert's perpendicular planes), times |e|^2.
   float boundary_weight = 20.0f;
   // A collapse is rejected when any remaining triangle's normal turns by more than this (degrees).

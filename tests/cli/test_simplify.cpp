@@ -1,0 +1,48 @@
+// `lodstream simplify` end to end: targets, JSON keys, the written mesh, bad arguments.
+#include <gtest/gtest.h>
+
+#include "support/run.hpp"
+
+using lodstream::test::data_file;
+using lodstream::test::run_lodstream;
+using lodstream::test::temp_dir;
+
+TEST(CliSimplify, RatioWritesMeshAndReportsJson) {
+  auto out = temp_dir() / "bunny_10.ply";
+  auto r = run_lodstream(
+      {"simplify", data_file("bunny.obj").string(), "-o", out.string(), "--ratio", "0.1", "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto j = r.json();
+  size_t in = j["input_triangles"], got = j["output_triangles"];
+  EXPECT_GT(in, 60000u);
+  EXPECT_NEAR(double(got), 0.1 * double(in), 0.01 * 0.1 * double(in) + 1);
+  EXPECT_GT(j["error_bound"].get<double>(), 0.0);
+  EXPECT_GT(j["time_s"].get<double>(), 0.0);
+  auto info = run_lodstream({"info", out.string(), "--json"});
+  if (info.status == 0) EXPECT_EQ(info.json()["triangles"].get<size_t>(), got);
+}
+
+TEST(CliSimplify, ErrorRelativeIsNotExceeded) {
+  auto out = temp_dir() / "horse.obj";
+  auto r = run_lodstream({"simplify", data_file("horse.ply").string(), "-o", out.string(), "--error-relative",
+                          "0.01", "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto j = r.json();
+  EXPECT_LT(j["output_triangles"].get<size_t>(), j["input_triangles"].get<size_t>());
+  EXPECT_GT(j["error_bound"].get<double>(), 0.0);
+}
+
+TEST(CliSimplify, BadArgumentsAreOneLineErrors) {
+  auto out = (temp_dir() / "x.ply").string();
+  auto model = data_file("bunny.obj").string();
+  for (const auto& args : std::vector<std::vector<std::string>>{
+           {"simplify", model, "-o", out},
+           {"simplify", model, "-o", out, "--ratio", "0.5", "--triangles", "10"},
+           {"simplify", model, "-o", out, "--ratio", "1.5"},
+           {"simplify", model, "-o", (temp_dir() / "x.stl").string(), "--ratio", "0.5"},
+           {"simplify", "/nonexistent.obj", "-o", out, "--ratio", "0.5"}}) {
+    auto r = run_lodstream(args);
+    EXPECT_EQ(r.status, 1) << args[4];
+    EXPECT_NE(r.err.find("lodstream: error:"), std::string::npos) << r.err;
+  }
+}
