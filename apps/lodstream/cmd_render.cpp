@@ -68,7 +68,9 @@ int run_render(const RenderOptions& opt) {
 
   auto context = render::create_headless_context();
   render::Renderer renderer(*context, {opt.msaa});
+  const auto upload_start = std::chrono::steady_clock::now();
   const render::SceneUpload upload = render::upload_scene(renderer, scene);
+  const double upload_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - upload_start).count();
   for (const std::string& warning : upload.warnings)
     std::fprintf(stderr, "lodstream: warning: %s\n", warning.c_str());
 
@@ -87,6 +89,7 @@ int run_render(const RenderOptions& opt) {
                 {"draw_ms", median},
                 {"draw_ms_min", draw_ms.front()},
                 {"load_s", load_s},
+                {"upload_s", upload_s},
                 {"renderer", context->renderer()},
                 {"platform", context->platform()},
                 {"msaa", opt.msaa},

@@ -1,6 +1,7 @@
 #include "render/renderer.hpp"
 
 #include <epoxy/gl.h>
+#include <meshoptimizer.h>
 
 #include <chrono>
 #include <cstring>
@@ -173,8 +174,14 @@ MeshHandle Renderer::upload_mesh(const Mesh& mesh) {
   // Zero-sized buffer storage is an error; an empty mesh keeps one dummy byte and draws nothing.
   glNamedBufferStorage(gpu.vertex_buffer, std::max<GLsizeiptr>(1, vertices.size() * sizeof(float)),
                        vertices.empty() ? nullptr : vertices.data(), 0);
-  glNamedBufferStorage(gpu.index_buffer, std::max<GLsizeiptr>(1, mesh.indices.size() * sizeof(uint32_t)),
-                       mesh.indices.empty() ? nullptr : mesh.indices.data(), 0);
+  std::vector<uint32_t> reordered;
+  if (options_.optimize_vertex_cache && !mesh.indices.empty()) {
+    reordered.resize(mesh.indices.size());
+    meshopt_optimizeVertexCache(reordered.data(), mesh.indices.data(), mesh.indices.size(), mesh.positions.size());
+  }
+  const std::vector<uint32_t>& indices = reordered.empty() ? mesh.indices : reordered;
+  glNamedBufferStorage(gpu.index_buffer, std::max<GLsizeiptr>(1, indices.size() * sizeof(uint32_t)),
+                       indices.empty() ? nullptr : indices.data(), 0);
   glCreateVertexArrays(1, &gpu.vertex_array);
   const GLuint vao = gpu.vertex_array;
   glVertexArrayVertexBuffer(vao, 0, gpu.vertex_buffer, 0, GLsizei(floats * sizeof(float)));
