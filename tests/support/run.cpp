@@ -24,6 +24,19 @@ std::string slurp(const std::filesystem::path& p) {
   s << in.rdbuf();
   return s.str();
 }
+// Starts build/bin/lodstream with `args` and the given descriptor set-up; -1 (and a test failure) if it
+// fails.
+pid_t spawn(const std::vector<std::string>& args, const posix_spawn_file_actions_t& actions) {
+  std::vector<std::string> argv_s{LODSTREAM_BINARY};
+  argv_s.insert(argv_s.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : argv_s) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ) == 0) return pid;
+  ADD_FAILURE() << "cannot start " << argv[0];
+  return -1;
+}
 }  // namespace
 
 nlohmann::json RunResult::json() const {
@@ -43,18 +56,10 @@ RunResult run_lodstream(const std::vector<std::string>& args) {
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, 1, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  std::vector<std::string> argv_s{LODSTREAM_BINARY};
-  argv_s.insert(argv_s.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& a : argv_s) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  RunResult r;
-  if (posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ) != 0) {
-    ADD_FAILURE() << "cannot start " << argv[0];
-    return r;
-  }
+  pid_t pid = spawn(args, actions);
   posix_spawn_file_actions_destroy(&actions);
+  RunResult r;
+  if (pid < 0) return r;
   int status = 0;
   waitpid(pid, &status, 0);
   r.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
@@ -74,17 +79,9 @@ BackgroundProcess::BackgroundProcess(const std::vector<std::string>& args) {
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], 1);
   posix_spawn_file_actions_addclose(&actions, pipe_fds[0]);
-  std::vector<std::string> argv_s{LODSTREAM_BINARY};
-  argv_s.insert(argv_s.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& a : argv_s) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  if (posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ) != 0)
-    ADD_FAILURE() << "cannot start " << argv[0];
+  pid_ = spawn(args, actions);
   posix_spawn_file_actions_destroy(&actions);
   close(pipe_fds[1]);
-  pid_ = pid;
   out_ = pipe_fds[0];
 }
 
@@ -113,7 +110,10 @@ std::string BackgroundProcess::read_line(double timeout_s) {
 }
 
 int BackgroundProcess::stop() {
-  if (pid_ < 0) return -1;
+  if (pid_ < 0) {
+    if (out_ >= 0) close(out_), out_ = -1;
+    return -1;
+  }
   kill(pid_, SIGTERM);
   int status = 0;
   waitpid(pid_, &status, 0);
