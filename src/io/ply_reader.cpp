@@ -365,7 +365,20 @@ void read_binary(const char* data, size_t size, const Header& h, const std::stri
             throw Error(file + ": negative list length at byte offset " + std::to_string(offset - cs));
           if (static_cast<uint64_t>(n) > (size - offset) / is)
             throw truncated("face " + std::to_string(f), face_start);
-          if (is_face_list(prop)) {
+          if (is_face_list(prop) && n == 3) {  // the common case, without the polygon buffer
+            uint32_t tri[3];
+            for (int k = 0; k < 3; ++k) {
+              int64_t idx = as_index(load<Swap>(data + offset + k * is, prop.type));
+              tri[k] = idx < 0 || idx > UINT32_MAX ? UINT32_MAX : static_cast<uint32_t>(idx);
+            }
+            if (tri[0] >= vertex_count || tri[1] >= vertex_count || tri[2] >= vertex_count) {
+              faces.polygon.assign(tri, tri + 3);
+              faces.add([&] {
+                return "face " + std::to_string(f) + " at byte offset " + std::to_string(face_start);
+              });
+            }
+            mesh.indices.insert(mesh.indices.end(), tri, tri + 3);
+          } else if (is_face_list(prop)) {
             faces.polygon.resize(static_cast<size_t>(n));
             for (int64_t k = 0; k < n; ++k) {
               int64_t idx = as_index(load<Swap>(data + offset + k * is, prop.type));

@@ -1,9 +1,9 @@
 #include "io/weld.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
-#include <unordered_map>
 #include <vector>
 
 namespace lodstream {
@@ -59,24 +59,29 @@ struct VertexKey {
   }
 };
 
-// For every vertex, the first vertex equal to it under `key` (open addressing, linear probing, load <= 0.5).
+// For every vertex, the first vertex equal to it under `key`. Open addressing with linear probing at load
+// <= 0.5; each slot keeps 32 bits of the hash next to the vertex, so a probe touches the vertex data only
+// when the hashes agree (one cache miss per vertex in the common case).
 std::vector<uint32_t> representatives(const VertexKey& key, size_t n) {
   size_t capacity = 16;
   while (capacity < 2 * n) capacity *= 2;
-  std::vector<uint32_t> table(capacity, kNone);
+  constexpr uint64_t kEmpty = UINT64_MAX;
+  std::vector<uint64_t> table(capacity, kEmpty);
   std::vector<uint32_t> rep(n);
   const size_t mask = capacity - 1;
   for (uint32_t v = 0; v < n; ++v) {
-    size_t slot = key.hash(v) & mask;
+    const uint64_t h = key.hash(v);
+    const uint64_t tag = h >> 32;
+    size_t slot = h & mask;
     for (;;) {
-      uint32_t e = table[slot];
-      if (e == kNone) {
-        table[slot] = v;
+      const uint64_t e = table[slot];
+      if (e == kEmpty) {
+        table[slot] = (tag << 32) | v;
         rep[v] = v;
         break;
       }
-      if (key.equal(e, v)) {
-        rep[v] = e;
+      if ((e >> 32) == tag && key.equal(static_cast<uint32_t>(e), v)) {
+        rep[v] = static_cast<uint32_t>(e);
         break;
       }
       slot = (slot + 1) & mask;
@@ -122,6 +127,27 @@ void weld_by(Mesh& mesh, const VertexKey& key) {
   compact(mesh, keep);
 }
 
+// Flat shading: (nearly) every corner's normal is its triangle's normal (within 1 degree), and positions are
+// duplicated (at least 10% of vertices share their position with another) because neighbouring faces need
+// different normals. Dense smooth meshes can pass the first test but not the second; a shared-vertex
+// flat-looking mesh (a subdivided plane) passes neither.
+bool looks_flat_shaded(const Mesh& mesh) {
+  const float cos_tolerance = std::cos(glm::radians(1.0f));
+  size_t matching = 0;
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const uint32_t* v = &mesh.indices[3 * t];
+    const glm::vec3 n = glm::normalize(
+        glm::cross(mesh.positions[v[1]] - mesh.positions[v[0]], mesh.positions[v[2]] - mesh.positions[v[0]]));
+    for (int k = 0; k < 3; ++k)
+      matching += glm::dot(mesh.normals[v[k]], n) > cos_tolerance * glm::length(mesh.normals[v[k]]);
+  }
+  if (10 * matching < 9 * mesh.indices.size()) return false;
+  std::vector<uint32_t> rep = representatives(VertexKey{mesh, false, false, false}, mesh.vertex_count());
+  size_t unique = 0;
+  for (uint32_t v = 0; v < rep.size(); ++v) unique += rep[v] == v;
+  return 10 * unique <= 9 * mesh.vertex_count();
+}
+
 }  // namespace
 
 void weld_identical(Mesh& mesh) {
@@ -133,17 +159,22 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
   weld_by(mesh, VertexKey{mesh, false, mesh.has_uvs(), mesh.has_colors()});
   const size_t nv = mesh.positions.size(), nt = mesh.triangle_count(), nc = mesh.indices.size();
 
-  // Position classes: vertices that differ only in UV or colour share a normal.
-  std::vector<uint32_t> position = representatives(VertexKey{mesh, false, false, false}, nv);
+  // Position classes: vertices that differ only in UV or colour share a normal. Without UVs and colours every
+  // vertex is its own class already.
+  std::vector<uint32_t> position;
+  if (mesh.has_uvs() || mesh.has_colors()) {
+    position = representatives(VertexKey{mesh, false, false, false}, nv);
+  } else {
+    position.resize(nv);
+    for (uint32_t v = 0; v < nv; ++v) position[v] = v;
+  }
 
-  // Face normals: unnormalized (area-weighted) for the sums, unit for the crease test.
-  std::vector<glm::vec3> face(nt), unit(nt);
+  // Face normals, unnormalized: their length is twice the area, which weights the sums.
+  std::vector<glm::vec3> face(nt);
   for (size_t t = 0; t < nt; ++t) {
     const uint32_t* v = &mesh.indices[3 * t];
     face[t] =
         glm::cross(mesh.positions[v[1]] - mesh.positions[v[0]], mesh.positions[v[2]] - mesh.positions[v[0]]);
-    float len = glm::length(face[t]);
-    unit[t] = len > 0 ? face[t] / len : glm::vec3(0.0f);
   }
 
   // Corners grouped by position class (counting sort).
@@ -155,63 +186,55 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
     for (uint32_t c = 0; c < nc; ++c) corners[fill[position[mesh.indices[c]]]++] = c;
   }
 
-  // Crease groups per position: corner_group[c] is a global group id, group_sum its normal sum.
+  // Per position: group its corners by crease, then give each (welded vertex, group) pair one output vertex.
+  // A welded vertex belongs to exactly one position, so all its corners are handled here and the indices can
+  // be rewritten in place.
   const float cos_crease = std::cos(glm::radians(crease_angle_degrees));
-  std::vector<uint32_t> corner_group(nc);
-  std::vector<glm::vec3> group_sum;
-  std::vector<uint32_t> seeds;  // seed triangle of each group of the current position
-  for (size_t p = 0; p < nv; ++p) {
-    if (start[p] == start[p + 1]) continue;
-    const uint32_t first_group = static_cast<uint32_t>(group_sum.size());
-    seeds.clear();
-    for (uint32_t k = start[p]; k < start[p + 1]; ++k) {
-      const uint32_t c = corners[k], t = c / 3;
-      size_t g = 0;
-      while (g < seeds.size() && glm::dot(unit[seeds[g]], unit[t]) < cos_crease) ++g;
-      if (g == seeds.size()) {
-        seeds.push_back(t);
-        group_sum.push_back(glm::vec3(0.0f));
-      }
-      corner_group[c] = first_group + static_cast<uint32_t>(g);
-      group_sum[first_group + g] += face[t];
-    }
-  }
-
-  // One output vertex per (welded vertex, crease group); most vertices have one group, kept in flat arrays,
-  // the few extra (vertices on a crease) in a hash map.
-  std::vector<uint32_t> slot_group(nv, kNone), slot_vertex(nv, kNone);
-  std::unordered_map<uint64_t, uint32_t> extra;
+  struct Group {
+    glm::vec3 seed;  // unit normal of the group's first triangle
+    glm::vec3 sum;   // area-weighted normal sum
+  };
+  struct Output {
+    uint32_t vertex, group, out;
+  };
+  std::vector<Group> groups;
+  std::vector<uint32_t> corner_group;
+  std::vector<Output> outputs;
   std::vector<uint32_t> keep;
   std::vector<glm::vec3> normals;
   keep.reserve(nv);
   normals.reserve(nv);
-  for (uint32_t c = 0; c < nc; ++c) {
-    const uint32_t w = mesh.indices[c], g = corner_group[c];
-    uint32_t out;
-    if (slot_group[w] == g) {
-      out = slot_vertex[w];
-    } else {
-      uint32_t* found = nullptr;
-      if (slot_group[w] != kNone) {
-        auto [it, inserted] = extra.try_emplace((uint64_t(w) << 32) | g, kNone);
-        found = &it->second;
-        if (!inserted) {
-          mesh.indices[c] = it->second;
-          continue;
-        }
-      }
-      out = static_cast<uint32_t>(keep.size());
-      keep.push_back(w);
-      float len = glm::length(group_sum[g]);
-      normals.push_back(len > 0 ? group_sum[g] / len : glm::vec3(0.0f, 0.0f, 1.0f));
-      if (found) {
-        *found = out;
-      } else {
-        slot_group[w] = g;
-        slot_vertex[w] = out;
-      }
+  for (size_t p = 0; p < nv; ++p) {
+    const uint32_t begin = start[p], end = start[p + 1];
+    if (begin == end) continue;
+    groups.clear();
+    corner_group.clear();
+    for (uint32_t k = begin; k < end; ++k) {
+      const glm::vec3& n = face[corners[k] / 3];
+      const float len = glm::length(n);
+      const glm::vec3 unit = len > 0 ? n / len : glm::vec3(0.0f);
+      size_t g = 0;
+      while (g < groups.size() && glm::dot(groups[g].seed, unit) < cos_crease) ++g;
+      if (g == groups.size()) groups.push_back({unit, glm::vec3(0.0f)});
+      groups[g].sum += n;
+      corner_group.push_back(static_cast<uint32_t>(g));
     }
-    mesh.indices[c] = out;
+    outputs.clear();
+    for (uint32_t k = begin; k < end; ++k) {
+      const uint32_t c = corners[k], w = mesh.indices[c], g = corner_group[k - begin];
+      // Distinct (vertex, group) pairs at one position are few (seams, creases): a linear search is enough.
+      auto it = std::find_if(outputs.begin(), outputs.end(),
+                             [w, g](const Output& o) { return o.vertex == w && o.group == g; });
+      if (it == outputs.end()) {
+        const uint32_t out = static_cast<uint32_t>(keep.size());
+        keep.push_back(w);
+        const float len = glm::length(groups[g].sum);
+        normals.push_back(len > 0 ? groups[g].sum / len : glm::vec3(0.0f, 0.0f, 1.0f));
+        outputs.push_back({w, g, out});
+        it = outputs.end() - 1;
+      }
+      mesh.indices[c] = it->out;
+    }
   }
   compact(mesh, keep);
   mesh.normals = std::move(normals);
@@ -220,10 +243,15 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
 WeldResult weld(Mesh& mesh, float crease_angle_degrees) {
   WeldResult r;
   r.vertices_before = mesh.vertex_count();
+  if (!mesh.has_normals()) {
+    weld_with_crease_normals(mesh, crease_angle_degrees);  // welds by position, UV and colour first
+    r.normals_recomputed = true;
+    r.vertices_after = mesh.vertex_count();
+    return r;
+  }
   weld_identical(mesh);
-  // Mean triangles per vertex is 3T/V: about 6 on a shared-vertex surface, 1 when every triangle has its own.
-  const bool flat = mesh.has_normals() && 3 * mesh.triangle_count() < 2 * mesh.vertex_count();
-  if (!mesh.has_normals() || flat) {
+  const bool flat = looks_flat_shaded(mesh);
+  if (flat) {
     weld_with_crease_normals(mesh, crease_angle_degrees);
     r.normals_recomputed = true;
   }

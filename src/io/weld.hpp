@@ -22,9 +22,10 @@ void weld_identical(Mesh& mesh);
 // sharper than the crease angle stay seams; everything else is smooth. Cost: O(V + T) expected.
 void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees);
 
-// What import does with every mesh: weld_identical; then, when the mesh has no normals or looks flat-shaded /
-// unwelded (fewer than 2 triangles per vertex on average, where a shared-vertex surface has about 6),
-// weld_with_crease_normals. Authored smooth normals are kept as they are.
+// What import does with every mesh: weld_with_crease_normals when it has no normals; otherwise
+// weld_identical, then weld_with_crease_normals when it looks flat-shaded (at least 90% of corners carry
+// their triangle's normal within 1 degree, and at least 10% of vertices share their position with another).
+// Authored smooth normals are kept as they are.
 WeldResult weld(Mesh& mesh, float crease_angle_degrees);
 
 }  // namespace lodstream
