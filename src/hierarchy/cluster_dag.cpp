@@ -1,0 +1,328 @@
+#include "hierarchy/cluster_dag.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+#include "hierarchy/bounding_sphere.hpp"
+#include "hierarchy/clusterize.hpp"
+#include "hierarchy/group_partition.hpp"
+#include "hierarchy/position_index.hpp"
+#include "simplify/simplify.hpp"
+
+namespace lodstream::hierarchy {
+namespace {
+
+// Build state: the DAG plus, per cluster, the position id of each vertex (ids equal <=> positions equal).
+struct Builder {
+  const DagOptions& options;
+  ClusterDag dag;
+  std::vector<std::vector<uint32_t>> position_ids;  // by cluster
+  std::vector<uint8_t> open_boundary;               // by position id (ids of the input mesh)
+  std::atomic<uint32_t> next_position_id{0};
+};
+
+uint64_t edge_key(uint32_t a, uint32_t b) {
+  if (a > b) std::swap(a, b);
+  return uint64_t(a) << 32 | b;
+}
+
+// Edges of a cluster used by exactly one of its triangles (by position id), as sorted keys.
+std::vector<uint64_t> cluster_boundary(const Mesh& mesh, const std::vector<uint32_t>& ids) {
+  std::vector<uint64_t> edges;
+  edges.reserve(mesh.indices.size());
+  for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3)
+    for (int k = 0; k < 3; ++k)
+      edges.push_back(edge_key(ids[mesh.indices[t + k]], ids[mesh.indices[t + (k + 1) % 3]]));
+  std::sort(edges.begin(), edges.end());
+  std::vector<uint64_t> once;
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i;
+    while (j < edges.size() && edges[j] == edges[i]) ++j;
+    if (j - i == 1) once.push_back(edges[i]);
+    i = j;
+  }
+  return once;
+}
+
+float round_up(double x) {
+  float f = float(x);
+  return double(f) < x ? std::nextafter(f, INFINITY) : f;
+}
+
+// Level 0: the input (without degenerate triangles) split into clusters; position ids by exact welding.
+void build_level0(Builder& b, const Mesh& input) {
+  Mesh mesh;
+  mesh.positions = input.positions, mesh.normals = input.normals, mesh.uvs = input.uvs;
+  mesh.colors = input.colors, mesh.material = input.material;
+  mesh.indices.reserve(input.indices.size());
+  for (size_t t = 0; t + 2 < input.indices.size(); t += 3) {
+    const uint32_t a = input.indices[t], c1 = input.indices[t + 1], c2 = input.indices[t + 2];
+    if (a == c1 || c1 == c2 || a == c2) continue;
+    mesh.indices.insert(mesh.indices.end(), {a, c1, c2});
+  }
+  b.dag.input_triangles = mesh.triangle_count();
+  if (mesh.indices.empty()) return;
+
+  PositionIndex index(mesh.positions.size());
+  std::vector<uint32_t> vertex_id(mesh.positions.size());
+  for (size_t v = 0; v < mesh.positions.size(); ++v) vertex_id[v] = index.insert(mesh.positions[v]);
+  b.next_position_id = uint32_t(index.size());
+
+  std::vector<ClusterPart> parts =
+      clusterize(mesh, b.options.max_cluster_vertices, b.options.max_cluster_triangles);
+  b.dag.clusters.resize(parts.size());
+  b.position_ids.resize(parts.size());
+  tbb::parallel_for(size_t(0), parts.size(), [&](size_t c) {
+    DagCluster& cluster = b.dag.clusters[c];
+    cluster.mesh = cluster_mesh(mesh, parts[c]);
+    cluster.locked.assign(cluster.mesh.positions.size(), 0);
+    cluster.sphere = sphere_of_points(cluster.mesh.positions);
+    auto& ids = b.position_ids[c];
+    for (uint32_t v : parts[c].vertices) ids.push_back(vertex_id[v]);
+  });
+}
+
+// Marks the positions of edges that no other cluster shares (the mesh's open boundary).
+void mark_open_boundary(Builder& b, std::vector<ClusterEdge>& edges) {
+  b.open_boundary.assign(b.next_position_id, 0);
+  std::sort(edges.begin(), edges.end());
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i;
+    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
+    if (j - i == 1) {
+      b.open_boundary[uint32_t(edges[i].first >> 32)] = 1;
+      b.open_boundary[uint32_t(edges[i].first)] = 1;
+    }
+    i = j;
+  }
+}
+
+struct NewCluster {
+  Mesh mesh;
+  std::vector<uint32_t> ids;
+  std::vector<uint8_t> locked;
+  Sphere sphere;
+};
+
+struct GroupResult {
+  bool accepted = false;
+  DagGroup group;
+  std::vector<NewCluster> clusters;
+};
+
+// Merges, simplifies with the border locked and re-splits one group (formula of error_g in the header).
+GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
+                           const std::vector<uint8_t>& border, uint32_t level) {
+  const DagOptions& o = b.options;
+  GroupResult out;
+  Mesh merged;
+  std::vector<uint32_t> merged_ids;
+  simplify::Options so;
+  const Mesh& first = b.dag.clusters[members[0]].mesh;
+  merged.material = first.material;
+  for (uint32_t c : members) {
+    const Mesh& m = b.dag.clusters[c].mesh;
+    const uint32_t base = uint32_t(merged.positions.size());
+    merged.positions.insert(merged.positions.end(), m.positions.begin(), m.positions.end());
+    merged.normals.insert(merged.normals.end(), m.normals.begin(), m.normals.end());
+    merged.uvs.insert(merged.uvs.end(), m.uvs.begin(), m.uvs.end());
+    merged.colors.insert(merged.colors.end(), m.colors.begin(), m.colors.end());
+    for (uint32_t i : m.indices) merged.indices.push_back(base + i);
+    for (uint32_t id : b.position_ids[c]) {
+      merged_ids.push_back(id);
+      so.locked.push_back(border[id] ||
+                          (o.lock_open_boundary && id < b.open_boundary.size() && b.open_boundary[id]));
+    }
+  }
+  const size_t input_triangles = merged.triangle_count();
+  so.target_triangles = std::max<size_t>(1, size_t(double(input_triangles) * o.group_ratio));
+  so.normal_weight = o.normal_weight, so.uv_weight = o.uv_weight, so.color_weight = o.color_weight;
+  simplify::Result r = simplify::simplify_mesh(merged, so);
+  GroupOutcome outcome = r.mesh.triangle_count() <= size_t(double(input_triangles) * o.group_ratio * 1.1)
+                             ? GroupOutcome::halved
+                             : GroupOutcome::partial;
+  const auto stuck = [&](const simplify::Result& res) {
+    return double(res.mesh.triangle_count()) > double(input_triangles) * o.stuck_ratio;
+  };
+  if (stuck(r)) {  // fallback: positions only, looser fold-over limit (attribute seams no longer matter)
+    so.normal_weight = so.uv_weight = so.color_weight = 0.0f;
+    so.max_normal_change_deg = 120.0f;
+    r = simplify::simplify_mesh(merged, so);
+    outcome = GroupOutcome::positions_only;
+    if (stuck(r)) return out;
+  }
+
+  // Position ids of the result: positions of the group's input keep theirs (locked ones never move).
+  PositionIndex local(merged.positions.size());
+  std::vector<uint32_t> local_to_id;
+  std::vector<uint8_t> local_locked;
+  for (size_t v = 0; v < merged.positions.size(); ++v) {
+    if (local.insert(merged.positions[v]) == local_to_id.size()) {
+      local_to_id.push_back(merged_ids[v]);
+      local_locked.push_back(so.locked[v]);
+    } else if (so.locked[v]) {
+      local_locked[local.find(merged.positions[v])] = 1;
+    }
+  }
+  const Mesh& result = r.mesh;
+  std::vector<uint32_t> result_ids(result.positions.size());
+  std::vector<uint8_t> result_locked(result.positions.size(), 0);
+  for (size_t v = 0; v < result.positions.size(); ++v) {
+    // A new position (seam vertices share one) gets one new id.
+    const uint32_t l = local.insert(result.positions[v]);
+    if (l == local_to_id.size()) {
+      local_to_id.push_back(b.next_position_id.fetch_add(1));
+      local_locked.push_back(0);
+    }
+    result_ids[v] = local_to_id[l];
+    result_locked[v] = local_locked[l];
+  }
+
+  DagGroup& g = out.group;
+  g.level = level;
+  g.children = members;
+  g.simplification_bound = r.error_bound;
+  g.input_triangles = input_triangles;
+  g.output_triangles = result.triangle_count();
+  g.outcome = outcome;
+  double child_error = 0.0;
+  std::vector<Sphere> spheres;
+  for (uint32_t c : members) {
+    child_error = std::max(child_error, double(b.dag.clusters[c].error));
+    spheres.push_back(b.dag.clusters[c].sphere);
+  }
+  g.error = round_up(child_error + r.error_bound);
+  g.sphere = sphere_of_spheres(spheres, result.positions);
+
+  for (const ClusterPart& part : clusterize(result, o.max_cluster_vertices, o.max_cluster_triangles)) {
+    NewCluster nc;
+    nc.mesh = cluster_mesh(result, part);
+    for (uint32_t v : part.vertices) {
+      nc.ids.push_back(result_ids[v]);
+      nc.locked.push_back(result_locked[v]);
+    }
+    out.clusters.push_back(std::move(nc));
+  }
+  out.accepted = true;
+  return out;
+}
+
+}  // namespace
+
+ClusterDag build_cluster_dag(const Mesh& mesh, const DagOptions& options) {
+  Builder b{options, {}, {}, {}, {}};
+  build_level0(b, mesh);
+  ClusterDag& dag = b.dag;
+  if (dag.clusters.empty()) return std::move(dag);
+  dag.levels = 1;
+
+  std::vector<uint32_t> active(dag.clusters.size());
+  for (uint32_t c = 0; c < active.size(); ++c) active[c] = c;
+  for (uint32_t level = 1; level <= options.max_levels; ++level) {
+    size_t active_triangles = 0;
+    for (uint32_t c : active) active_triangles += dag.clusters[c].mesh.triangle_count();
+    if (options.progress) options.progress(level - 1, active_triangles);
+    if (active.size() <= 1 || active_triangles <= options.root_triangles) break;
+
+    // Boundary edges of the active clusters -> adjacency (and, at level 0, the open boundary).
+    std::vector<std::vector<uint64_t>> boundary(active.size());
+    tbb::parallel_for(size_t(0), active.size(), [&](size_t i) {
+      boundary[i] = cluster_boundary(dag.clusters[active[i]].mesh, b.position_ids[active[i]]);
+    });
+    std::vector<ClusterEdge> edges;
+    for (uint32_t i = 0; i < active.size(); ++i)
+      for (uint64_t e : boundary[i]) edges.emplace_back(e, i);
+    boundary.clear();
+    if (level == 1) mark_open_boundary(b, edges);
+    std::vector<uint32_t> triangles(active.size());
+    std::vector<glm::vec3> centroids(active.size());
+    for (size_t i = 0; i < active.size(); ++i) {
+      triangles[i] = uint32_t(dag.clusters[active[i]].mesh.triangle_count());
+      centroids[i] = dag.clusters[active[i]].sphere.center;
+    }
+    std::vector<std::vector<uint32_t>> groups =
+        partition_clusters(triangles, centroids, edges, options.group_clusters);
+    edges = {};
+    for (auto& g : groups)
+      for (uint32_t& i : g) i = active[i];  // active position -> cluster id
+
+    // Group borders: positions used by clusters of more than one group.
+    std::vector<uint32_t> owner(b.next_position_id, UINT32_MAX);
+    std::vector<uint8_t> border(b.next_position_id, 0);
+    for (uint32_t g = 0; g < groups.size(); ++g)
+      for (uint32_t c : groups[g])
+        for (uint32_t id : b.position_ids[c]) {
+          if (owner[id] == UINT32_MAX)
+            owner[id] = g;
+          else if (owner[id] != g)
+            border[id] = 1;
+        }
+    owner = {};
+
+    std::vector<GroupResult> results(groups.size());
+    tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
+      // A group of one cluster at a level with several groups cannot change its (locked) border: skip it.
+      if (groups[g].size() > 1 || groups.size() == 1)
+        results[g] = simplify_group(b, groups[g], border, level);
+    });
+
+    std::vector<uint32_t> next;
+    bool any = false;
+    for (size_t g = 0; g < groups.size(); ++g) {
+      GroupResult& r = results[g];
+      if (!r.accepted) {
+        if (groups[g].size() > 1) ++dag.abandoned_groups;
+        next.insert(next.end(), groups[g].begin(), groups[g].end());
+        continue;
+      }
+      any = true;
+      const uint32_t gid = uint32_t(dag.groups.size());
+      for (uint32_t c : r.group.children) {
+        DagCluster& child = dag.clusters[c];
+        child.parent_group = gid;
+        child.parent_error = r.group.error;
+        child.parent_sphere = r.group.sphere;
+        // Positions locked in this simplification are shared with other groups' clusters: codec-locked.
+        const auto& ids = b.position_ids[c];
+        for (size_t v = 0; v < ids.size(); ++v)
+          if (border[ids[v]] ||
+              (options.lock_open_boundary && ids[v] < b.open_boundary.size() && b.open_boundary[ids[v]]))
+            child.locked[v] = 1;
+      }
+      for (NewCluster& nc : r.clusters) {
+        const uint32_t cid = uint32_t(dag.clusters.size());
+        DagCluster cluster;
+        cluster.mesh = std::move(nc.mesh);
+        cluster.locked = std::move(nc.locked);
+        cluster.level = level;
+        cluster.group = gid;
+        cluster.error = r.group.error;
+        cluster.sphere = r.group.sphere;
+        dag.clusters.push_back(std::move(cluster));
+        b.position_ids.push_back(std::move(nc.ids));
+        r.group.clusters.push_back(cid);
+        next.push_back(cid);
+      }
+      dag.groups.push_back(std::move(r.group));
+      dag.levels = std::max(dag.levels, level + 1);
+    }
+    active = std::move(next);
+    if (!any) {
+      dag.stalled = true;
+      break;
+    }
+  }
+  for (uint32_t c : active) {
+    DagCluster& root = dag.clusters[c];
+    root.parent_group = kNoGroup;
+    root.parent_error = std::numeric_limits<float>::infinity();
+    root.parent_sphere = root.sphere;
+  }
+  dag.roots = std::move(active);
+  return std::move(dag);
+}
+
+}  // namespace lodstream::hierarchy

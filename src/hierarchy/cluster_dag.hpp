@@ -1,0 +1,98 @@
+// Cluster DAG of one large mesh (DESIGN.md, Data model; Nanite / batched multi-triangulation style, seed
+// 001's multiresolution DAG built bottom-up):
+//   level 0: the mesh split into clusters of at most 128 triangles (clusterize.hpp);
+//   each level: the active clusters are partitioned into groups of about 8 neighbours (METIS on the cluster
+//   adjacency weighted by shared edges, group_partition.hpp); each group is merged and simplified to about
+//   half with its outer border locked (positions shared with clusters of other groups, and the mesh's own
+//   open boundary), and the result is split into new clusters; repeat until the active clusters hold at most
+//   `root_triangles` triangles (or one cluster), or no group of a level can be reduced.
+// Fallbacks (recorded per group, like meshoptimizer's clusterlod): a group that does not reach 85 % of its
+// triangles with attributes is retried positions-only with a looser normal limit; a group still above 85 %
+// is abandoned and its clusters stay active for the next level (with other neighbours); the build always
+// terminates because every accepted group removes triangles, and a level where none is accepted ends it.
+//
+// Errors (totals, object units): a level-0 cluster has error 0; the clusters made by group g all share
+// (error_g, sphere_g) with error_g = max over g's input clusters of their error + g's simplification bound
+// (Result::error_bound, >= the symmetric Hausdorff distance to g's input), rounded up to float, so errors are
+// monotonic and bound the two-sided distance to the full-resolution surface; sphere_g contains the input
+// clusters' spheres and the output geometry. Each input cluster of g stores (error_g, sphere_g) as its
+// parents' pair. Cut rule (cut.hpp): draw a cluster when its own error projects to <= tau and its parents'
+// to > tau; because border positions are locked bit for bit, the selected clusters form a crack-free surface.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "core/bounds.hpp"
+#include "core/mesh.hpp"
+
+namespace lodstream::hierarchy {
+
+inline constexpr uint32_t kNoGroup = UINT32_MAX;
+
+struct DagOptions {
+  size_t max_cluster_triangles = 128;  // divisible by 4, at most 512 (meshoptimizer's meshlet limit)
+  size_t max_cluster_vertices = 128;   // at most 255
+  size_t group_clusters = 8;           // target clusters per group
+  double group_ratio = 0.5;            // target triangles after simplifying a group, as a fraction
+  double stuck_ratio = 0.85;           // a group above this fraction after the fallback is abandoned
+  size_t root_triangles = 256;         // stop when the active clusters hold at most this many
+  uint32_t max_levels = 48;
+  // Lock the mesh's open boundary at every level: its outline stays exact, which makes "the cut's boundary
+  // edges are the original boundary edges" an exact test. Costs reduction on meshes with long open borders.
+  bool lock_open_boundary = true;
+  // Attribute weights of the group simplification (simplify::Options); the fallback uses 0.
+  float normal_weight = 0.01f, uv_weight = 0.05f, color_weight = 0.05f;
+  // Called with (level, active triangles) after each level.
+  std::function<void(uint32_t, size_t)> progress;
+};
+
+struct DagCluster {
+  Mesh mesh;                    // its own vertices (positions and the input's attributes), <= 128 triangles
+  std::vector<uint8_t> locked;  // per vertex: position on the border of the group that made or consumes it
+  uint32_t level = 0;           // 0 = finest
+  uint32_t group = kNoGroup;    // the group simplification that made it (kNoGroup at level 0)
+  uint32_t parent_group = kNoGroup;  // the group that consumes it (kNoGroup for a root)
+  float error = 0.0f;                // its own (error, sphere): its group's
+  Sphere sphere;
+  float parent_error = std::numeric_limits<float>::infinity();  // its parents' pair; +inf for a root
+  Sphere parent_sphere;
+};
+
+enum class GroupOutcome : uint8_t {
+  halved,          // reached the target with attributes
+  partial,         // accepted with less reduction than the target (under stuck_ratio)
+  positions_only,  // accepted only by the positions-only fallback
+};
+
+struct DagGroup {
+  uint32_t level = 1;              // level of the clusters it made
+  std::vector<uint32_t> children;  // input clusters
+  std::vector<uint32_t> clusters;  // clusters it made
+  float error = 0.0f;
+  Sphere sphere;
+  double simplification_bound = 0.0;  // this step's bound alone
+  size_t input_triangles = 0, output_triangles = 0;
+  GroupOutcome outcome = GroupOutcome::halved;
+};
+
+struct ClusterDag {
+  std::vector<DagCluster> clusters;
+  std::vector<DagGroup> groups;
+  std::vector<uint32_t> roots;  // clusters nobody consumes (the coarsest cut)
+  uint32_t levels = 0;          // cluster levels (1 = only the full-resolution clusters)
+  size_t input_triangles = 0;
+  size_t abandoned_groups = 0;  // groups abandoned (their clusters retried at the next level)
+  bool stalled = false;         // the build ended because no group of a level could be reduced
+};
+
+// Builds the DAG. Degenerate triangles (a repeated index) are dropped; an empty mesh gives an empty DAG.
+// Cost: about twice the cost of simplifying the whole mesh once (every level simplifies half the previous
+// one), groups of a level in parallel (TBB); memory about 60 bytes per input triangle for the clusters.
+// Never throws on odd input (non-manifold, many tiny components, degenerate).
+ClusterDag build_cluster_dag(const Mesh& mesh, const DagOptions& options = {});
+
+}  // namespace lodstream::hierarchy

@@ -1,0 +1,24 @@
+// Splitting a mesh into clusters of at most N triangles and M vertices: triangles are first put in a
+// spatial (Morton) order, then meshoptimizer's meshlet builder grows each cluster greedily over shared
+// vertices, which keeps clusters spatially coherent with few boundary edges.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/mesh.hpp"
+
+namespace lodstream::hierarchy {
+
+struct ClusterPart {
+  std::vector<uint32_t> vertices;  // mesh vertex of each cluster vertex
+  std::vector<uint32_t> indices;   // three cluster-vertex numbers per triangle
+};
+
+// Clusters of `mesh`'s triangles, every triangle in exactly one. Cost: O(T log T), one core.
+std::vector<ClusterPart> clusterize(const Mesh& mesh, size_t max_vertices, size_t max_triangles);
+
+// The cluster's own mesh: positions and every attribute the mesh has, material copied.
+Mesh cluster_mesh(const Mesh& mesh, const ClusterPart& part);
+
+}  // namespace lodstream::hierarchy

@@ -1,0 +1,110 @@
+#include "hierarchy/group_partition.hpp"
+
+#include <metis.h>
+
+#include <algorithm>
+#include <numeric>
+
+#include "core/error.hpp"
+
+namespace lodstream::hierarchy {
+namespace {
+
+// 30-bit Morton code of a point inside [lo, lo + extent].
+uint32_t morton(const glm::vec3& p, const glm::vec3& lo, const glm::vec3& extent) {
+  auto spread = [](uint32_t v) {  // 10 bits -> every third bit
+    v = (v | (v << 16)) & 0x030000FF;
+    v = (v | (v << 8)) & 0x0300F00F;
+    v = (v | (v << 4)) & 0x030C30C3;
+    v = (v | (v << 2)) & 0x09249249;
+    return v;
+  };
+  uint32_t code = 0;
+  for (int a = 0; a < 3; ++a) {
+    float t = extent[a] > 0 ? (p[a] - lo[a]) / extent[a] : 0.0f;
+    code |= spread(uint32_t(std::clamp(t, 0.0f, 1.0f) * 1023.0f)) << a;
+  }
+  return code;
+}
+
+}  // namespace
+
+std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> triangles,
+                                                      std::span<const glm::vec3> centroids,
+                                                      std::vector<ClusterEdge>& edges,
+                                                      size_t group_clusters) {
+  const size_t n = triangles.size();
+  std::vector<std::vector<uint32_t>> groups;
+  if (n == 0) return groups;
+  if (n <= group_clusters) {
+    groups.emplace_back(n);
+    std::iota(groups[0].begin(), groups[0].end(), 0u);
+    return groups;
+  }
+
+  // Cluster pairs sharing an edge: runs of equal edge keys.
+  std::sort(edges.begin(), edges.end());
+  std::vector<std::pair<uint32_t, uint32_t>> pairs;
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i;
+    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
+    for (size_t a = i; a < j; ++a)
+      for (size_t b = a + 1; b < j; ++b)
+        if (edges[a].second != edges[b].second) {
+          pairs.emplace_back(edges[a].second, edges[b].second);
+          pairs.emplace_back(edges[b].second, edges[a].second);
+        }
+    i = j;
+  }
+  // Isolated clusters: link to the previous and next cluster in Morton order.
+  std::vector<uint8_t> linked(n, 0);
+  for (const auto& p : pairs) linked[p.first] = 1;
+  if (std::find(linked.begin(), linked.end(), 0) != linked.end()) {
+    glm::vec3 lo(INFINITY), hi(-INFINITY);
+    for (const glm::vec3& c : centroids) lo = glm::min(lo, c), hi = glm::max(hi, c);
+    std::vector<std::pair<uint32_t, uint32_t>> order(n);
+    for (uint32_t i = 0; i < n; ++i) order[i] = {morton(centroids[i], lo, hi - lo), i};
+    std::sort(order.begin(), order.end());
+    for (size_t k = 0; k < n; ++k) {
+      const uint32_t c = order[k].second;
+      if (linked[c]) continue;
+      for (size_t other : {k - 1, k + 1}) {  // k - 1 wraps to SIZE_MAX at k = 0
+        if (other >= n) continue;
+        pairs.emplace_back(c, order[other].second);
+        pairs.emplace_back(order[other].second, c);
+      }
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+
+  // CSR graph with multiplicities as edge weights.
+  std::vector<idx_t> xadj(n + 1, 0), adjncy, adjwgt, vwgt(n);
+  for (size_t i = 0; i < pairs.size();) {
+    size_t j = i;
+    while (j < pairs.size() && pairs[j] == pairs[i]) ++j;
+    adjncy.push_back(idx_t(pairs[i].second));
+    adjwgt.push_back(idx_t(j - i));
+    ++xadj[pairs[i].first + 1];
+    i = j;
+  }
+  for (size_t i = 0; i < n; ++i) xadj[i + 1] += xadj[i];
+  for (size_t i = 0; i < n; ++i) vwgt[i] = idx_t(std::max<uint32_t>(1, triangles[i]));
+
+  idx_t nvtxs = idx_t(n), ncon = 1, nparts = idx_t((n + group_clusters - 1) / group_clusters), objval = 0;
+  idx_t options[METIS_NOPTIONS];
+  METIS_SetDefaultOptions(options);
+  options[METIS_OPTION_SEED] = 1;  // deterministic builds
+  options[METIS_OPTION_NUMBERING] = 0;
+  std::vector<idx_t> part(n, 0);
+  const int status =
+      METIS_PartGraphKway(&nvtxs, &ncon, xadj.data(), adjncy.data(), vwgt.data(), nullptr, adjwgt.data(),
+                          &nparts, nullptr, nullptr, options, &objval, part.data());
+  if (status != METIS_OK) throw Error("cluster grouping: METIS failed with status " + std::to_string(status));
+
+  groups.resize(size_t(nparts));
+  for (size_t i = 0; i < n; ++i) groups[size_t(part[i])].push_back(uint32_t(i));
+  std::erase_if(groups, [](const std::vector<uint32_t>& g) { return g.empty(); });
+  return groups;
+}
+
+}  // namespace lodstream::hierarchy

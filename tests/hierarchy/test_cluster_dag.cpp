@@ -1,0 +1,193 @@
+// Cluster DAG invariants (cluster_dag.hpp): monotonic errors, containing spheres, crack-free cuts at many
+// views and thresholds, the error bound against a brute-force distance, termination on awkward input.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "hierarchy/bounding_sphere.hpp"
+#include "hierarchy/cluster_dag.hpp"
+#include "hierarchy/cut.hpp"
+#include "support/shapes.hpp"
+
+namespace lodstream::hierarchy {
+namespace {
+
+// Monotonic errors, containing spheres, shared pairs within a group, parents' pairs equal to the group's.
+void check_invariants(const ClusterDag& dag) {
+  for (const DagGroup& g : dag.groups) {
+    for (uint32_t c : g.children) {
+      const DagCluster& child = dag.clusters[c];
+      EXPECT_GE(g.error, child.error);
+      EXPECT_TRUE(sphere_contains(g.sphere, child.sphere)) << "group sphere misses a child's";
+      EXPECT_EQ(child.parent_error, g.error);
+      EXPECT_EQ(child.parent_sphere.radius, g.sphere.radius);
+    }
+    for (uint32_t c : g.clusters) {
+      EXPECT_EQ(dag.clusters[c].error, g.error);
+      EXPECT_EQ(dag.clusters[c].sphere.radius, g.sphere.radius);
+      for (const glm::vec3& p : dag.clusters[c].mesh.positions)
+        EXPECT_LE(glm::length(p - g.sphere.center), g.sphere.radius * 1.000001f);
+    }
+  }
+  for (const DagCluster& c : dag.clusters) {
+    EXPECT_LE(c.mesh.triangle_count(), 128u);
+    EXPECT_GE(c.parent_error, c.error);
+  }
+  for (uint32_t r : dag.roots) EXPECT_TRUE(std::isinf(dag.clusters[r].parent_error));
+}
+
+// Cuts for random eyes and thresholds: welded by position, their boundary edges must be the input's.
+// Returns how many distinct cut sizes were seen (so that the test can check that cuts varied).
+size_t check_cuts(const ClusterDag& dag, const Mesh& input, int cuts) {
+  SurfaceWelder welder;
+  const std::vector<uint32_t> input_ids = welder.weld(input);
+  const std::vector<uint32_t>* input_part = &input_ids;
+  const std::vector<uint64_t> reference = boundary_edges({&input_part, 1});
+  std::vector<std::vector<uint32_t>> welded;
+  for (const DagCluster& c : dag.clusters) welded.push_back(welder.weld(c.mesh));
+
+  const Sphere all = sphere_of_points(input.positions);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<size_t> sizes;
+  for (int i = 0; i < cuts; ++i) {
+    CutView view;
+    glm::dvec3 dir(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5);
+    view.eye = glm::dvec3(all.center) + glm::normalize(dir) * double(all.radius) * (0.5 + 30.0 * u(rng));
+    const double tau = std::pow(10.0, -1.0 + 4.0 * u(rng));
+    std::vector<const std::vector<uint32_t>*> parts;
+    for (size_t c = 0; c < dag.clusters.size(); ++c) {
+      const DagCluster& k = dag.clusters[c];
+      if (in_cut(k.error, k.sphere, k.parent_error, k.parent_sphere, view, tau)) parts.push_back(&welded[c]);
+    }
+    EXPECT_FALSE(parts.empty());
+    const std::string diff = compare_boundaries(boundary_edges(parts), reference, welder);
+    EXPECT_EQ(diff, "") << "cut " << i << " (tau " << tau << ", " << parts.size() << " clusters)";
+    if (!diff.empty()) break;
+    sizes.push_back(parts.size());
+  }
+  std::sort(sizes.begin(), sizes.end());
+  return size_t(std::unique(sizes.begin(), sizes.end()) - sizes.begin());
+}
+
+// Distance from p to triangle abc (Ericson, Real-Time Collision Detection, 5.1.5).
+double point_triangle_distance(glm::dvec3 p, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
+  const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return glm::length(p - a);
+  const glm::dvec3 bp = p - b;
+  const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return glm::length(p - b);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return glm::length(p - (a + ab * (d1 / (d1 - d3))));
+  const glm::dvec3 cp = p - c;
+  const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return glm::length(p - c);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return glm::length(p - (a + ac * (d2 / (d2 - d6))));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0)
+    return glm::length(p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
+  const double denom = 1.0 / (va + vb + vc);
+  return glm::length(p - (a + ab * (vb * denom) + ac * (vc * denom)));
+}
+
+double distance_to(const glm::dvec3& p, const std::vector<const Mesh*>& meshes) {
+  double best = INFINITY;
+  for (const Mesh* m : meshes)
+    for (size_t t = 0; t + 2 < m->indices.size(); t += 3)
+      best = std::min(best,
+                      point_triangle_distance(p, m->positions[m->indices[t]], m->positions[m->indices[t + 1]],
+                                              m->positions[m->indices[t + 2]]));
+  return best;
+}
+
+// Points of a mesh to test distances from: vertices, triangle centroids and edge midpoints.
+std::vector<glm::dvec3> samples(const Mesh& m) {
+  std::vector<glm::dvec3> s(m.positions.begin(), m.positions.end());
+  for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+    glm::dvec3 a = m.positions[m.indices[t]], b = m.positions[m.indices[t + 1]],
+               c = m.positions[m.indices[t + 2]];
+    s.push_back((a + b + c) / 3.0);
+    s.push_back((a + b) * 0.5);
+  }
+  return s;
+}
+
+TEST(ClusterDag, SphereIsMonotonicAndCrackFree) {
+  const Mesh mesh = test::sphere(1.0f, 64, 128);
+  const ClusterDag dag = build_cluster_dag(mesh);
+  EXPECT_EQ(dag.input_triangles, mesh.triangle_count());
+  EXPECT_GE(dag.levels, 5u);
+  size_t root_triangles = 0;
+  for (uint32_t r : dag.roots) root_triangles += dag.clusters[r].mesh.triangle_count();
+  EXPECT_LE(root_triangles, 512u);
+  EXPECT_FALSE(dag.stalled);
+  check_invariants(dag);
+  EXPECT_GE(check_cuts(dag, mesh, 60), 10u);
+}
+
+TEST(ClusterDag, GridKeepsItsBoundaryInEveryCut) {
+  const Mesh mesh = test::grid(64);
+  const ClusterDag dag = build_cluster_dag(mesh);
+  EXPECT_GE(dag.levels, 4u);
+  check_invariants(dag);
+  EXPECT_GE(check_cuts(dag, mesh, 60), 8u);
+}
+
+TEST(ClusterDag, SeamsSurviveAndStayCrackFree) {
+  const Mesh mesh = test::uv_sphere(1.0f, 48, 96);
+  const ClusterDag dag = build_cluster_dag(mesh);
+  check_invariants(dag);
+  check_cuts(dag, mesh, 40);
+  for (const DagCluster& c : dag.clusters) EXPECT_EQ(c.mesh.uvs.size(), c.mesh.positions.size());
+}
+
+TEST(ClusterDag, ErrorBoundHoldsAgainstBruteForceDistance) {
+  const Mesh mesh = test::sphere(1.0f, 24, 48);
+  const ClusterDag dag = build_cluster_dag(mesh);
+  ASSERT_GE(dag.groups.size(), 2u);
+  const std::vector<const Mesh*> full = {&mesh};
+  // One-sided from every coarse cluster to the full-resolution surface.
+  for (const DagCluster& c : dag.clusters) {
+    if (c.level == 0) continue;
+    for (const glm::dvec3& p : samples(c.mesh))
+      EXPECT_LE(distance_to(p, full), double(c.error) * 1.0001 + 1e-6);
+  }
+  // Other side: from the full-resolution surface to the coarsest cut.
+  std::vector<const Mesh*> roots;
+  float root_error = 0.0f;
+  for (uint32_t r : dag.roots)
+    roots.push_back(&dag.clusters[r].mesh), root_error = std::max(root_error, dag.clusters[r].error);
+  EXPECT_GT(root_error, 0.0f);
+  for (const glm::dvec3& p : samples(mesh))
+    EXPECT_LE(distance_to(p, roots), double(root_error) * 1.0001 + 1e-6);
+}
+
+TEST(ClusterDag, TerminatesOnNonManifoldAndManyTinyComponents) {
+  Mesh soup;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0.0f, 10.0f);
+  for (int k = 0; k < 600; ++k) {  // 600 separate tetrahedra (closed, 4 triangles each)
+    const glm::vec3 o(u(rng), u(rng), u(rng));
+    const uint32_t base = uint32_t(soup.positions.size());
+    for (glm::vec3 d : {glm::vec3(0), glm::vec3(0.1f, 0, 0), glm::vec3(0, 0.1f, 0), glm::vec3(0, 0, 0.1f)})
+      soup.positions.push_back(o + d);
+    for (uint32_t i : {0u, 2u, 1u, 0u, 1u, 3u, 0u, 3u, 2u, 1u, 2u, 3u}) soup.indices.push_back(base + i);
+  }
+  const ClusterDag dag = build_cluster_dag(soup);
+  check_invariants(dag);
+  check_cuts(dag, soup, 20);
+
+  const Mesh odd = test::non_manifold();
+  const ClusterDag small = build_cluster_dag(odd);
+  EXPECT_EQ(small.roots.size(), small.clusters.size());
+  check_cuts(small, odd, 5);
+
+  EXPECT_TRUE(build_cluster_dag(Mesh{}).clusters.empty());
+}
+
+}  // namespace
+}  // namespace lodstream::hierarchy
