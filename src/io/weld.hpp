@@ -23,9 +23,9 @@ void weld_identical(Mesh& mesh);
 void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees);
 
 // What import does with every mesh: weld_with_crease_normals when it has no normals; otherwise
-// weld_identical, then weld_with_crease_normals when it looks flat-shaded (at least 90% of corners carry
-// their triangle's normal within 1 degree, and at least 10% of vertices share their position with another).
-// Authored smooth normals are kept as they are.
+// weld_identical, then weld_with_crease_normals when it looks flat-shaded (in at least 90% of the triangles
+// the three corners carry one and the same normal, the triangle's own within 1 degree). Authored smooth
+// normals are kept as they are.
 WeldResult weld(Mesh& mesh, float crease_angle_degrees);
 
 }  // namespace lodstream
