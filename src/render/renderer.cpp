@@ -177,7 +177,8 @@ MeshHandle Renderer::upload_mesh(const Mesh& mesh) {
   std::vector<uint32_t> reordered;
   if (options_.optimize_vertex_cache && !mesh.indices.empty()) {
     reordered.resize(mesh.indices.size());
-    meshopt_optimizeVertexCache(reordered.data(), mesh.indices.data(), mesh.indices.size(), mesh.positions.size());
+    meshopt_optimizeVertexCache(reordered.data(), mesh.indices.data(), mesh.indices.size(),
+                                mesh.positions.size());
   }
   const std::vector<uint32_t>& indices = reordered.empty() ? mesh.indices : reordered;
   glNamedBufferStorage(gpu.index_buffer, std::max<GLsizeiptr>(1, indices.size() * sizeof(uint32_t)),
@@ -207,10 +208,6 @@ void Renderer::release_mesh(MeshHandle mesh) {
   glDeleteBuffers(1, &gpu.vertex_buffer);
   glDeleteBuffers(1, &gpu.index_buffer);
   gpu = GpuMesh{};
-}
-
-size_t Renderer::triangle_count(MeshHandle mesh) const {
-  return meshes_.at(mesh - 1).index_count / 3;
 }
 
 TextureHandle Renderer::upload_texture(const Image& image) {

@@ -47,8 +47,9 @@ struct RendererOptions {
   int msaa = 0;  // samples per pixel; 0 or 1 for none (deterministic and fastest)
   // Reorder each uploaded mesh's triangles for the post-transform vertex cache (meshoptimizer's
   // optimizeVertexCache, Forsyth-style): llvmpipe shades a vertex again on every cache miss, and real models
-  // come with an average cache miss ratio near 1.6 (motorBike) against 0.7 after reordering, 12-17 % less draw
-  // time. Costs about 0.1 s per million triangles at upload; the image changes only where triangles tie in depth.
+  // come with an average cache miss ratio near 1.6 (motorBike) against 0.7 after reordering, 12-17 % less
+  // draw time. Costs about 0.1 s per million triangles at upload; the image changes only where triangles tie
+  // in depth.
   bool optimize_vertex_cache = true;
 };
 
@@ -69,7 +70,6 @@ class Renderer {
   MeshHandle upload_mesh(const Mesh& mesh);
   // Frees a mesh's buffers; its handle must not be drawn again.
   void release_mesh(MeshHandle mesh);
-  size_t triangle_count(MeshHandle mesh) const;
 
   // Uploads an sRGB-encoded RGBA image as a mipmapped base-colour texture (sampled trilinear, repeating).
   // UV (0,0) is the image's bottom-left corner, (1,1) its top-right (the OpenGL / OBJ convention).

@@ -23,7 +23,4 @@ struct SceneUpload {
 // a lodstream::Error (the Scene is malformed). Cost: the meshes' upload plus decoding each texture file once.
 SceneUpload upload_scene(Renderer& renderer, const Scene& scene);
 
-// Releases what upload_scene() uploaded.
-void release_scene(Renderer& renderer, const SceneUpload& upload);
-
 }  // namespace lodstream::render

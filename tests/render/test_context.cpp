@@ -34,6 +34,19 @@ Image render_sphere(Context& context) {
   return renderer.read_pixels();
 }
 
+// The same GL implementation draws bit-identical images whatever the context; a different one (a GPU's device
+// platform next to Mesa's surfaceless one) draws the same shape, so the covered areas agree closely.
+void expect_same_image(const Image& a, const std::string& renderer_a, const Image& b,
+                       const std::string& renderer_b) {
+  const double covered = double(test::covered_pixels(a));
+  EXPECT_GT(covered, 100.0);
+  if (renderer_a == renderer_b)
+    EXPECT_EQ(a.rgba, b.rgba) << renderer_a;
+  else
+    EXPECT_NEAR(double(test::covered_pixels(b)), covered, 0.02 * covered)
+        << renderer_a << " vs " << renderer_b;
+}
+
 // An X server for the window test: Xvfb picks a free display and writes its number to a pipe (-displayfd).
 class Xvfb {
  public:
@@ -85,8 +98,7 @@ TEST(Context, EachEglPlatformWorksAndDrawsTheSameImage) {
   auto surfaceless = create_headless_context({EglPlatform::surfaceless});
   EXPECT_EQ(surfaceless->platform(), "egl-surfaceless");
   Image b = render_sphere(*surfaceless);
-  EXPECT_EQ(a.rgba, b.rgba);
-  EXPECT_GT(test::covered_pixels(a), 100u);
+  expect_same_image(a, device->renderer(), b, surfaceless->renderer());
 }
 
 TEST(Context, NoPlatformIsAClearError) {
@@ -116,12 +128,16 @@ TEST(WindowContext, UnderXvfbDrawsWhatHeadlessDraws) {
   ASSERT_FALSE(server.display().empty()) << "Xvfb did not start (scripts/setup installs xvfb)";
   setenv("DISPLAY", server.display().c_str(), 1);
   Image windowed;
+  std::string window_renderer;
   {
     auto window = create_window_context(80, 60, "lodstream test", false);
     EXPECT_EQ(window->platform(), "glfw");
     EXPECT_TRUE(window->poll_events());
     windowed = render_sphere(*window);
+    window->swap_buffers();
+    window_renderer = window->renderer();
   }
   unsetenv("DISPLAY");
-  EXPECT_EQ(windowed.rgba, render_sphere(test::headless_context()).rgba);
+  expect_same_image(windowed, window_renderer, render_sphere(test::headless_context()),
+                    test::headless_context().renderer());
 }
