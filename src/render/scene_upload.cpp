@@ -46,4 +46,9 @@ SceneUpload upload_scene(Renderer& renderer, const Scene& scene) {
   return upload;
 }
 
+void release_scene(Renderer& renderer, const SceneUpload& upload) {
+  for (MeshHandle mesh : upload.meshes) renderer.release_mesh(mesh);
+  for (TextureHandle texture : upload.textures) renderer.release_texture(texture);
+}
+
 }  // namespace lodstream::render

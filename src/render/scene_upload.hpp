@@ -23,4 +23,7 @@ struct SceneUpload {
 // a lodstream::Error (the Scene is malformed). Cost: the meshes' upload plus decoding each texture file once.
 SceneUpload upload_scene(Renderer& renderer, const Scene& scene);
 
+// Releases what upload_scene() uploaded (its meshes and textures); its items must not be drawn again.
+void release_scene(Renderer& renderer, const SceneUpload& upload);
+
 }  // namespace lodstream::render
