@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 
 #include "core/error.hpp"
@@ -46,9 +47,14 @@ void prepare_scene(Scene& scene, const ImportOptions& options, const std::string
                  file.c_str(), dropped_normals);
 
   // Drop empty objects, then renumber the meshes and materials that are still used.
-  for (const auto& o : scene.objects)
+  for (const auto& o : scene.objects) {
     if (o.mesh >= scene.meshes.size())
       throw Error(file + ": object '" + o.name + "' references a missing mesh");
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r)
+        if (!std::isfinite(o.transform[c][r]))
+          throw Error(file + ": object '" + o.name + "' has a non-finite transform");
+  }
   std::erase_if(scene.objects, [&](const Object& o) { return scene.meshes[o.mesh].indices.empty(); });
   if (scene.objects.empty()) throw Error(file + ": no triangles (the model is empty)");
   std::vector<uint32_t> mesh_index(scene.meshes.size(), UINT32_MAX),
