@@ -3,8 +3,8 @@
 //
 // Shading is fixed and deterministic (the same input gives the same bytes on the same GL implementation):
 // a headlight along the view axis, two-sided Lambert plus a small ambient term in linear space,
-//   c = albedo * (kAmbient + (1 - kAmbient) |n_view . z_view|),  albedo = base colour * vertex colour *
-//   texture,
+//   c = albedo * (kAmbient + (1 - kAmbient) |n_view . z_view|),
+//   albedo = base colour * vertex colour * texture,
 // written as sRGB-encoded 8-bit RGBA (alpha 255) over a fixed background colour. No face culling (real models
 // have mixed winding), depth test on a 24-bit depth buffer, no multisampling unless asked for.
 #pragma once
@@ -58,6 +58,7 @@ class Renderer {
   // Compiles the shaders in `context`, which must be current on this thread whenever the renderer is used.
   // Throws lodstream::Error when msaa exceeds GL_MAX_SAMPLES.
   explicit Renderer(Context& context, const RendererOptions& options = {});
+  // Frees every GL object; the context must still exist and be current.
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
