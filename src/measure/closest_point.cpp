@@ -20,34 +20,33 @@ float distance2(const glm::vec3& p, const glm::vec3& q) {
 
 glm::vec3 closest_point_on_triangle(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b,
                                     const glm::vec3& c) {
-  // Variable names follow Ericson's listing.
-  const glm::vec3 ab = b - a, ac = c - a, ap = p - a;
-  const float d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
-  if (d1 <= 0.0f && d2 <= 0.0f) return a;  // vertex region A
+  // Variable names follow Ericson's listing. The region tests multiply dot products (va, vb, vc are twice a
+  // squared area): in float they cancel catastrophically on long thin triangles far from the origin (a 200 m
+  // face of buildings.obj measured 0.014 m from itself), so they run in double.
+  const glm::dvec3 A(a), ab = glm::dvec3(b) - A, ac = glm::dvec3(c) - A, ap = glm::dvec3(p) - A;
+  const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return a;  // vertex region A
 
-  const glm::vec3 bp = p - b;
-  const float d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
-  if (d3 >= 0.0f && d4 <= d3) return b;  // vertex region B
+  const glm::dvec3 bp = ap - ab;
+  const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+  if (d3 >= 0.0 && d4 <= d3) return b;  // vertex region B
 
-  const float vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) return a + (d1 / (d1 - d3)) * ab;  // edge region AB
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return glm::vec3(A + (d1 / (d1 - d3)) * ab);  // edge region AB
 
-  const glm::vec3 cp = p - c;
-  const float d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
-  if (d6 >= 0.0f && d5 <= d6) return c;  // vertex region C
+  const glm::dvec3 cp = ap - ac;
+  const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+  if (d6 >= 0.0 && d5 <= d6) return c;  // vertex region C
 
-  const float vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) return a + (d2 / (d2 - d6)) * ac;  // edge region AC
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return glm::vec3(A + (d2 / (d2 - d6)) * ac);  // edge region AC
 
-  const float va = d3 * d6 - d5 * d4;
-  if (va <= 0.0f && (d4 - d3) >= 0.0f && (d5 - d6) >= 0.0f)
-    return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);  // edge region BC
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0)
+    return glm::vec3(A + ab + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (ac - ab));  // edge region BC
 
-  const float sum = va + vb + vc;  // twice the squared area: zero for a degenerate triangle
-  if (sum > 0.0f) {
-    const float v = vb / sum, w = vc / sum;
-    return a + ab * v + ac * w;  // face region
-  }
+  const double sum = va + vb + vc;  // twice the squared area: zero for a degenerate triangle
+  if (sum > 0.0) return glm::vec3(A + ab * (vb / sum) + ac * (vc / sum));  // face region
   // Degenerate triangle (a segment or a point): the nearest of its three edges.
   glm::vec3 best = closest_point_on_segment(p, a, b);
   for (glm::vec3 q : {closest_point_on_segment(p, b, c), closest_point_on_segment(p, c, a)})

@@ -60,3 +60,17 @@ TEST(ClosestPoint, DegenerateTrianglesAreSegments) {
   // All three corners at one point.
   EXPECT_EQ(closest_point_on_triangle({1, 1, 1}, c, c, c), c);
 }
+
+TEST(ClosestPoint, LongThinTrianglesFarFromTheOriginStayExact) {
+  // Slivers like the facades of buildings.obj (200 units long, a few millimetres wide, far from the origin):
+  // points on them are at distance ~0 from them.
+  glm::vec3 a{30.0f, 150.0f, 10.0f}, b{237.0f, 158.0f, 76.0f};
+  for (float width : {1e-1f, 1e-2f, 1e-3f})
+    for (int i = 1; i < 100; ++i) {
+      glm::vec3 c = 0.5f * (a + b) + glm::vec3(0.0f, 0.0f, width);
+      float u = float(i) / 100.0f, v = 0.5f * (1.0f - u);
+      glm::vec3 p = a + u * (b - a) + v * (c - a);
+      EXPECT_LT(glm::length(closest_point_on_triangle(p, a, b, c) - p), 1e-4f)
+          << "width " << width << ", u " << u;
+    }
+}
