@@ -1,0 +1,312 @@
+// `lodstream bake MODEL... -o SCENE.lods [--json]`: every mesh of the imported models becomes a cluster DAG
+// (hierarchy/cluster_dag.hpp), written into one .lods package (package/writer.hpp). Objects keep their
+// transforms; objects that instance one mesh share its representation.
+//
+// Node order (ids) and page order: first the roots of every representation (the root index, enough for a
+// first frame), then, from the coarsest level down, the input clusters of each group simplification as one
+// page group: refining a group needs exactly its input clusters, so they travel together.
+//
+// Precision (how the codec's position_shift is spent): level-0 clusters are stored on the finest grid
+// (2^-14 of the object's diagonal). A coarser cluster made by a group of error e drops k low bits of its
+// free vertices, k = floor(log2(e / (4 * step))) clamped to [0, 16], so that the rounding adds at most
+// q(e) = sqrt(3)/2 * 2^k * step <= e / 4 * sqrt(3)/2; the stored error and sphere radius are raised by q(e).
+// q is a non-decreasing function of e, so stored errors stay monotonic and spheres containing. Vertices on
+// the border of the group that made or consumes a cluster are flagged locked and decode exactly, so cuts stay
+// crack-free (free vertices are shared only by clusters of one group, which use one shift).
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <mutex>
+
+#include "command.hpp"
+#include "core/error.hpp"
+#include "hierarchy/cluster_dag.hpp"
+#include "io/import.hpp"
+#include "package/writer.hpp"
+
+namespace lodstream::cli {
+namespace {
+
+using namespace package;
+
+struct BakeArgs {
+  std::vector<std::string> models;
+  std::string output;
+  bool json = false;
+  uint32_t normal_bits = 10;
+};
+
+uint64_t peak_rss_bytes() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line))
+    if (line.rfind("VmHWM:", 0) == 0) return std::stoull(line.substr(6)) * 1024;
+  return 0;
+}
+
+uint32_t position_shift(float error, const PositionGrid& grid) {
+  if (!(error > 0.0f) || std::isinf(error)) return 0;
+  const double k = std::floor(std::log2(double(error) / (4.0 * double(grid.step))));
+  return uint32_t(std::clamp(k, 0.0, 16.0));
+}
+
+// q(e) of the header comment: the extra error of a node stored with the shift for error e.
+float quantization_error(float error, const PositionGrid& grid) {
+  const uint32_t k = position_shift(error, grid);
+  return k == 0 ? 0.0f : float(std::sqrt(3.0) * 0.5 * std::ldexp(double(grid.step), int(k)));
+}
+
+float stored_error(float error, const PositionGrid& grid) {
+  const float q = quantization_error(error, grid);
+  return q == 0.0f ? error : std::nextafter(error + q, INFINITY);
+}
+Sphere stored_sphere(const Sphere& s, float error, const PositionGrid& grid) {
+  const float q = std::isinf(error) ? 0.0f : quantization_error(error, grid);
+  return q == 0.0f ? s : Sphere{s.center, std::nextafter(s.radius + q, INFINITY)};
+}
+
+// The scene of all models: materials, meshes and objects concatenated.
+Scene import_all(const std::vector<std::string>& models) {
+  Scene all;
+  for (const std::string& model : models) {
+    Scene s = import_model(model);
+    const uint32_t materials = uint32_t(all.materials.size()), meshes = uint32_t(all.meshes.size());
+    for (Material& m : s.materials) all.materials.push_back(std::move(m));
+    for (Mesh& m : s.meshes) {
+      m.material += materials;
+      all.meshes.push_back(std::move(m));
+    }
+    for (Object& o : s.objects) {
+      o.mesh += meshes;
+      all.objects.push_back(std::move(o));
+    }
+  }
+  return all;
+}
+
+int run_bake(const BakeArgs& args) {
+  const auto start = std::chrono::steady_clock::now();
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  if (args.normal_bits < 4 || args.normal_bits > 16) throw Error("--normal-bits: must be in 4..16");
+  Scene scene = import_all(args.models);
+  const uint64_t input_triangles = scene.triangle_count();
+  const size_t unique_triangles = scene.unique_triangle_count();
+  std::fprintf(stderr, "bake: %zu objects, %zu meshes, %llu triangles imported in %.2f s\n",
+               scene.objects.size(), scene.meshes.size(), (unsigned long long)input_triangles, elapsed());
+
+  // One DAG per stored mesh; meshes in parallel (each also parallel inside).
+  std::vector<hierarchy::ClusterDag> dags(scene.meshes.size());
+  std::vector<Bounds> bounds(scene.meshes.size());
+  std::atomic<size_t> done_triangles{0};
+  std::mutex progress_mutex;
+  auto report = [&](size_t add) {
+    const size_t done = done_triangles += add;
+    std::lock_guard lock(progress_mutex);
+    const int percent = int(100.0 * double(done) / double(std::max<size_t>(1, unique_triangles)));
+    std::fprintf(stderr, "\rbake: hierarchy [%-40s] %3d%% %.1f s",
+                 std::string(size_t(percent * 40 / 100), '#').c_str(), percent, elapsed());
+    std::fflush(stderr);
+  };
+  tbb::parallel_for(size_t(0), scene.meshes.size(), [&](size_t m) {
+    bounds[m] = scene.meshes[m].bounds();
+    hierarchy::DagOptions options;
+    const size_t triangles = scene.meshes[m].triangle_count();
+    size_t reported = 0;
+    options.progress = [&](uint32_t, size_t active) {
+      // Level l removes about half of what is left: count the removed triangles as done.
+      const size_t done_here = triangles - std::min(triangles, active);
+      if (done_here > reported) report(done_here - reported), reported = done_here;
+    };
+    dags[m] = hierarchy::build_cluster_dag(scene.meshes[m], options);
+    report(triangles - reported);
+    scene.meshes[m] = Mesh{};  // the DAG holds the geometry now
+  });
+  std::fprintf(stderr, "\n");
+
+  // Representations, and the node order: roots, then each group's input clusters, coarse levels first.
+  PackageScene ps;
+  ps.input_triangles = input_triangles;
+  for (const Material& m : scene.materials) ps.materials.push_back({m, kNone});
+  struct Ref {
+    uint32_t mesh, cluster;
+  };
+  std::vector<Ref> order;
+  std::vector<std::vector<uint32_t>> node_id(dags.size());
+  std::vector<size_t> page_group_ends;
+  uint32_t levels = 0;
+  size_t abandoned = 0, partial = 0, positions_only = 0, stalled = 0;
+  for (uint32_t m = 0; m < dags.size(); ++m) {
+    const hierarchy::ClusterDag& dag = dags[m];
+    node_id[m].assign(dag.clusters.size(), kNone);
+    Representation rep;
+    rep.kind = RepresentationKind::cluster_dag;
+    rep.name = "mesh" + std::to_string(m);
+    rep.bounds = bounds[m];
+    rep.grid = PositionGrid::for_bounds(bounds[m], 14);
+    rep.levels = std::max(1u, dag.levels);
+    for (uint32_t r : dag.roots) {
+      node_id[m][r] = uint32_t(order.size());
+      rep.roots.push_back(uint32_t(order.size()));
+      order.push_back({m, r});
+    }
+    page_group_ends.push_back(order.size());
+    ps.representations.push_back(std::move(rep));
+    levels = std::max(levels, dag.levels);
+    abandoned += dag.abandoned_groups;
+    stalled += dag.stalled;
+    for (const hierarchy::DagGroup& g : dag.groups) {
+      partial += g.outcome == hierarchy::GroupOutcome::partial;
+      positions_only += g.outcome == hierarchy::GroupOutcome::positions_only;
+    }
+  }
+  const uint32_t root_nodes = uint32_t(order.size());
+  struct GroupRef {
+    uint32_t level, mesh, group;
+  };
+  std::vector<GroupRef> groups;
+  for (uint32_t m = 0; m < dags.size(); ++m)
+    for (uint32_t g = 0; g < dags[m].groups.size(); ++g) groups.push_back({dags[m].groups[g].level, m, g});
+  std::stable_sort(groups.begin(), groups.end(),
+                   [](const GroupRef& a, const GroupRef& b) { return a.level > b.level; });
+  for (const GroupRef& gr : groups) {
+    for (uint32_t c : dags[gr.mesh].groups[gr.group].children) {
+      node_id[gr.mesh][c] = uint32_t(order.size());
+      order.push_back({gr.mesh, c});
+    }
+    page_group_ends.push_back(order.size());
+  }
+  for (const Object& o : scene.objects) ps.objects.push_back({o.name, o.transform, o.mesh});
+
+  // Records.
+  std::vector<NodeRecord> records(order.size());
+  tbb::parallel_for(size_t(0), order.size(), [&](size_t id) {
+    const hierarchy::ClusterDag& dag = dags[order[id].mesh];
+    const hierarchy::DagCluster& c = dag.clusters[order[id].cluster];
+    const PositionGrid& grid = ps.representations[order[id].mesh].grid;
+    const auto& ids = node_id[order[id].mesh];
+    NodeRecord& n = records[id];
+    n.kind = NodeKind::cluster;
+    n.representation = order[id].mesh;
+    n.material = c.mesh.material;
+    n.level = c.level;
+    n.triangles = uint32_t(c.mesh.triangle_count());
+    n.vertices = uint32_t(c.mesh.vertex_count());
+    n.error = stored_error(c.error, grid);
+    n.sphere = stored_sphere(c.sphere, c.error, grid);
+    n.parent_error = stored_error(c.parent_error, grid);
+    n.parent_sphere = stored_sphere(c.parent_sphere, c.parent_error, grid);
+    if (c.group != hierarchy::kNoGroup)
+      for (uint32_t k : dag.groups[c.group].children) n.children.push_back(ids[k]);
+    if (c.parent_group != hierarchy::kNoGroup)
+      for (uint32_t k : dag.groups[c.parent_group].clusters) n.parents.push_back(ids[k]);
+  });
+
+  // Encode (parallel, a batch of page groups at a time) and write (serial).
+  PackageWriter writer(args.output);
+  const NodeCodec& codec = default_node_codec();
+  NodeSizeBreakdown breakdown;
+  size_t first = 0;
+  std::vector<std::vector<uint8_t>> encoded;
+  for (size_t g = 0; g < page_group_ends.size();) {
+    size_t g_end = g, end = first;
+    while (g_end < page_group_ends.size() && page_group_ends[g_end] - first < 4096)
+      end = page_group_ends[g_end++];
+    if (g_end == g) end = page_group_ends[g_end++];
+    encoded.assign(end - first, {});
+    tbb::parallel_for(first, end, [&](size_t id) {
+      const hierarchy::DagCluster& c = dags[order[id].mesh].clusters[order[id].cluster];
+      const PositionGrid& grid = ps.representations[order[id].mesh].grid;
+      NodeGeometry geometry;
+      geometry.mesh = &c.mesh;
+      geometry.position_shift = position_shift(c.error, grid);
+      if (geometry.position_shift > 0) geometry.locked = c.locked;
+      geometry.normal_bits = args.normal_bits;
+      encoded[id - first] = codec.encode(geometry, grid);
+    });
+    for (size_t id = first; id < end; ++id) {
+      NodeSizeBreakdown b = codec.breakdown(encoded[id - first], args.output);
+      breakdown.header += b.header, breakdown.vertices += b.vertices, breakdown.locked += b.locked;
+      breakdown.indices += b.indices;
+      writer.add_node(uint32_t(id), encoded[id - first]);
+      if (id + 1 == page_group_ends[g]) writer.end_group(), ++g;
+    }
+    first = end;
+  }
+  encoded = {};
+  size_t stored_triangles = 0;
+  for (const NodeRecord& n : records) stored_triangles += n.triangles;
+  nlohmann::json metadata = {
+      {"baker", "lodstream bake"}, {"normal_bits", args.normal_bits}, {"grid_bits", 14}};
+  ps.metadata = metadata.dump();
+  const WrittenPackage written = writer.finish(std::move(ps), std::move(records), root_nodes);
+  const double time_s = elapsed();
+  const uint64_t rss = peak_rss_bytes();
+  const double per_triangle = double(written.bytes) / double(std::max<uint64_t>(1, input_triangles));
+
+  if (args.json) {
+    const double raw = double(std::max<size_t>(1, breakdown.total()));
+    print_json({{"input_triangles", input_triangles},
+                {"unique_triangles", unique_triangles},
+                {"objects", scene.objects.size()},
+                {"representations", dags.size()},
+                {"nodes", written.nodes},
+                {"root_nodes", root_nodes},
+                {"pages", written.pages},
+                {"levels", levels},
+                {"bytes", written.bytes},
+                {"bytes_per_input_triangle", per_triangle},
+                {"stored_triangles", stored_triangles},
+                {"root_index_bytes", written.root_index_bytes},
+                {"index_bytes", written.index_bytes},
+                {"page_bytes", written.page_bytes},
+                {"raw_share",
+                 {{"header", breakdown.header / raw},
+                  {"vertices", breakdown.vertices / raw},
+                  {"locked", breakdown.locked / raw},
+                  {"indices", breakdown.indices / raw}}},
+                {"fallbacks",
+                 {{"partial", partial},
+                  {"positions_only", positions_only},
+                  {"abandoned", abandoned},
+                  {"stalled_meshes", stalled}}},
+                {"time_s", time_s},
+                {"triangles_per_s", double(input_triangles) / time_s},
+                {"peak_rss_bytes", rss}});
+  } else {
+    std::printf(
+        "%s: %llu input triangles, %zu objects, %u nodes (%zu triangles stored), %u pages, %u levels\n",
+        args.output.c_str(), (unsigned long long)input_triangles, scene.objects.size(), written.nodes,
+        stored_triangles, written.pages, levels);
+    std::printf(
+        "  %llu bytes (%.3f per input triangle; root index %llu), %.2f s (%.0f triangles/s), peak RSS %.1f "
+        "MB\n",
+        (unsigned long long)written.bytes, per_triangle, (unsigned long long)written.root_index_bytes, time_s,
+        double(input_triangles) / time_s, double(rss) / 1e6);
+    std::printf("  fallbacks: %zu partial, %zu positions-only, %zu abandoned groups, %zu stalled meshes\n",
+                partial, positions_only, abandoned, stalled);
+  }
+  return 0;
+}
+
+const bool registered = register_command(
+    {"bake", "build the multiresolution package (.lods) of one or more models", [](CLI::App& sub) {
+       auto args = std::make_shared<BakeArgs>();
+       sub.add_option("MODEL", args->models, "input models (PLY, OBJ, OFF, or any format assimp reads)")
+           ->required();
+       sub.add_option("-o,--output", args->output, "the package to write (.lods)")->required();
+       sub.add_option("--normal-bits", args->normal_bits, "octahedral normal bits per component (4..16)");
+       sub.add_flag("--json", args->json,
+                    "print one JSON object: input_triangles, objects, nodes, pages, levels, bytes, time_s, "
+                    "peak_rss_bytes");
+       return [args] { return run_bake(*args); };
+     }});
+
+}  // namespace
+}  // namespace lodstream::cli

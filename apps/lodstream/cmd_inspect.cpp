@@ -1,0 +1,227 @@
+// `lodstream inspect SCENE.lods [--json] [--verify] [--cuts N]`: what a package holds (nodes, pages, levels,
+// bytes, per-level counts and errors) and, with --verify, whether every invariant of DESIGN.md's Data model
+// holds: the content hash, monotonic errors (a node's parents' pair is its parents' own pair and at least its
+// own), containing spheres, every page and node decodes and matches its record, and crack-free cuts: for N
+// random eyes and thresholds per representation, the cut chosen by the cut rule, welded by decoded position,
+// has exactly the boundary edges of the full-resolution (level-0) surface. Exits 1 naming the first
+// violation.
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <random>
+
+#include "command.hpp"
+#include "core/error.hpp"
+#include "hierarchy/bounding_sphere.hpp"
+#include "hierarchy/cut.hpp"
+#include "package/reader.hpp"
+
+namespace lodstream::cli {
+namespace {
+
+using namespace package;
+
+struct InspectArgs {
+  std::string package;
+  bool json = false, verify = false;
+  int cuts = 32;
+};
+
+bool same_sphere(const Sphere& a, const Sphere& b) {
+  return a.center == b.center && a.radius == b.radius;
+}
+
+// The first violation of the record invariants, or "".
+std::string check_records(const std::vector<NodeRecord>& nodes) {
+  for (uint32_t id = 0; id < nodes.size(); ++id) {
+    const NodeRecord& n = nodes[id];
+    const std::string where = "node " + std::to_string(id) + ": ";
+    if (!(n.parent_error >= n.error)) return where + "parents' error is below its own (not monotonic)";
+    if (n.parents.empty() != std::isinf(n.parent_error))
+      return where + "parents' error must be infinite exactly when it has no parents";
+    if (!n.parents.empty() && !hierarchy::sphere_contains(n.parent_sphere, n.sphere))
+      return where + "parents' sphere does not contain its own";
+    for (uint32_t p : n.parents)
+      if (nodes[p].error != n.parent_error || !same_sphere(nodes[p].sphere, n.parent_sphere))
+        return where + "parent " + std::to_string(p) +
+               "'s (error, sphere) differs from its stored parents' pair";
+    for (uint32_t c : n.children)
+      if (nodes[c].parent_error != n.error || !same_sphere(nodes[c].parent_sphere, n.sphere))
+        return where + "child " + std::to_string(c) + "'s parents' pair differs from this node's own pair";
+  }
+  return "";
+}
+
+struct Summary {
+  nlohmann::json json;
+  std::string text;
+};
+
+int run_inspect(const InspectArgs& args) {
+  if (args.cuts < 0) throw Error("--cuts: must be >= 0");
+  PackageReader reader = PackageReader::open(args.package);
+  const RootIndex& root = reader.root();
+  std::vector<NodeRecord> nodes(reader.node_count());
+  for (uint32_t id = 0; id < nodes.size(); ++id) nodes[id] = reader.node(id);
+
+  uint32_t levels = 0;
+  for (const Representation& r : root.scene.representations) levels = std::max(levels, r.levels);
+  struct Level {
+    size_t nodes = 0, triangles = 0;
+    float min_error = INFINITY, max_error = 0.0f;
+  };
+  std::map<uint32_t, Level> per_level;
+  size_t stored_triangles = 0;
+  for (const NodeRecord& n : nodes) {
+    Level& l = per_level[n.level];
+    ++l.nodes, l.triangles += n.triangles, stored_triangles += n.triangles;
+    l.min_error = std::min(l.min_error, n.error), l.max_error = std::max(l.max_error, n.error);
+  }
+  const uint64_t bytes = reader.header().file_size;
+
+  std::string violation;
+  if (args.verify) {
+    reader.verify();  // header = trailer, content hash (throws on mismatch)
+    violation = check_records(nodes);
+    // Decode every page and node; weld each representation's nodes by decoded position.
+    std::vector<hierarchy::SurfaceWelder> welders(root.scene.representations.size());
+    std::vector<std::vector<uint32_t>> welded(nodes.size());
+    std::vector<std::vector<uint32_t>> on_page(root.pages.size());
+    for (uint32_t id = 0; id < nodes.size(); ++id)
+      if (nodes[id].encoding == NodeEncoding::codec) on_page[nodes[id].page].push_back(id);
+    const size_t batch = 64;
+    for (size_t first = 0; first < on_page.size() && violation.empty(); first += batch) {
+      const size_t end = std::min(on_page.size(), first + batch);
+      std::vector<std::vector<DecodedNode>> decoded(end - first);
+      tbb::parallel_for(first, end, [&](size_t p) {
+        const std::vector<uint8_t> page = reader.read_page(uint32_t(p));
+        for (uint32_t id : on_page[p]) {
+          const NodeRecord& n = nodes[id];
+          decoded[p - first].push_back(
+              reader.codec().decode(std::span<const uint8_t>(page).subspan(n.offset, n.size),
+                                    root.scene.representations[n.representation].grid,
+                                    args.package + ": node " + std::to_string(id)));
+        }
+      });
+      for (size_t p = first; p < end && violation.empty(); ++p)
+        for (size_t k = 0; k < on_page[p].size(); ++k) {
+          const uint32_t id = on_page[p][k];
+          const Mesh& m = decoded[p - first][k].mesh;
+          if (m.triangle_count() != nodes[id].triangles || m.vertex_count() != nodes[id].vertices) {
+            violation = "node " + std::to_string(id) + ": decoded counts differ from its record";
+            break;
+          }
+          // Tolerance: the finest grid's rounding (level-0 spheres bound the unquantized positions).
+          for (const glm::vec3& v : m.positions)
+            if (glm::length(v - nodes[id].sphere.center) >
+                nodes[id].sphere.radius * 1.00001f +
+                    2.0f * root.scene.representations[nodes[id].representation].grid.step) {
+              violation = "node " + std::to_string(id) + ": a decoded vertex lies outside its sphere";
+              break;
+            }
+          welded[id] = welders[nodes[id].representation].weld(m);
+        }
+    }
+    // Crack-free cuts per cluster DAG.
+    std::mt19937 rng(12345);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (uint32_t r = 0; r < root.scene.representations.size() && violation.empty(); ++r) {
+      const Representation& rep = root.scene.representations[r];
+      if (rep.kind != RepresentationKind::cluster_dag) continue;
+      std::vector<uint32_t> members;
+      std::vector<const std::vector<uint32_t>*> finest;
+      for (uint32_t id = 0; id < nodes.size(); ++id)
+        if (nodes[id].representation == r && nodes[id].kind == NodeKind::cluster) {
+          members.push_back(id);
+          if (nodes[id].level == 0) finest.push_back(&welded[id]);
+        }
+      const std::vector<uint64_t> reference = hierarchy::boundary_edges(finest);
+      const glm::vec3 centre = rep.bounds.center();
+      const double radius = std::max(1e-6f, 0.5f * rep.bounds.diagonal());
+      for (int i = 0; i < args.cuts && violation.empty(); ++i) {
+        hierarchy::CutView view;
+        const glm::dvec3 dir(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5);
+        view.eye = glm::dvec3(centre) + glm::normalize(dir) * radius * (0.2 + 20.0 * u(rng));
+        const double tau = std::pow(10.0, -1.0 + 3.5 * u(rng));
+        std::vector<const std::vector<uint32_t>*> cut;
+        for (uint32_t id : members) {
+          const NodeRecord& n = nodes[id];
+          if (hierarchy::in_cut(n.error, n.sphere, n.parent_error, n.parent_sphere, view, tau))
+            cut.push_back(&welded[id]);
+        }
+        const std::string diff = cut.empty() ? std::string("the cut is empty")
+                                             : hierarchy::compare_boundaries(hierarchy::boundary_edges(cut),
+                                                                             reference, welders[r]);
+        if (!diff.empty()) {
+          char eye[160];
+          std::snprintf(eye, sizeof eye, "eye (%g,%g,%g), tau %g px: ", view.eye.x, view.eye.y, view.eye.z,
+                        tau);
+          violation =
+              "representation " + std::to_string(r) + ", cut " + std::to_string(i) + " at " + eye + diff;
+        }
+      }
+    }
+  }
+
+  if (args.json) {
+    nlohmann::json level_json = nlohmann::json::array();
+    for (const auto& [l, s] : per_level)
+      level_json.push_back({{"level", l},
+                            {"nodes", s.nodes},
+                            {"triangles", s.triangles},
+                            {"min_error", s.min_error},
+                            {"max_error", s.max_error}});
+    nlohmann::json out = {{"nodes", nodes.size()},
+                          {"pages", root.pages.size()},
+                          {"levels", levels},
+                          {"bytes", bytes},
+                          {"input_triangles", root.scene.input_triangles},
+                          {"stored_triangles", stored_triangles},
+                          {"objects", root.scene.objects.size()},
+                          {"representations", root.scene.representations.size()},
+                          {"root_nodes", root.root_nodes.size()},
+                          {"index_pages", root.index_pages.size()},
+                          {"per_level", level_json}};
+    if (args.verify) {
+      out["verified"] = violation.empty();
+      out["violation"] = violation.empty() ? nlohmann::json(nullptr) : nlohmann::json(violation);
+    }
+    print_json(out);
+  } else {
+    std::printf(
+        "%s: %zu nodes, %zu pages, %u levels, %llu bytes, %llu input triangles (%zu stored), %zu objects\n",
+        args.package.c_str(), nodes.size(), root.pages.size(), levels, (unsigned long long)bytes,
+        (unsigned long long)root.scene.input_triangles, stored_triangles, root.scene.objects.size());
+    for (const auto& [l, s] : per_level)
+      std::printf("  level %2u: %7zu nodes %10zu triangles  error %.4g .. %.4g\n", l, s.nodes, s.triangles,
+                  s.min_error, s.max_error);
+    if (args.verify && violation.empty())
+      std::printf("verified: every invariant holds (%d cuts per DAG)\n", args.cuts);
+  }
+  if (!violation.empty()) {
+    std::fprintf(stderr, "lodstream: inspect: %s: verify failed: %s\n", args.package.c_str(),
+                 violation.c_str());
+    return 1;
+  }
+  return 0;
+}
+
+const bool registered = register_command(
+    {"inspect", "summarize a package (.lods) and, with --verify, check every invariant", [](CLI::App& sub) {
+       auto args = std::make_shared<InspectArgs>();
+       sub.add_option("SCENE", args->package, "the package (.lods)")->required();
+       sub.add_flag("--verify", args->verify,
+                    "check content hash, monotonic errors, containing spheres, decoding of every node and "
+                    "crack-free cuts; exit 1 naming the first violation");
+       sub.add_option("--cuts", args->cuts, "random cuts checked per cluster DAG with --verify (default 32)");
+       sub.add_flag(
+           "--json", args->json,
+           "print one JSON object: nodes, pages, levels, bytes, input_triangles, per_level, verified");
+       return [args] { return run_inspect(*args); };
+     }});
+
+}  // namespace
+}  // namespace lodstream::cli
