@@ -19,7 +19,7 @@ struct SimplifyArgs {
   std::string model, output;
   std::optional<double> ratio, error, error_relative;
   std::optional<size_t> triangles;
-  bool json = false, positions_only = false, half_edge = false;
+  bool json = false, positions_only = false, half_edge = false, allow_topology_change = false;
 };
 
 // A text progress bar on standard error, redrawn when the percentage changes.
@@ -64,6 +64,7 @@ int run_simplify(const SimplifyArgs& args) {
   simplify::Options options;
   if (args.positions_only) options.normal_weight = options.uv_weight = options.color_weight = 0;
   options.half_edge = args.half_edge;
+  options.allow_topology_change = args.allow_topology_change;
   ProgressBar bar;
   if (input > 1000000) options.progress = [&bar](float f) { bar(f); };
   auto result = simplify::simplify_scene(scene, target, max_error, options);
@@ -72,9 +73,8 @@ int run_simplify(const SimplifyArgs& args) {
   double time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   if (!result.target_reached)
-    std::fprintf(stderr,
-                 "lodstream: simplify: topology-preserving collapse stopped at %zu triangles, short of the "
-                 "target %zu\n",
+    std::fprintf(stderr, "lodstream: simplify: %s stopped at %zu triangles, short of the target %zu\n",
+                 args.allow_topology_change ? "vertex clustering" : "topology-preserving collapse",
                  result.output_triangles, target);
   if (args.json) {
     print_json({{"input_triangles", input},
@@ -107,6 +107,8 @@ const bool registered = register_command(
        sub.add_flag("--positions-only", args->positions_only, "attribute weights 0 (geometry-only metric)");
        sub.add_flag("--half-edge", args->half_edge,
                     "half-edge collapses (output vertices are input vertices)");
+       sub.add_flag("--allow-topology-change", args->allow_topology_change,
+                    "continue with vertex clustering where edge collapse cannot reach the triangle target");
        sub.add_flag("--json", args->json,
                     "print one JSON object: input_triangles, output_triangles, time_s, "
                     "error_bound");

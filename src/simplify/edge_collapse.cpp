@@ -4,12 +4,12 @@
 // neither seams nor a bound).
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 
+#include "simplify/cluster.hpp"
 #include "simplify/quadric.hpp"
 #include "simplify/simplify.hpp"
 
@@ -93,7 +93,7 @@ class Simplifier {
   std::vector<glm::vec4> col_;
   std::vector<uint32_t> wedge_, pid_;  // wedge ring (same position) and its representative
   std::vector<uint8_t> kind_, touched_, moved_;
-  std::vector<float> radius_;
+  std::vector<float> radius_, radius2_;  // the two bound radii (simplify.hpp): interpolated, face-maximum
   std::vector<Quadric> quadric_;
   std::vector<AttributeTerm> attr_;  // channels_ per vertex
   std::vector<float> channel_weight_;
@@ -101,14 +101,14 @@ class Simplifier {
   std::vector<uint32_t> open_out_, open_in_;
   glm::vec3 origin_{0.0f};
   float scale_ = 1.0f;
-  double bound_ = 0.0;  // normalized units
+  double bound_ = 0.0, bound2_ = 0.0;  // max of radius_ and radius2_, normalized units
   double max_error_ = 0.0;
   bool error_limited_ = false;  // a collapse was refused because of Options::max_error
 
   std::vector<uint32_t> indices_;  // alive faces; dead ones have indices_[3f] == kNone during a pass
   size_t alive_triangles_ = 0;
   std::vector<uint32_t> offsets_, faces_;  // vertex -> faces (CSR), rebuilt each pass
-  std::vector<Candidate> slots_, order_;
+  std::vector<Candidate> slots_, order_, sorted_;
   uint32_t step_ = 0;
   std::vector<Collapse>* record_ = nullptr;
 
@@ -122,7 +122,7 @@ class Simplifier {
     origin_ = box.empty() ? glm::vec3(0.0f) : box.min;
     float extent = box.empty() ? 0.0f : std::max({box.extent().x, box.extent().y, box.extent().z});
     scale_ = extent > 0 ? extent : 1.0f;
-    max_error_ = opt_.max_error / scale_;
+    max_error_ = (opt_.max_error * (1 - 1e-6) - 1e-6 * double(scale_)) / (double(scale_) * (1 + 1e-5));
 
     size_t cap = 1;
     while (cap < 2 * n + 2) cap <<= 1;
@@ -151,9 +151,10 @@ class Simplifier {
     }
     const size_t m = source_.size();
     kind_.assign(m, kManifold);
-    touched_.assign(m, 0);
+    touched_.assign(m, 1);  // every cost is evaluated in the first pass
     moved_.assign(m, 0);
     radius_.assign(m, 0.0f);
+    radius2_.assign(m, 0.0f);
     for (uint32_t v = 0; v < n; ++v)
       if (v < opt_.locked.size() && opt_.locked[v]) kind_[weld_remap_[v]] = kLocked;
 
@@ -187,14 +188,20 @@ class Simplifier {
     return v;
   }
 
+  // Drops dead faces; their corners' cached candidates move with them.
   void compact_faces() {
+    const bool cached = slots_.size() == indices_.size();
     size_t w = 0;
     for (size_t f = 0; f < indices_.size(); f += 3)
       if (indices_[f] != kNone) {
-        indices_[w] = indices_[f], indices_[w + 1] = indices_[f + 1], indices_[w + 2] = indices_[f + 2];
+        for (size_t k = 0; k < 3; ++k) {
+          indices_[w + k] = indices_[f + k];
+          if (cached) slots_[w + k] = slots_[f + k];
+        }
         w += 3;
       }
     indices_.resize(w);
+    if (cached) slots_.resize(w);
   }
 
   void build_adjacency() {
@@ -282,7 +289,6 @@ class Simplifier {
       thread_local std::vector<uint32_t> outs, ins;
       for (uint32_t v = r.begin(); v < r.end(); ++v) {
         open_out_[v] = open_in_[v] = kNone;
-        touched_[v] = 0;
         if (kind_[v] != kBorder && kind_[v] != kSeam) continue;
         fan(v, outs, ins);
         uint32_t no = 0, ni = 0;
@@ -453,21 +459,32 @@ class Simplifier {
 
   // ---- one pass --------------------------------------------------------------------------------------
 
+  // Candidates live per face corner (slots_[3f + k]: the edge from corner k to corner k + 1), so that a
+  // pass re-evaluates only edges with an end touched by the previous pass: an edge whose ends kept their
+  // quadrics, positions and faces keeps its cost and allowed direction (open edges and seam twins only
+  // change at touched vertices).
   size_t run_pass(size_t target) {
     const size_t m = source_.size();
-    slots_.resize(faces_.size());
+    if (slots_.size() != indices_.size()) {
+      slots_.assign(indices_.size(), Candidate{std::numeric_limits<float>::infinity(), kNone, kNone});
+      std::fill(touched_.begin(), touched_.end(), 1);
+    }
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 1024), [&](const auto& r) {
       thread_local std::vector<uint32_t> outs, ins;
       for (uint32_t i = r.begin(); i < r.end(); ++i) {
         fan(i, outs, ins);
         for (uint32_t s = offsets_[i], k = 0; s < offsets_[i + 1]; ++s, ++k) {
           uint32_t j = outs[k];
+          if (!touched_[i] && !touched_[j]) continue;
+          const uint32_t* t = &indices_[3 * size_t(faces_[s])];
+          size_t corner = 3 * size_t(faces_[s]) + (t[0] == i ? 0 : (t[1] == i ? 1 : 2));
           bool twin = std::find(ins.begin(), ins.end(), j) != ins.end();
-          slots_[s] = (twin && i > j) ? Candidate{std::numeric_limits<float>::infinity(), kNone, kNone}
-                                      : evaluate(i, j);
+          slots_[corner] = (twin && i > j) ? Candidate{std::numeric_limits<float>::infinity(), kNone, kNone}
+                                           : evaluate(i, j);
         }
       }
     });
+    std::fill(touched_.begin(), touched_.end(), 0);
     order_.clear();
     for (const Candidate& c : slots_)
       if (c.a != kNone && std::isfinite(c.cost)) order_.push_back(c);
@@ -484,7 +501,7 @@ class Simplifier {
           std::partition(order_.begin(), order_.end(), [&](const Candidate& c) { return c.cost <= limit; }),
           order_.end());
     }
-    tbb::parallel_sort(order_.begin(), order_.end(), cheaper);
+    radix_sort_by_cost();
     size_t collapsed = 0;
     for (const Candidate& c : order_) {
       if (c.cost > limit || alive_triangles_ <= target) break;
@@ -495,6 +512,30 @@ class Simplifier {
       if (try_collapse(p)) ++collapsed;
     }
     return collapsed;
+  }
+
+  // Sorts order_ by cost: LSD radix sort on the float bits (costs are >= 0, so their bits order like them),
+  // 11 + 11 + 10 bits.
+  void radix_sort_by_cost() {
+    sorted_.resize(order_.size());
+    std::vector<Candidate>*src = &order_, *dst = &sorted_;
+    for (int shift : {0, 11, 22}) {
+      uint32_t count[2048] = {};
+      auto digit = [shift](const Candidate& c) {
+        uint32_t u;
+        std::memcpy(&u, &c.cost, 4);
+        return (u >> shift) & 2047u;
+      };
+      for (const Candidate& c : *src) ++count[digit(c)];
+      uint32_t sum = 0;
+      for (uint32_t& n : count) {
+        uint32_t k = n;
+        n = sum, sum += k;
+      }
+      for (const Candidate& c : *src) (*dst)[count[digit(c)]++] = c;
+      std::swap(src, dst);
+    }
+    if (src != &order_) order_.swap(sorted_);
   }
 
   template <class F>
@@ -510,14 +551,17 @@ class Simplifier {
   }
 
   std::vector<uint32_t> na_, nb_, apex_, removed_;
+  std::vector<uint32_t> mark_a_, mark_b_;  // neighbour marks (stamp_ = this collapse)
+  uint32_t stamp_ = 0;
 
   // Validity (link condition, boundary pinch, lost surface, normal change), bound, then the collapse.
   bool try_collapse(const Plan& p) {
     const uint32_t pa = pid_[p.a], pb = pid_[p.b];
-    const double ra = radius_[p.a] + glm::length(glm::dvec3(pos_[p.a]) - p.x);
-    const double rb = radius_[p.b] + glm::length(glm::dvec3(pos_[p.b]) - p.x);
-    const double r_new = std::max(ra, rb);
-    if (r_new > max_error_) {
+    const glm::vec3 x(p.x);  // as stored: the bounds use the rounded position
+    const double da = glm::length(glm::dvec3(pos_[p.a]) - glm::dvec3(x));
+    const double db = glm::length(glm::dvec3(pos_[p.b]) - glm::dvec3(x));
+    const double r_new = std::max(radius_[p.a] + da, radius_[p.b] + db);
+    if (r_new > max_error_ && bound2_ > max_error_) {
       error_limited_ = true;
       return false;
     }
@@ -550,26 +594,19 @@ class Simplifier {
     if (apex_.size() == 2 && apex_[0] == apex_[1]) return false;
     const bool interior = kind_[p.a] == kManifold && kind_[p.b] == kManifold;
     if (kept_faces < (interior ? 3u : 1u)) return false;
-    std::sort(na_.begin(), na_.end()), na_.erase(std::unique(na_.begin(), na_.end()), na_.end());
-    std::sort(nb_.begin(), nb_.end()), nb_.erase(std::unique(nb_.begin(), nb_.end()), nb_.end());
     // Link condition: the neighbours a and b share are exactly the apexes of the removed faces; each apex
     // keeps an edge to x (else a removed face's image would be a dangling edge and the bound would fail).
-    for (size_t i = 0, j = 0; i < na_.size() && j < nb_.size();) {
-      if (na_[i] < nb_[j])
-        ++i;
-      else if (nb_[j] < na_[i])
-        ++j;
-      else {
-        if (std::find(apex_.begin(), apex_.end(), na_[i]) == apex_.end()) return false;
-        ++i, ++j;
-      }
-    }
+    // Neighbour sets are marked with this collapse's stamp instead of sorted.
+    if (mark_a_.size() != source_.size() || ++stamp_ == 0)
+      mark_a_.assign(source_.size(), 0), mark_b_.assign(source_.size(), 0), stamp_ = 1;
+    for (uint32_t v : na_) mark_a_[v] = stamp_;
+    for (uint32_t v : nb_) mark_b_[v] = stamp_;
+    for (uint32_t v : nb_)
+      if (mark_a_[v] == stamp_ && std::find(apex_.begin(), apex_.end(), v) == apex_.end()) return false;
     for (uint32_t c : apex_)
-      if (!std::binary_search(na_.begin(), na_.end(), c) && !std::binary_search(nb_.begin(), nb_.end(), c))
-        return false;
+      if (mark_a_[c] != stamp_ && mark_b_[c] != stamp_) return false;
 
     // Normal change of every face that stays and moves.
-    const glm::vec3 x(p.x);
     const float cos_max = std::cos(glm::radians(opt_.max_normal_change_deg));
     bool ok = true;
     auto check = [&](uint32_t f) {
@@ -590,6 +627,11 @@ class Simplifier {
     for_faces(p.a, check);
     if (p.move) for_faces(p.b, check);
     if (!ok) return false;
+    const double r2_new = local_bound(p, x, std::max(da, db));
+    if (std::min(std::max(bound_, r_new), std::max(bound2_, r2_new)) > max_error_) {
+      error_limited_ = true;
+      return false;
+    }
 
     // Apply.
     for (uint32_t f : removed_) indices_[3 * size_t(f)] = kNone;
@@ -606,6 +648,7 @@ class Simplifier {
     uint32_t v = p.b;
     do {
       radius_[v] = float(r_new);
+      radius2_[v] = float(r2_new);
       if (p.move) pos_[v] = x, moved_[v] = 1;
       touched_[v] = 1;
       v = wedge_[v];
@@ -613,12 +656,59 @@ class Simplifier {
     touched_[p.a] = 1;
     if (p.a2 != kNone) touched_[p.a2] = 1;
     bound_ = std::max(bound_, r_new);
+    bound2_ = std::max(bound2_, r2_new);
     if (record_) {
-      record_->push_back({p.a, p.b, step_, float(r_new)});
-      if (p.a2 != kNone) record_->push_back({p.a2, p.b2, step_, float(r_new)});
+      const float e = reported(std::min(bound_, bound2_));
+      record_->push_back({p.a, p.b, step_, e});
+      if (p.a2 != kNone) record_->push_back({p.a2, p.b2, step_, e});
       ++step_;
     }
     return true;
+  }
+
+  // Face-maximum radius of x after collapse p (simplify.hpp): max radius2_ over the changed faces' vertices
+  // plus delta >= both one-sided Hausdorff distances between the changed faces before and after. delta is
+  // the largest displacement (the natural mapping) or, when the changed region is a closed star at the
+  // position level and every old and new face projects with positive orientation onto the plane of the mean
+  // old normal n, the spread of its vertices along n: both triangulations then cover the same region of that
+  // plane (same boundary chain, no folds), so a point of one lies over a point of the other, at most the
+  // spread away.
+  double local_bound(const Plan& p, const glm::vec3& x, double displacement) const {
+    const uint32_t pa = pid_[p.a], pb = pid_[p.b];
+    auto changed = [&](auto&& f) {
+      for_faces(p.a, f);
+      if (p.move) for_faces(p.b, f);
+    };
+    glm::dvec3 nsum(0.0);
+    double r = 0;
+    changed([&](uint32_t f) {
+      const uint32_t* t = &indices_[3 * size_t(f)];
+      glm::dvec3 p0(pos_[t[0]]), p1(pos_[t[1]]), p2(pos_[t[2]]);
+      nsum += glm::cross(p1 - p0, p2 - p0);
+      r = std::max({r, double(radius2_[t[0]]), double(radius2_[t[1]]), double(radius2_[t[2]])});
+    });
+    auto closed = [&](uint32_t v) { return kind_[v] == kManifold || kind_[v] == kSeam; };
+    double len = glm::length(nsum);
+    if (!closed(p.a) || (p.move && !closed(p.b)) || !(len > 0)) return r + displacement;
+    const glm::dvec3 n = nsum / len, xd(x);
+    double lo = glm::dot(n, xd), hi = lo;
+    bool flat = true;
+    changed([&](uint32_t f) {
+      if (!flat) return;
+      const uint32_t* t = &indices_[3 * size_t(f)];
+      glm::dvec3 c[3], d[3];
+      bool dies = false, moves = false;
+      for (int k = 0; k < 3; ++k) {
+        c[k] = d[k] = glm::dvec3(pos_[t[k]]);
+        double h = glm::dot(n, c[k]);
+        lo = std::min(lo, h), hi = std::max(hi, h);
+        const uint32_t q = pid_[t[k]];
+        if (q == pa || q == pb) d[k] = xd, dies = dies || moves, moves = true;
+      }
+      if (!(glm::dot(glm::cross(c[1] - c[0], c[2] - c[0]), n) > 0)) flat = false;
+      if (!dies && !(glm::dot(glm::cross(d[1] - d[0], d[2] - d[0]), n) > 0)) flat = false;
+    });
+    return r + (flat ? std::min(displacement, hi - lo) : displacement);
   }
 
   // Merges quadrics and sets b's attributes: the attribute quadric's optimum s* = (G.x + D)/W for weighted
@@ -661,12 +751,21 @@ class Simplifier {
 
   // ---- output ------------------------------------------------------------------------------------------
 
+  // A normalized radius in model units, with room for the float rounding of scaled positions (max_error_
+  // is the inverse).
+  float reported(double r) const { return float(r * scale_ * (1 + 1e-5) + 1e-6 * double(scale_)); }
+
   void output(Result& result) {
     compact_faces();
     Mesh& out = result.mesh;
     out.material = in_.material;
     std::vector<uint32_t> remap(source_.size(), kNone);
-    const double slack = 1e-6 * double(scale_);  // float rounding of moved positions
+    std::vector<uint8_t> user_locked(source_.size(), 0);
+    for (size_t v = 0; v < opt_.locked.size() && v < weld_remap_.size(); ++v)
+      if (opt_.locked[v]) user_locked[weld_remap_[v]] = 1;
+    output_locked_.clear();
+    // The invariant with the smaller maximum gives the bound (each one alone bounds the distance).
+    const std::vector<float>& radius = bound2_ < bound_ ? radius2_ : radius_;
     for (uint32_t& v : indices_) {
       if (remap[v] == kNone) {
         remap[v] = uint32_t(out.positions.size());
@@ -674,8 +773,8 @@ class Simplifier {
         if (!nrm_.empty()) out.normals.push_back(nrm_[v]);
         if (!uv_.empty()) out.uvs.push_back(uv_[v]);
         if (!col_.empty()) out.colors.push_back(col_[v]);
-        result.vertex_error.push_back(radius_[v] > 0 ? float(radius_[v] * scale_ * (1 + 1e-5) + slack)
-                                                     : 0.0f);
+        result.vertex_error.push_back(radius[v] > 0 || moved_[v] ? reported(radius[v]) : 0.0f);
+        output_locked_.push_back(user_locked[v]);
       }
       v = remap[v];
     }
@@ -690,6 +789,11 @@ class Simplifier {
 
  public:
   void set_record(std::vector<Collapse>* r) { record_ = r; }
+  // Per output vertex: locked by Options::locked.
+  std::vector<uint8_t> output_locked() const { return output_locked_; }
+
+ private:
+  std::vector<uint8_t> output_locked_;
 };
 
 }  // namespace
@@ -704,6 +808,17 @@ Result simplify_mesh(const Mesh& mesh, const Options& options) {
     result.collapses = std::move(record);
   } else {
     result = s.run();
+  }
+  if (options.allow_topology_change && !result.target_reached) {
+    Options o = options;
+    o.locked = s.output_locked();
+    Result clustered = cluster_mesh(result.mesh, o, result.vertex_error);
+    if (clustered.mesh.triangle_count() < result.mesh.triangle_count()) {
+      result.mesh = std::move(clustered.mesh);
+      result.vertex_error = std::move(clustered.vertex_error);
+      result.error_bound = clustered.error_bound;
+      result.target_reached = clustered.target_reached;
+    }
   }
   return result;
 }

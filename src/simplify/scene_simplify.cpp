@@ -40,6 +40,9 @@ SceneResult simplify_scene(const Scene& scene, size_t target_triangles, double m
     out.scene.meshes.push_back(std::move(r.mesh));
   }
   out.output_triangles = out.scene.triangle_count();
+  // Meshes given a target below what they can reach may be made up for by others.
+  if (target_triangles > 0 && out.output_triangles <= target_triangles + target_triangles / 100)
+    out.target_reached = true;
   return out;
 }
 

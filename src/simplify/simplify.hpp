@@ -1,13 +1,19 @@
 // Quadric edge-collapse simplification (Garland & Heckbert 97, attributes after Hoppe 99) with a tracked,
-// conservative two-sided error bound (the vertex-radius construction of the LOD book digest, §7.5: the
-// natural mapping of a vertex merge moves every surface point by at most the barycentric interpolation of its
-// triangle's vertex displacements, so r_new = max(r_a + |a - x|, r_b + |b - x|) bounds both one-sided
-// Hausdorff distances).
+// conservative two-sided error bound. Two per-vertex radii are kept, each an invariant that alone bounds
+// both one-sided Hausdorff distances; the result reports the one with the smaller maximum:
+// - interpolated (the vertex-radius construction of the LOD book digest, §7.5): the natural mapping of a
+//   vertex merge moves every surface point by at most the barycentric interpolation of its triangle's vertex
+//   displacements, so r_new = max(r_a + |a - x|, r_b + |b - x|);
+// - face maximum: every point of a face is within the largest radius of its corners of the input, and every
+//   input point within that of some face. A collapse gives x the largest radius over the changed faces plus
+//   a bound on the local two-sided distance between the changed faces before and after: the largest
+//   displacement, or on a locally flat, fold-free closed star the spread of its vertices along the mean
+//   normal (0 on planar regions, about curvature x length^2 on smooth ones).
 //
 // Operator: edge collapse a -> b with optimal placement x (full edge) or x = b (half edge). Framework: passes
-// of independent collapses in quadric-cost order (a lazy queue that re-evaluates every edge once per pass, in
-// parallel), each pass limited to 1.5x the cost of the collapse that would reach the target, which keeps the
-// order close to greedy.
+// of independent collapses in quadric-cost order (a lazy queue: each pass re-evaluates, in parallel, the
+// edges with an end touched by the previous one and radix-sorts the candidates), each pass limited to 1.5x
+// the cost of the collapse that would reach the target, which keeps the order close to greedy.
 //
 // Vertices are classified once (meshoptimizer's vertex kinds, extended): Manifold (interior), Border (one
 // open edge in and out), Seam (two vertices share the position and their open edges pair up: a UV, normal
@@ -50,13 +56,16 @@ struct Options {
   std::vector<uint8_t> locked;
   // Record the collapse sequence in Result::collapses (used by progressive meshes).
   bool record_collapses = false;
+  // When edge collapse stops short of target_triangles, continue with vertex clustering (cluster.hpp), which
+  // may change topology; Result::error_bound then covers both steps.
+  bool allow_topology_change = false;
   // Called now and then with the fraction of the requested reduction done (0..1).
   std::function<void(float)> progress;
 };
 
 // One half-edge collapse (record_collapses): vertex `removed` merged into vertex `kept` (input numbering,
-// after welding). A seam collapse is two records with the same `step`; `error_bound` is the mesh bound after
-// it.
+// after welding). A seam collapse is two records with the same `step`; `error_bound` is the mesh's two-sided
+// bound after it (model units, non-decreasing).
 struct Collapse {
   uint32_t removed;
   uint32_t kept;
@@ -65,9 +74,11 @@ struct Collapse {
 };
 
 struct Result {
-  Mesh mesh;                        // the simplified mesh; unused vertices are removed
-  double error_bound = 0.0;         // >= symmetric Hausdorff distance(result, input), model units
-  std::vector<float> vertex_error;  // per output vertex: the bound radius r_v (model units)
+  Mesh mesh;                 // the simplified mesh; unused vertices are removed
+  double error_bound = 0.0;  // >= symmetric Hausdorff distance(result, input), model units
+  // Per output vertex (model units): every point of an output face is within the largest vertex_error of its
+  // corners of the input, and every input point within that of some output face.
+  std::vector<float> vertex_error;
   size_t input_triangles = 0;
   bool target_reached = true;        // false when no valid collapse was left before the triangle target
   std::vector<Collapse> collapses;   // with Options::record_collapses

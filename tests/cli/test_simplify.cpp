@@ -46,3 +46,22 @@ TEST(CliSimplify, BadArgumentsAreOneLineErrors) {
     EXPECT_NE(r.err.find("lodstream: error:"), std::string::npos) << r.err;
   }
 }
+
+TEST(CliSimplify, AllowTopologyChangeReachesWhatCollapseCannot) {
+  // motorBike has hundreds of parts: topology-preserving collapse keeps a few triangles of each.
+  auto out = temp_dir() / "bike.ply";
+  std::vector<std::string> args = {
+      "simplify", data_file("motorBike.obj").string(), "-o", out.string(), "--triangles", "200", "--json"};
+  auto stuck = run_lodstream(args);
+  ASSERT_EQ(stuck.status, 0) << stuck.err;
+  EXPECT_FALSE(stuck.json()["target_reached"].get<bool>());
+  EXPECT_NE(stuck.err.find("short of the target"), std::string::npos);
+  args.push_back("--allow-topology-change");
+  auto r = run_lodstream(args);
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto j = r.json();
+  EXPECT_TRUE(j["target_reached"].get<bool>());
+  EXPECT_LE(j["output_triangles"].get<size_t>(), 200u);
+  EXPECT_GT(j["output_triangles"].get<size_t>(), 0u);
+  EXPECT_GE(j["error_bound"].get<double>(), stuck.json()["error_bound"].get<double>());
+}
