@@ -1,0 +1,206 @@
+#include "runtime/cut.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+#include <tuple>
+#include <unordered_set>
+
+#include "core/error.hpp"
+
+namespace lodstream::runtime {
+
+namespace {
+
+struct ObjectView {
+  glm::mat4 transform;
+  double scale = 1.0;
+};
+
+// One refinement candidate: the exchange below drawn node `node` of `object`, keyed by `error_px`, the
+// projected error of its P (= node's own).
+struct Candidate {
+  double error_px;
+  uint32_t object, node;
+  bool operator<(const Candidate& o) const {  // max-heap on error; ties: smaller (object, node) first
+    return std::tie(error_px, o.object, o.node) < std::tie(o.error_px, object, node);
+  }
+};
+
+uint64_t key(uint32_t object, uint32_t node) {
+  return uint64_t(object) << 32 | node;
+}
+
+std::vector<uint32_t> sorted(std::vector<uint32_t> ids) {
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
+
+class Traversal {
+ public:
+  Traversal(const package::PackageScene& scene, const NodeSource& nodes, const View& view,
+            const CutOptions& options, bool ideal)
+      : scene_(scene), nodes_(nodes), view_(view), options_(options), ideal_(ideal) {}
+
+  // Runs the greedy refinement over the objects in state `drawn`.
+  void run(const std::vector<ObjectState>& states, const std::vector<ObjectView>& objects) {
+    objects_ = &objects;
+    tau_ = options_.tau;
+    for (uint32_t o = 0; o < states.size(); ++o) {
+      if (states[o] != ObjectState::drawn) continue;
+      for (uint32_t root : scene_.representations[scene_.objects[o].representation].roots) draw(o, root);
+    }
+    while (!heap_.empty()) {
+      const Candidate c = heap_.top();
+      heap_.pop();
+      if (!(c.error_px > options_.tau)) break;
+      if (!drawn_.count(key(c.object, c.node))) continue;  // refined already through another P member
+      const package::NodeRecord& p = *nodes_.record(c.node);
+      // G and P of the exchange, checked to be one.
+      std::vector<const package::NodeRecord*> g(p.children.size());
+      bool known = true;
+      for (size_t i = 0; i < g.size(); ++i) {
+        g[i] = nodes_.record(p.children[i]);
+        if (!g[i]) {
+          known = false;
+          if (ideal_) missing_.push_back({c.object, p.children[i], 0.0, c.error_px, false});
+        }
+      }
+      if (!known) continue;
+      const std::vector<uint32_t> parents = sorted(g[0]->parents);
+      bool all_drawn = true;
+      for (uint32_t q : parents) all_drawn = all_drawn && drawn_.count(key(c.object, q));
+      if (!all_drawn) continue;  // queued again when the last member of P is drawn
+      check_exchange(c.node, p, g, parents);
+      uint64_t removed = 0, added = 0;
+      bool available = true;
+      for (uint32_t q : parents) removed += nodes_.record(q)->triangles;
+      for (size_t i = 0; i < g.size(); ++i) {
+        added += g[i]->triangles;
+        available = available && nodes_.available(p.children[i]);
+      }
+      if (!available && !ideal_) continue;  // the best available ancestor level (P) stays drawn
+      if (triangles_ - removed + added > options_.triangle_budget) {
+        budget_limited_ = true;
+        tau_ = c.error_px;
+        break;
+      }
+      for (uint32_t q : parents) drawn_.erase(key(c.object, q));
+      triangles_ -= removed;
+      for (size_t i = 0; i < g.size(); ++i) {
+        if (ideal_ && !nodes_.available(p.children[i]))
+          missing_.push_back({c.object, p.children[i], project(c.object, *g[i]), c.error_px, true});
+        draw(c.object, p.children[i]);
+      }
+    }
+  }
+
+  // Marks node `id` of `object` drawn (its record must be known) and queues the exchange below it.
+  void draw(uint32_t object, uint32_t id) {
+    const package::NodeRecord& r = *nodes_.record(id);
+    drawn_.insert(key(object, id));
+    triangles_ += r.triangles;
+    if (!r.children.empty()) heap_.push({project(object, r), object, id});
+  }
+
+  double project(uint32_t object, const package::NodeRecord& r) const {
+    const ObjectView& o = (*objects_)[object];
+    return screen_error(double(r.error) * o.scale, to_world(r.sphere, o.transform, o.scale), view_);
+  }
+
+  void check_exchange(uint32_t id, const package::NodeRecord& p,
+                      const std::vector<const package::NodeRecord*>& g,
+                      const std::vector<uint32_t>& parents) const {
+    const std::vector<uint32_t> children = sorted(p.children);
+    for (const package::NodeRecord* member : g)
+      if (sorted(member->parents) != parents)
+        throw Error("node " + std::to_string(id) +
+                    ": its children do not share one set of parents (not a group exchange)");
+    for (uint32_t q : parents) {
+      const package::NodeRecord* r = nodes_.record(q);
+      if (!r || sorted(r->children) != children)
+        throw Error("node " + std::to_string(q) + ": its children differ from node " + std::to_string(id) +
+                    "'s (not a group exchange)");
+    }
+  }
+
+  const package::PackageScene& scene_;
+  const NodeSource& nodes_;
+  const View& view_;
+  const CutOptions& options_;
+  const bool ideal_;
+  const std::vector<ObjectView>* objects_ = nullptr;
+  std::priority_queue<Candidate> heap_;
+  std::unordered_set<uint64_t> drawn_;
+  uint64_t triangles_ = 0;
+  double tau_ = 0.0;
+  bool budget_limited_ = false;
+  std::vector<MissingNode> missing_;
+};
+
+}  // namespace
+
+Cut select_cut(const package::PackageScene& scene, const NodeSource& nodes, const View& view,
+               const CutOptions& options) {
+  Cut cut;
+  std::vector<ObjectView> objects(scene.objects.size());
+  cut.objects.assign(scene.objects.size(), ObjectState::drawn);
+  std::vector<ObjectState> ideal_states = cut.objects;
+  std::vector<MissingNode> missing_roots;
+  for (uint32_t o = 0; o < scene.objects.size(); ++o) {
+    const package::ObjectRecord& object = scene.objects[o];
+    const package::Representation& rep = scene.representations[object.representation];
+    objects[o] = {object.transform, max_scale(object.transform)};
+    const Sphere bounds{rep.bounds.center(), 0.5f * rep.bounds.diagonal()};
+    if (rep.bounds.empty() || !in_frustum(to_world(bounds, object.transform, objects[o].scale), view)) {
+      cut.objects[o] = ideal_states[o] = ObjectState::culled;
+      continue;
+    }
+    for (uint32_t root : rep.roots) {
+      const package::NodeRecord* r = nodes.record(root);
+      if (!r) {
+        missing_roots.push_back({o, root, 0.0, INFINITY, false});
+        cut.objects[o] = ideal_states[o] = ObjectState::incomplete;
+      } else if (!nodes.available(root)) {
+        const double e = screen_error(double(r->error) * objects[o].scale,
+                                      to_world(r->sphere, object.transform, objects[o].scale), view);
+        missing_roots.push_back({o, root, e, INFINITY, true});
+        cut.objects[o] = ObjectState::incomplete;
+      }
+    }
+  }
+
+  Traversal available(scene, nodes, view, options, false);
+  available.run(cut.objects, objects);
+  Traversal ideal(scene, nodes, view, options, true);
+  ideal.run(ideal_states, objects);
+
+  for (uint64_t k : available.drawn_) {
+    const uint32_t o = uint32_t(k >> 32), id = uint32_t(k);
+    cut.drawn.push_back({o, id, available.project(o, *nodes.record(id)), nodes.record(id)->triangles});
+  }
+  std::sort(cut.drawn.begin(), cut.drawn.end(), [](const DrawnNode& a, const DrawnNode& b) {
+    return std::tie(a.object, a.node) < std::tie(b.object, b.node);
+  });
+  cut.triangles = available.triangles_;
+  cut.ideal_triangles = ideal.triangles_;
+  cut.tau = available.tau_;
+  cut.budget_limited = available.budget_limited_;
+  cut.missing = std::move(missing_roots);
+  cut.missing.insert(cut.missing.end(), ideal.missing_.begin(), ideal.missing_.end());
+  // Each member of P reports G's unknown records: keep one entry per (object, node).
+  std::sort(cut.missing.begin(), cut.missing.end(), [](const MissingNode& a, const MissingNode& b) {
+    return std::tie(a.object, a.node) < std::tie(b.object, b.node);
+  });
+  cut.missing.erase(std::unique(cut.missing.begin(), cut.missing.end(),
+                                [](const MissingNode& a, const MissingNode& b) {
+                                  return a.object == b.object && a.node == b.node;
+                                }),
+                    cut.missing.end());
+  std::stable_sort(cut.missing.begin(), cut.missing.end(), [](const MissingNode& a, const MissingNode& b) {
+    return a.parent_error_px > b.parent_error_px;
+  });
+  return cut;
+}
+
+}  // namespace lodstream::runtime
