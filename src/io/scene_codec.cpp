@@ -13,7 +13,9 @@ constexpr uint32_t kNormals = 1, kUvs = 2, kColors = 4;
 
 struct Writer {
   std::string out;
-  void bytes(const void* p, size_t n) { out.append(static_cast<const char*>(p), n); }
+  void bytes(const void* p, size_t n) {
+    if (n > 0) out.append(static_cast<const char*>(p), n);
+  }
   void u32(uint32_t v) { bytes(&v, 4); }
   void str(const std::string& s) {
     u32(static_cast<uint32_t>(s.size()));
@@ -32,6 +34,7 @@ struct Reader {
   [[noreturn]] void fail(const std::string& why) const { throw Error(what + ": " + why); }
   void bytes(void* dst, size_t n) {
     if (n > left) fail("truncated scene data from the import worker");
+    if (n == 0) return;  // an empty array's data() may be null
     std::memcpy(dst, p, n);
     p += n;
     left -= n;
