@@ -140,6 +140,12 @@ class Traversal {
 
 }  // namespace
 
+WorldSphere object_sphere(const package::PackageScene& scene, uint32_t object) {
+  const package::ObjectRecord& o = scene.objects[object];
+  const Bounds& b = scene.representations[o.representation].bounds;
+  return to_world(Sphere{b.center(), 0.5f * b.diagonal()}, o.transform, max_scale(o.transform));
+}
+
 Cut select_cut(const package::PackageScene& scene, const NodeSource& nodes, const View& view,
                const CutOptions& options) {
   Cut cut;
@@ -151,8 +157,7 @@ Cut select_cut(const package::PackageScene& scene, const NodeSource& nodes, cons
     const package::ObjectRecord& object = scene.objects[o];
     const package::Representation& rep = scene.representations[object.representation];
     objects[o] = {object.transform, max_scale(object.transform)};
-    const Sphere bounds{rep.bounds.center(), 0.5f * rep.bounds.diagonal()};
-    if (rep.bounds.empty() || !in_frustum(to_world(bounds, object.transform, objects[o].scale), view)) {
+    if (rep.bounds.empty() || !in_frustum(object_sphere(scene, o), view)) {
       cut.objects[o] = ideal_states[o] = ObjectState::culled;
       continue;
     }

@@ -84,6 +84,10 @@ struct Cut {
   bool converged() const { return missing.empty(); }
 };
 
+// Object `object`'s bounding sphere in world space: its representation's bounds (centre, half diagonal) under
+// its transform (radius scaled by the largest axis scale). What culling and the benefit ratio's A_i use.
+WorldSphere object_sphere(const package::PackageScene& scene, uint32_t object);
+
 // Selects the cut for `view` over `scene`'s objects. Throws lodstream::Error (naming the node) when node
 // links do not form group exchanges (a G member's parents differ from P, a P member's children from G).
 Cut select_cut(const package::PackageScene& scene, const NodeSource& nodes, const View& view,

@@ -1,0 +1,70 @@
+#include "runtime/quality.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace lodstream::runtime {
+
+double projected_area(const WorldSphere& sphere, const View& view) {
+  const glm::dvec3 d = sphere.center - view.eye;
+  const double x = glm::dot(d, view.right), y = glm::dot(d, view.up), z = glm::dot(d, view.forward);
+  const double r = sphere.radius;
+  if (z <= -r) return 0.0;
+  if (z <= r) return view.width * view.height;
+  const double f = view.focal_pixels();
+  const double rho = f * r / std::sqrt(glm::dot(d, d) - r * r);
+  const double cx = 0.5 * view.width + f * x / z, cy = 0.5 * view.height + f * y / z;
+  // Chords of the disc over the strips of y inside the viewport, clipped to [0, width].
+  const double y0 = std::max(cy - rho, 0.0), y1 = std::min(cy + rho, view.height);
+  if (!(y1 > y0)) return 0.0;
+  constexpr int kStrips = 256;
+  const double h = (y1 - y0) / kStrips;
+  double area = 0.0;
+  for (int i = 0; i < kStrips; ++i) {
+    const double yy = y0 + (i + 0.5) * h - cy;
+    const double w = std::sqrt(std::max(rho * rho - yy * yy, 0.0));
+    area += std::max(std::min(cx + w, view.width) - std::max(cx - w, 0.0), 0.0) * h;
+  }
+  return area;
+}
+
+FrameQuality frame_quality(const package::PackageScene& scene, const NodeSource& nodes, const Cut& cut,
+                           const View& view, double tau) {
+  const size_t n = scene.objects.size();
+  std::vector<double> weight(n, 0.0), accuracy(n, 0.0), error(n, 0.0);
+  std::vector<size_t> count(n, 0);
+  std::vector<double> plain(n, 0.0);  // unweighted sum, for an object whose nodes all have zero area
+  for (const DrawnNode& d : cut.drawn) {
+    const package::ObjectRecord& o = scene.objects[d.object];
+    const package::NodeRecord& r = *nodes.record(d.node);
+    const double a = projected_area(to_world(r.sphere, o.transform, max_scale(o.transform)), view);
+    const double alpha = d.error_px > 0.0 ? std::min(1.0, tau / d.error_px) : 1.0;
+    weight[d.object] += a;
+    accuracy[d.object] += a * alpha;
+    plain[d.object] += alpha;
+    ++count[d.object];
+    error[d.object] = std::max(error[d.object], d.error_px);
+  }
+  FrameQuality q;
+  double covered = 0.0, benefit = 0.0;
+  size_t drawn_objects = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    if (cut.objects[i] == ObjectState::culled) continue;
+    ++q.visible_objects;
+    const double a = projected_area(object_sphere(scene, i), view);
+    double alpha = 0.0;
+    if (count[i] > 0) {
+      alpha = weight[i] > 0.0 ? accuracy[i] / weight[i] : plain[i] / double(count[i]);
+      q.pixel_error_max = std::max(q.pixel_error_max, error[i]);
+      q.pixel_error_mean += error[i];
+      ++drawn_objects;
+    }
+    covered += a;
+    benefit += a * alpha;
+  }
+  if (drawn_objects > 0) q.pixel_error_mean /= double(drawn_objects);
+  q.benefit_ratio = covered > 0.0 ? benefit / covered : 1.0;
+  return q;
+}
+
+}  // namespace lodstream::runtime

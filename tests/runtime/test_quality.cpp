@@ -1,0 +1,116 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "runtime/quality.hpp"
+#include "synthetic_dag.hpp"
+
+using namespace lodstream;
+using namespace lodstream::runtime;
+
+namespace {
+// 200x100 viewport, 90° vertical: focal 50 px, tan_half_x = 2.
+View test_view() {
+  Camera c;
+  c.eye = {0, 0, 0};
+  c.target = {0, 0, -1};
+  c.fov_y_degrees = 90.0f;
+  c.width = 200;
+  c.height = 100;
+  return View::of(c);
+}
+}  // namespace
+
+TEST(Quality, ProjectedAreaOfADiscInsideAtAnEdgeAndInACorner) {
+  View v = test_view();
+  const double pi = 3.14159265358979;
+  // On the axis at distance 10, radius 1: disc radius 50 / sqrt(99).
+  EXPECT_NEAR(projected_area({{0, 0, -10}, 1.0}, v), pi * 2500.0 / 99.0, 1e-3 * pi * 2500.0 / 99.0);
+  // Centre projected onto the left edge (x / z = -2): half of the disc.
+  WorldSphere edge{{-20, 0, -10}, 1.0};
+  const double rho = 50.0 / std::sqrt(500.0 - 1.0);
+  EXPECT_NEAR(projected_area(edge, v), 0.5 * pi * rho * rho, 1e-3 * pi * rho * rho);
+  // Centre projected onto the top-left corner (x / z = -2, y / z = 1): a quarter.
+  WorldSphere corner{{-20, 10, -10}, 1.0};
+  const double rho_c = 50.0 / std::sqrt(600.0 - 1.0);
+  EXPECT_NEAR(projected_area(corner, v), 0.25 * pi * rho_c * rho_c, 1e-3 * pi * rho_c * rho_c);
+  // Around the eye: the whole viewport; behind: nothing; far outside: nothing.
+  EXPECT_DOUBLE_EQ(projected_area({{0, 0, 0.5}, 1.0}, v), 200.0 * 100.0);
+  EXPECT_DOUBLE_EQ(projected_area({{0, 0, 10}, 1.0}, v), 0.0);
+  EXPECT_DOUBLE_EQ(projected_area({{-100, 0, -10}, 1.0}, v), 0.0);
+}
+
+TEST(Quality, BenefitRatioAndPixelErrorOfHandMadeCuts) {
+  // Two objects, each one node with its own sphere equal to the object's bounding sphere.
+  package::NodeRecord a, b;
+  a.sphere = b.sphere = {{0, 0, 0}, 1.0f};
+  a.triangles = b.triangles = 10;
+  struct Nodes : NodeSource {
+    std::vector<package::NodeRecord> r;
+    const package::NodeRecord* record(uint32_t id) const override { return &r.at(id); }
+    bool available(uint32_t) const override { return true; }
+  } nodes;
+  nodes.r = {a, b};
+  package::PackageScene scene;
+  package::Representation rep;
+  rep.bounds.add(glm::vec3(-1.0f / std::sqrt(3.0f)));  // half diagonal 1: the object sphere is the node's
+  rep.bounds.add(glm::vec3(1.0f / std::sqrt(3.0f)));
+  scene.representations = {rep};
+  scene.objects = {{"near", glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, -10)), 0},
+                   {"far", glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, -20)), 0},
+                   {"behind", glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, 20)), 0}};
+  View v = test_view();
+  const double a0 = projected_area(object_sphere(scene, 0), v),
+               a1 = projected_area(object_sphere(scene, 1), v);
+  ASSERT_GT(a0, 3.0 * a1);
+
+  Cut cut;
+  cut.objects = {ObjectState::drawn, ObjectState::drawn, ObjectState::culled};
+  cut.drawn = {{0, 0, 0.5, 10}, {1, 1, 4.0, 10}};  // tau 1: near at tau/2 (alpha 1), far at 4 tau (alpha 1/4)
+  FrameQuality q = frame_quality(scene, nodes, cut, v, 1.0);
+  EXPECT_EQ(q.visible_objects, 2u);
+  EXPECT_NEAR(q.benefit_ratio, (a0 * 1.0 + a1 * 0.25) / (a0 + a1), 1e-12);
+  EXPECT_DOUBLE_EQ(q.pixel_error_max, 4.0);
+  EXPECT_DOUBLE_EQ(q.pixel_error_mean, 2.25);
+
+  // Nothing of the far one drawn (a root missing): alpha 0, and it leaves the pixel error.
+  cut.objects[1] = ObjectState::incomplete;
+  cut.drawn = {{0, 0, 0.5, 10}};
+  q = frame_quality(scene, nodes, cut, v, 1.0);
+  EXPECT_NEAR(q.benefit_ratio, a0 / (a0 + a1), 1e-12);
+  EXPECT_DOUBLE_EQ(q.pixel_error_max, 0.5);
+  EXPECT_DOUBLE_EQ(q.pixel_error_mean, 0.5);
+
+  // Everything at tau or better: exactly 1.
+  cut.objects[1] = ObjectState::drawn;
+  cut.drawn = {{0, 0, 1.0, 10}, {1, 1, 0.0, 10}};
+  EXPECT_DOUBLE_EQ(frame_quality(scene, nodes, cut, v, 1.0).benefit_ratio, 1.0);
+}
+
+TEST(Quality, AreaWeightedOverTheDrawnNodesOfASelectedCut) {
+  test::SyntheticDag dag = test::SyntheticDag::make();
+  test::TestNodes nodes(dag);
+  auto scene = dag.scene({glm::mat4(1.0f)});
+  Camera c;
+  c.eye = {-1.0f, 0.5f, 1.0f};
+  c.target = {8.0f, 0.0f, 0.0f};
+  View v = View::of(c);
+  const double tau = 0.5;
+  Cut ideal = select_cut(scene, nodes, v, {tau});
+  EXPECT_DOUBLE_EQ(frame_quality(scene, nodes, ideal, v, tau).benefit_ratio, 1.0);
+  // Coarser than wished (a level missing): alpha is the area-weighted mean of tau / e_px of the roots.
+  for (uint32_t n = 23; n <= 27; ++n) nodes.unavailable.insert(n);
+  Cut coarse = select_cut(scene, nodes, v, {tau});
+  ASSERT_EQ(coarse.drawn.size(), 2u);
+  double wsum = 0.0, asum = 0.0;
+  for (const auto& d : coarse.drawn) {
+    const double a = projected_area(to_world(dag.records[d.node].sphere, glm::mat4(1.0f), 1.0), v);
+    wsum += a;
+    asum += a * std::min(1.0, tau / d.error_px);
+  }
+  FrameQuality q = frame_quality(scene, nodes, coarse, v, tau);
+  EXPECT_NEAR(q.benefit_ratio, asum / wsum, 1e-12);
+  EXPECT_LT(q.benefit_ratio, 1.0);
+  EXPECT_DOUBLE_EQ(q.pixel_error_max, std::max(coarse.drawn[0].error_px, coarse.drawn[1].error_px));
+}
