@@ -315,6 +315,19 @@ ClusterDag build_cluster_dag(const Mesh& mesh, const DagOptions& options) {
       break;
     }
   }
+  // A position locked in one cluster of a group is locked in every cluster of that group holding it: the
+  // group's clusters share one position shift, so a vertex they share must decode the same way in all.
+  tbb::parallel_for(size_t(0), dag.groups.size(), [&](size_t g) {
+    std::vector<uint32_t> locked_ids;
+    for (uint32_t c : dag.groups[g].clusters)
+      for (size_t v = 0; v < b.position_ids[c].size(); ++v)
+        if (dag.clusters[c].locked[v]) locked_ids.push_back(b.position_ids[c][v]);
+    std::sort(locked_ids.begin(), locked_ids.end());
+    for (uint32_t c : dag.groups[g].clusters)
+      for (size_t v = 0; v < b.position_ids[c].size(); ++v)
+        if (std::binary_search(locked_ids.begin(), locked_ids.end(), b.position_ids[c][v]))
+          dag.clusters[c].locked[v] = 1;
+  });
   for (uint32_t c : active) {
     DagCluster& root = dag.clusters[c];
     root.parent_group = kNoGroup;

@@ -51,10 +51,13 @@ struct DagOptions {
 };
 
 struct DagCluster {
-  Mesh mesh;                    // its own vertices (positions and the input's attributes), <= 128 triangles
-  std::vector<uint8_t> locked;  // per vertex: position on the border of the group that made or consumes it
-  uint32_t level = 0;           // 0 = finest
-  uint32_t group = kNoGroup;    // the group simplification that made it (kNoGroup at level 0)
+  Mesh mesh;  // its own vertices (positions and the input's attributes), <= 128 triangles
+  // Per vertex: its position is on the border of the group that made or consumes this cluster or one of its
+  // siblings (clusters made by the same group). Such positions are shared with clusters of other groups that
+  // may be drawn beside it, so a codec must store them exactly (position shift 0 for them).
+  std::vector<uint8_t> locked;
+  uint32_t level = 0;                // 0 = finest
+  uint32_t group = kNoGroup;         // the group simplification that made it (kNoGroup at level 0)
   uint32_t parent_group = kNoGroup;  // the group that consumes it (kNoGroup for a root)
   float error = 0.0f;                // its own (error, sphere): its group's
   Sphere sphere;

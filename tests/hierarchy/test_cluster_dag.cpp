@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <random>
+#include <tuple>
 
 #include "hierarchy/bounding_sphere.hpp"
 #include "hierarchy/cluster_dag.hpp"
@@ -24,6 +26,15 @@ void check_invariants(const ClusterDag& dag) {
       EXPECT_EQ(child.parent_error, g.error);
       EXPECT_EQ(child.parent_sphere.radius, g.sphere.radius);
     }
+    // Clusters of one group (one position shift in a package) agree on which shared positions are locked.
+    std::map<std::tuple<float, float, float>, uint8_t> locked_at;
+    for (uint32_t c : g.clusters)
+      for (size_t v = 0; v < dag.clusters[c].mesh.positions.size(); ++v) {
+        const glm::vec3 p = dag.clusters[c].mesh.positions[v];
+        auto [it, fresh] = locked_at.emplace(std::make_tuple(p.x, p.y, p.z), dag.clusters[c].locked[v]);
+        if (!fresh)
+          EXPECT_EQ(it->second, dag.clusters[c].locked[v]) << "siblings disagree on a locked position";
+      }
     for (uint32_t c : g.clusters) {
       EXPECT_EQ(dag.clusters[c].error, g.error);
       EXPECT_EQ(dag.clusters[c].sphere.radius, g.sphere.radius);

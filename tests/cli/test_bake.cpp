@@ -1,0 +1,85 @@
+// `lodstream bake` and `lodstream inspect` end to end: JSON keys, the package verifies (monotonic errors,
+// spheres, decoding, crack-free cuts), multi-object scenes, bad input.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "support/run.hpp"
+
+using lodstream::test::data_file;
+using lodstream::test::run_lodstream;
+using lodstream::test::temp_dir;
+
+namespace {
+
+nlohmann::json bake_and_verify(const std::string& model, const std::filesystem::path& out) {
+  auto bake = run_lodstream({"bake", data_file(model).string(), "-o", out.string(), "--json"});
+  EXPECT_EQ(bake.status, 0) << bake.err;
+  if (bake.status != 0) return {};
+  auto j = bake.json();
+  for (const char* key :
+       {"input_triangles", "objects", "nodes", "pages", "levels", "bytes", "time_s", "peak_rss_bytes"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["bytes"].get<uint64_t>(), std::filesystem::file_size(out));
+  EXPECT_NE(bake.err.find("bake: hierarchy"), std::string::npos) << "no progress line";
+
+  auto inspect = run_lodstream({"inspect", out.string(), "--verify", "--json"});
+  EXPECT_EQ(inspect.status, 0) << inspect.err;
+  auto k = inspect.json();
+  EXPECT_EQ(k["verified"], true) << k.dump();
+  EXPECT_EQ(k["nodes"], j["nodes"]);
+  EXPECT_EQ(k["pages"], j["pages"]);
+  EXPECT_EQ(k["levels"], j["levels"]);
+  EXPECT_EQ(k["bytes"], j["bytes"]);
+  EXPECT_EQ(k["input_triangles"], j["input_triangles"]);
+  return j;
+}
+
+}  // namespace
+
+TEST(CliBake, ElephantBuildsAVerifiedHierarchy) {
+  auto j = bake_and_verify("elephant.off", temp_dir() / "elephant.lods");
+  EXPECT_EQ(j["input_triangles"].get<size_t>(), 5558u);
+  EXPECT_EQ(j["objects"].get<size_t>(), 1u);
+  EXPECT_GE(j["levels"].get<int>(), 3);
+  EXPECT_GT(j["nodes"].get<int>(), 44);  // more than the full-resolution clusters alone
+}
+
+TEST(CliBake, MotorBikeKeepsEveryObject) {
+  auto info = run_lodstream({"info", data_file("motorBike.obj").string(), "--json"});
+  ASSERT_EQ(info.status, 0) << info.err;
+  auto j = bake_and_verify("motorBike.obj", temp_dir() / "motorBike.lods");
+  EXPECT_EQ(j["objects"], info.json()["objects"]);
+  EXPECT_EQ(j["input_triangles"], info.json()["triangles"]);
+}
+
+TEST(CliBake, BadInputIsAOneLineError) {
+  const auto dir = temp_dir();
+  auto missing = run_lodstream({"bake", (dir / "nope.obj").string(), "-o", (dir / "x.lods").string()});
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_EQ(missing.err.rfind("lodstream: error:", 0), 0u) << missing.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.lods"));
+
+  auto garbage = dir / "garbage.lods";
+  std::ofstream(garbage) << "not a package at all";
+  auto inspect = run_lodstream({"inspect", garbage.string(), "--verify"});
+  EXPECT_EQ(inspect.status, 1);
+  EXPECT_NE(inspect.err.find("lodstream: error:"), std::string::npos) << inspect.err;
+
+  // A package with one flipped byte in its data fails --verify with an error naming the file.
+  auto good = dir / "elephant.lods";
+  ASSERT_EQ(run_lodstream({"bake", data_file("elephant.off").string(), "-o", good.string()}).status, 0);
+  {
+    std::fstream f(good, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(100);
+    char c = 0;
+    f.read(&c, 1);
+    f.seekp(100);
+    c = char(c ^ 0x40);
+    f.write(&c, 1);
+  }
+  auto flipped = run_lodstream({"inspect", good.string(), "--verify"});
+  EXPECT_EQ(flipped.status, 1);
+  EXPECT_NE(flipped.err.find(good.string()), std::string::npos) << flipped.err;
+}
