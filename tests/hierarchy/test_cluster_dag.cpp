@@ -32,8 +32,9 @@ void check_invariants(const ClusterDag& dag) {
       for (size_t v = 0; v < dag.clusters[c].mesh.positions.size(); ++v) {
         const glm::vec3 p = dag.clusters[c].mesh.positions[v];
         auto [it, fresh] = locked_at.emplace(std::make_tuple(p.x, p.y, p.z), dag.clusters[c].locked[v]);
-        if (!fresh)
+        if (!fresh) {
           EXPECT_EQ(it->second, dag.clusters[c].locked[v]) << "siblings disagree on a locked position";
+        }
       }
     for (uint32_t c : g.clusters) {
       EXPECT_EQ(dag.clusters[c].error, g.error);
