@@ -7,7 +7,9 @@
 // two locked vertices merge (a cell radius at which a locked vertex would lose all its triangles is too
 // coarse). rho is found by bisection for the triangle target.
 //
-// Two-sided bound (face-maximum form, simplify.hpp): the natural mapping moves each vertex to its cluster's
+// Two-sided bound, in face-maximum form (weaker than simplify.hpp's interpolation: every point of an output
+// face is within the largest vertex_error of its corners of the input, and every input point within that of
+// some output face): the natural mapping moves each vertex to its cluster's
 // representative, so points move at most the largest displacement of their triangle's corners; a dropped
 // triangle's image (a segment or a point) lies within the distance of its corners' images to a used
 // representative (the nearest one when none of them is used). A cluster's error is the largest, over the
@@ -23,9 +25,9 @@ namespace lodstream::simplify {
 
 // Clusters `mesh` to at most options.target_triangles (the closest count found below it; 0 = as few as the
 // bisection reaches) without a bound above options.max_error; uses options.locked and no other field.
-// `prior_error` (per vertex, model units, or empty) is the face-maximum error the mesh already carries (its
-// vertex_error from simplify_mesh), added to the new bound. Result::target_reached is false when the count
-// stays above the target. Cost: O((V + T) log) per bisection step, about 20 steps.
+// `prior_error` (per vertex, model units, or empty) is the error the mesh already carries (its vertex_error
+// from simplify_mesh; read in face-maximum form), added to the new bound. Result::target_reached is false
+// when the count stays above the target. Cost: O((V + T) log) per bisection step, about 20 steps.
 Result cluster_mesh(const Mesh& mesh, const Options& options, const std::vector<float>& prior_error = {});
 
 }  // namespace lodstream::simplify

@@ -93,7 +93,7 @@ class Simplifier {
   std::vector<glm::vec4> col_;
   std::vector<uint32_t> wedge_, pid_;  // wedge ring (same position) and its representative
   std::vector<uint8_t> kind_, touched_, moved_;
-  std::vector<float> radius_, radius2_;  // the two bound radii (simplify.hpp): interpolated, face-maximum
+  std::vector<float> radius_;  // bound radius r_v (simplify.hpp), normalized units
   std::vector<Quadric> quadric_;
   std::vector<AttributeTerm> attr_;  // channels_ per vertex
   std::vector<float> channel_weight_;
@@ -101,7 +101,7 @@ class Simplifier {
   std::vector<uint32_t> open_out_, open_in_;
   glm::vec3 origin_{0.0f};
   float scale_ = 1.0f;
-  double bound_ = 0.0, bound2_ = 0.0;  // max of radius_ and radius2_, normalized units
+  double bound_ = 0.0;  // max of radius_
   double max_error_ = 0.0;
   bool error_limited_ = false;  // a collapse was refused because of Options::max_error
 
@@ -154,7 +154,6 @@ class Simplifier {
     touched_.assign(m, 1);  // every cost is evaluated in the first pass
     moved_.assign(m, 0);
     radius_.assign(m, 0.0f);
-    radius2_.assign(m, 0.0f);
     for (uint32_t v = 0; v < n; ++v)
       if (v < opt_.locked.size() && opt_.locked[v]) kind_[weld_remap_[v]] = kLocked;
 
@@ -551,7 +550,15 @@ class Simplifier {
   }
 
   std::vector<uint32_t> na_, nb_, apex_, removed_;
-  std::vector<uint32_t> mark_a_, mark_b_;  // neighbour marks (stamp_ = this collapse)
+  std::vector<uint32_t> mark_a_, mark_b_;
+  struct Corners {  // one changed face for vertical_bound
+    glm::dvec3 p[3];
+    glm::dvec2 y[3];
+    double h[3], r[3];
+    bool moving[3];
+    bool dies;
+  };
+  std::vector<Corners> old_;  // neighbour marks (stamp_ = this collapse)
   uint32_t stamp_ = 0;
 
   // Validity (link condition, boundary pinch, lost surface, normal change), bound, then the collapse.
@@ -560,11 +567,7 @@ class Simplifier {
     const glm::vec3 x(p.x);  // as stored: the bounds use the rounded position
     const double da = glm::length(glm::dvec3(pos_[p.a]) - glm::dvec3(x));
     const double db = glm::length(glm::dvec3(pos_[p.b]) - glm::dvec3(x));
-    const double r_new = std::max(radius_[p.a] + da, radius_[p.b] + db);
-    if (r_new > max_error_ && bound2_ > max_error_) {
-      error_limited_ = true;
-      return false;
-    }
+    const double r_natural = std::max(radius_[p.a] + da, radius_[p.b] + db);
 
     na_.clear(), nb_.clear(), apex_.clear(), removed_.clear();
     size_t kept_faces = 0;
@@ -627,8 +630,8 @@ class Simplifier {
     for_faces(p.a, check);
     if (p.move) for_faces(p.b, check);
     if (!ok) return false;
-    const double r2_new = local_bound(p, x, std::max(da, db));
-    if (std::min(std::max(bound_, r_new), std::max(bound2_, r2_new)) > max_error_) {
+    const double r_new = std::min(r_natural, vertical_bound(p, x));
+    if (r_new > max_error_) {
       error_limited_ = true;
       return false;
     }
@@ -648,7 +651,6 @@ class Simplifier {
     uint32_t v = p.b;
     do {
       radius_[v] = float(r_new);
-      radius2_[v] = float(r2_new);
       if (p.move) pos_[v] = x, moved_[v] = 1;
       touched_[v] = 1;
       v = wedge_[v];
@@ -656,9 +658,8 @@ class Simplifier {
     touched_[p.a] = 1;
     if (p.a2 != kNone) touched_[p.a2] = 1;
     bound_ = std::max(bound_, r_new);
-    bound2_ = std::max(bound2_, r2_new);
     if (record_) {
-      const float e = reported(std::min(bound_, bound2_));
+      const float e = reported(bound_);
       record_->push_back({p.a, p.b, step_, e});
       if (p.a2 != kNone) record_->push_back({p.a2, p.b2, step_, e});
       ++step_;
@@ -666,49 +667,132 @@ class Simplifier {
     return true;
   }
 
-  // Face-maximum radius of x after collapse p (simplify.hpp): max radius2_ over the changed faces' vertices
-  // plus delta >= both one-sided Hausdorff distances between the changed faces before and after. delta is
-  // the largest displacement (the natural mapping) or, when the changed region is a closed star at the
-  // position level and every old and new face projects with positive orientation onto the plane of the mean
-  // old normal n, the spread of its vertices along n: both triangulations then cover the same region of that
-  // plane (same boundary chain, no folds), so a point of one lies over a point of the other, at most the
-  // spread away.
-  double local_bound(const Plan& p, const glm::vec3& x, double displacement) const {
-    const uint32_t pa = pid_[p.a], pb = pid_[p.b];
-    auto changed = [&](auto&& f) {
-      for_faces(p.a, f);
-      if (p.move) for_faces(p.b, f);
-    };
-    glm::dvec3 nsum(0.0);
-    double r = 0;
-    changed([&](uint32_t f) {
-      const uint32_t* t = &indices_[3 * size_t(f)];
-      glm::dvec3 p0(pos_[t[0]]), p1(pos_[t[1]]), p2(pos_[t[2]]);
-      nsum += glm::cross(p1 - p0, p2 - p0);
-      r = std::max({r, double(radius2_[t[0]]), double(radius2_[t[1]]), double(radius2_[t[2]])});
-    });
+  // Radius of x under the vertical mapping (simplify.hpp), or +inf where it does not apply. The changed
+  // region (a's faces, and b's when x moves) must be a closed star at the position level whose old and new
+  // faces all project with positive orientation onto the plane of its mean normal n: both then cover the
+  // same region of that plane, and the mapping pairs the points over the same place, |p' - p| = the height
+  // gap. The invariant needs r_new(p') >= gap(p) + r_old(p) everywhere; new radii are linear per new face and
+  // the right side is piecewise linear and concave-kinked over the common refinement of both fans, so it is
+  // enough to check the refinement's vertices: x in the old fan, a (and b) in the new fan, and the crossings
+  // of old edges at a or b with the new edges at x (ring vertices are shared and hold trivially).
+  double vertical_bound(const Plan& p, const glm::vec3& x) {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
     auto closed = [&](uint32_t v) { return kind_[v] == kManifold || kind_[v] == kSeam; };
-    double len = glm::length(nsum);
-    if (!closed(p.a) || (p.move && !closed(p.b)) || !(len > 0)) return r + displacement;
-    const glm::dvec3 n = nsum / len, xd(x);
-    double lo = glm::dot(n, xd), hi = lo;
-    bool flat = true;
-    changed([&](uint32_t f) {
-      if (!flat) return;
+    if (!closed(p.a) || (p.move && !closed(p.b))) return kInf;
+    const uint32_t pa = pid_[p.a], pb = pid_[p.b];
+    old_.clear();
+    glm::dvec3 nsum(0.0);
+    auto gather = [&](uint32_t f) {
       const uint32_t* t = &indices_[3 * size_t(f)];
-      glm::dvec3 c[3], d[3];
-      bool dies = false, moves = false;
+      Corners c;
+      int moving = 0;
       for (int k = 0; k < 3; ++k) {
-        c[k] = d[k] = glm::dvec3(pos_[t[k]]);
-        double h = glm::dot(n, c[k]);
-        lo = std::min(lo, h), hi = std::max(hi, h);
-        const uint32_t q = pid_[t[k]];
-        if (q == pa || q == pb) d[k] = xd, dies = dies || moves, moves = true;
+        c.p[k] = glm::dvec3(pos_[t[k]]);
+        c.r[k] = radius_[t[k]];
+        c.moving[k] = pid_[t[k]] == pa || pid_[t[k]] == pb;
+        moving += c.moving[k];
       }
-      if (!(glm::dot(glm::cross(c[1] - c[0], c[2] - c[0]), n) > 0)) flat = false;
-      if (!dies && !(glm::dot(glm::cross(d[1] - d[0], d[2] - d[0]), n) > 0)) flat = false;
-    });
-    return r + (flat ? std::min(displacement, hi - lo) : displacement);
+      c.dies = moving > 1;
+      nsum += glm::cross(c.p[1] - c.p[0], c.p[2] - c.p[0]);
+      old_.push_back(c);
+    };
+    for_faces(p.a, gather);
+    if (p.move)
+      for_faces(p.b, [&](uint32_t f) {
+        const uint32_t* t = &indices_[3 * size_t(f)];
+        if (pid_[t[0]] != pa && pid_[t[1]] != pa && pid_[t[2]] != pa) gather(f);
+      });
+    const double len = glm::length(nsum);
+    if (!(len > 0)) return kInf;
+    const glm::dvec3 n = nsum / len;
+    const glm::dvec3 u =
+        glm::normalize(glm::cross(n, std::abs(n.x) < 0.6 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0)));
+    const glm::dvec3 w = glm::cross(n, u);
+    auto proj = [&](const glm::dvec3& q) { return glm::dvec2(glm::dot(u, q), glm::dot(w, q)); };
+    auto cross2 = [](glm::dvec2 e, glm::dvec2 f) { return e.x * f.y - e.y * f.x; };
+    const glm::dvec3 xd(x);
+    const glm::dvec2 yx = proj(xd);
+    const double hx = glm::dot(n, xd);
+    for (Corners& c : old_) {
+      for (int k = 0; k < 3; ++k) c.y[k] = proj(c.p[k]), c.h[k] = glm::dot(n, c.p[k]);
+      if (!(cross2(c.y[1] - c.y[0], c.y[2] - c.y[0]) > 0)) return kInf;
+      if (c.dies) continue;
+      glm::dvec2 y[3];
+      for (int k = 0; k < 3; ++k) y[k] = c.moving[k] ? yx : c.y[k];
+      if (!(cross2(y[1] - y[0], y[2] - y[0]) > 0)) return kInf;
+    }
+    // Barycentric coordinates of q in triangle y (true when inside, with a little tolerance).
+    auto inside = [&](const glm::dvec2* y, glm::dvec2 q, double* l) {
+      double area = cross2(y[1] - y[0], y[2] - y[0]);
+      l[0] = cross2(y[1] - q, y[2] - q) / area;
+      l[1] = cross2(y[2] - q, y[0] - q) / area;
+      l[2] = 1 - l[0] - l[1];
+      return l[0] >= -1e-9 && l[1] >= -1e-9 && l[2] >= -1e-9;
+    };
+    double need = 0;
+    // x over the old fan.
+    bool found = false;
+    for (const Corners& c : old_) {
+      double l[3];
+      if (!inside(c.y, yx, l)) continue;
+      need = std::abs(hx - (l[0] * c.h[0] + l[1] * c.h[1] + l[2] * c.h[2])) + l[0] * c.r[0] + l[1] * c.r[1] +
+             l[2] * c.r[2];
+      found = true;
+      break;
+    }
+    if (!found) return kInf;
+    // Requirement mu_x r_x + rest >= rhs at a point of a new face: a lower bound on r_x.
+    auto require = [&](double mu_x, double rest, double rhs) {
+      if (mu_x > 1e-7) need = std::max(need, (rhs - rest) / mu_x);
+      return mu_x > 1e-7 || rest >= rhs - 1e-9;
+    };
+    // The moved old vertices over the new fan.
+    for (uint32_t v : {p.a, p.b}) {
+      if (v == p.b && !p.move) break;
+      const glm::dvec3 pv(pos_[v]);
+      const glm::dvec2 yv = proj(pv);
+      found = false;
+      for (const Corners& c : old_) {
+        if (c.dies) continue;
+        glm::dvec2 y[3];
+        for (int k = 0; k < 3; ++k) y[k] = c.moving[k] ? yx : c.y[k];
+        double l[3];
+        if (!inside(y, yv, l)) continue;
+        double h = 0, rest = 0, mu_x = 0;
+        for (int k = 0; k < 3; ++k) {
+          h += l[k] * (c.moving[k] ? hx : c.h[k]);
+          if (c.moving[k])
+            mu_x += l[k];
+          else
+            rest += l[k] * c.r[k];
+        }
+        if (!require(mu_x, rest, std::abs(h - glm::dot(n, pv)) + radius_[v])) return kInf;
+        found = true;
+        break;
+      }
+      if (!found) return kInf;
+    }
+    // Old edges at a or b against new edges at x.
+    for (const Corners& c : old_)
+      for (int i = 0; i < 3; ++i) {
+        const int j = (i + 1) % 3;
+        if (!c.moving[i] && !c.moving[j]) continue;
+        const glm::dvec2 o0 = c.y[i], od = c.y[j] - c.y[i];
+        for (const Corners& e : old_) {
+          if (e.dies) continue;
+          for (int k = 0; k < 3; ++k) {
+            if (e.moving[k]) continue;  // the new edge from x to the ring vertex k
+            const glm::dvec2 nd = e.y[k] - yx;
+            double den = cross2(nd, od);
+            if (std::abs(den) < 1e-30) continue;
+            double s = cross2(o0 - yx, od) / den, t = cross2(o0 - yx, nd) / den;
+            if (!(s > 0 && s < 1 && t > 0 && t < 1)) continue;
+            double gap = std::abs((1 - s) * hx + s * e.h[k] - ((1 - t) * c.h[i] + t * c.h[j]));
+            if (!require(1 - s, s * e.r[k], gap + (1 - t) * c.r[i] + t * c.r[j])) return kInf;
+          }
+        }
+      }
+    return need;
   }
 
   // Merges quadrics and sets b's attributes: the attribute quadric's optimum s* = (G.x + D)/W for weighted
@@ -765,7 +849,6 @@ class Simplifier {
       if (opt_.locked[v]) user_locked[weld_remap_[v]] = 1;
     output_locked_.clear();
     // The invariant with the smaller maximum gives the bound (each one alone bounds the distance).
-    const std::vector<float>& radius = bound2_ < bound_ ? radius2_ : radius_;
     for (uint32_t& v : indices_) {
       if (remap[v] == kNone) {
         remap[v] = uint32_t(out.positions.size());
@@ -773,7 +856,7 @@ class Simplifier {
         if (!nrm_.empty()) out.normals.push_back(nrm_[v]);
         if (!uv_.empty()) out.uvs.push_back(uv_[v]);
         if (!col_.empty()) out.colors.push_back(col_[v]);
-        result.vertex_error.push_back(radius[v] > 0 || moved_[v] ? reported(radius[v]) : 0.0f);
+        result.vertex_error.push_back(radius_[v] > 0 || moved_[v] ? reported(radius_[v]) : 0.0f);
         output_locked_.push_back(user_locked[v]);
       }
       v = remap[v];

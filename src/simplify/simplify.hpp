@@ -1,14 +1,13 @@
 // Quadric edge-collapse simplification (Garland & Heckbert 97, attributes after Hoppe 99) with a tracked,
-// conservative two-sided error bound. Two per-vertex radii are kept, each an invariant that alone bounds
-// both one-sided Hausdorff distances; the result reports the one with the smaller maximum:
-// - interpolated (the vertex-radius construction of the LOD book digest, §7.5): the natural mapping of a
-//   vertex merge moves every surface point by at most the barycentric interpolation of its triangle's vertex
-//   displacements, so r_new = max(r_a + |a - x|, r_b + |b - x|);
-// - face maximum: every point of a face is within the largest radius of its corners of the input, and every
-//   input point within that of some face. A collapse gives x the largest radius over the changed faces plus
-//   a bound on the local two-sided distance between the changed faces before and after: the largest
-//   displacement, or on a locally flat, fold-free closed star the spread of its vertices along the mean
-//   normal (0 on planar regions, about curvature x length^2 on smooth ones).
+// conservative two-sided error bound: a radius r_v per vertex such that every point p of the simplified
+// surface is within the barycentric interpolation r(p) of its triangle's radii of the input, and every input
+// point within r(p) of some p (the LOD book digest, §7.5). A collapse gives x the smaller of two radii, each
+// of which keeps that invariant through a mapping of the changed faces onto the new ones:
+// - natural mapping (vertex merge, linear per face): r_x = max(r_a + |a - x|, r_b + |b - x|);
+// - vertical mapping, on a fold-free closed star (projection onto the plane of its mean normal): points over
+//   the same place correspond, so r_x is the least value with r_new(p') >= height gap + r_old(p), checked at
+//   the vertices of the common refinement of both fans (0 growth on planar regions, about curvature x
+//   length^2 on smooth ones instead of about length/2).
 //
 // Operator: edge collapse a -> b with optimal placement x (full edge) or x = b (half edge). Framework: passes
 // of independent collapses in quadric-cost order (a lazy queue: each pass re-evaluates, in parallel, the
@@ -57,7 +56,8 @@ struct Options {
   // Record the collapse sequence in Result::collapses (used by progressive meshes).
   bool record_collapses = false;
   // When edge collapse stops short of target_triangles, continue with vertex clustering (cluster.hpp), which
-  // may change topology; Result::error_bound then covers both steps.
+  // may change topology; Result::error_bound then covers both steps and vertex_error holds in the
+  // face-maximum form of cluster.hpp.
   bool allow_topology_change = false;
   // Called now and then with the fraction of the requested reduction done (0..1).
   std::function<void(float)> progress;
@@ -76,8 +76,8 @@ struct Collapse {
 struct Result {
   Mesh mesh;                 // the simplified mesh; unused vertices are removed
   double error_bound = 0.0;  // >= symmetric Hausdorff distance(result, input), model units
-  // Per output vertex (model units): every point of an output face is within the largest vertex_error of its
-  // corners of the input, and every input point within that of some output face.
+  // Per output vertex (model units): r_v; every point of an output face is within the barycentric
+  // interpolation of its corners' vertex_error of the input, and every input point within that of some point.
   std::vector<float> vertex_error;
   size_t input_triangles = 0;
   bool target_reached = true;        // false when no valid collapse was left before the triangle target
