@@ -776,12 +776,12 @@ class Simplifier {
     for (const Corners& c : old_)
       for (int i = 0; i < 3; ++i) {
         const int j = (i + 1) % 3;
-        if (!c.moving[i] && !c.moving[j]) continue;
+        if (!c.moving[i]) continue;  // each edge at a or b leaves a or b in exactly one of its faces
         const glm::dvec2 o0 = c.y[i], od = c.y[j] - c.y[i];
         for (const Corners& e : old_) {
           if (e.dies) continue;
           for (int k = 0; k < 3; ++k) {
-            if (e.moving[k]) continue;  // the new edge from x to the ring vertex k
+            if (!e.moving[(k + 2) % 3]) continue;  // the new edge x -> ring vertex k (once per spoke)
             const glm::dvec2 nd = e.y[k] - yx;
             double den = cross2(nd, od);
             if (std::abs(den) < 1e-30) continue;
