@@ -243,8 +243,11 @@ ClusterDag build_cluster_dag(const Mesh& mesh, const DagOptions& options) {
       triangles[i] = uint32_t(dag.clusters[active[i]].mesh.triangle_count());
       centroids[i] = dag.clusters[active[i]].sphere.center;
     }
+    // Near the root, one group takes everything: no border left to lock, so small meshes with thin parts
+    // still reach a small root.
+    const bool last = active_triangles <= 2 * options.group_clusters * options.max_cluster_triangles;
     std::vector<std::vector<uint32_t>> groups =
-        partition_clusters(triangles, centroids, edges, options.group_clusters);
+        partition_clusters(triangles, centroids, edges, last ? active.size() : options.group_clusters);
     edges = {};
     for (auto& g : groups)
       for (uint32_t& i : g) i = active[i];  // active position -> cluster id

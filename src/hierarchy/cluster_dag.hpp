@@ -4,8 +4,9 @@
 //   each level: the active clusters are partitioned into groups of about 8 neighbours (METIS on the cluster
 //   adjacency weighted by shared edges, group_partition.hpp); each group is merged and simplified to about
 //   half with its outer border locked (positions shared with clusters of other groups, and the mesh's own
-//   open boundary), and the result is split into new clusters; repeat until the active clusters hold at most
-//   `root_triangles` triangles (or one cluster), or no group of a level can be reduced.
+//   open boundary), and the result is split into new clusters (once the active clusters hold at most
+//   2 * group_clusters * max_cluster_triangles triangles, they form one group); repeat until the active
+//   clusters hold at most `root_triangles` triangles (or one cluster), or no group of a level can be reduced.
 // Fallbacks (recorded per group, like meshoptimizer's clusterlod): a group that does not reach 85 % of its
 // triangles with attributes is retried positions-only with a looser normal limit; a group still above 85 %
 // is abandoned and its clusters stay active for the next level (with other neighbours); the build always
