@@ -72,6 +72,7 @@ struct HttpSource::Impl {
       stream.reset();
       fail("cannot connect: " + ec.message());
     }
+    stream->socket().set_option(tcp::no_delay(true), ec);  // one write per request; no Nagle delay
     ++connections;
   }
 

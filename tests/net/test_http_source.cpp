@@ -1,5 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <boost/asio.hpp>
+#include <chrono>
 #include <fstream>
 #include <thread>
 
@@ -47,6 +53,60 @@ std::string error_of(const std::function<void()>& f) {
   }
   return "";
 }
+
+// A real nginx on loopback serving `root`: configuration in a temporary prefix, no daemon, a free port.
+class Nginx {
+ public:
+  explicit Nginx(const std::filesystem::path& root) {
+    namespace asio = boost::asio;
+    {
+      asio::io_context io;
+      asio::ip::tcp::acceptor probe(io, {asio::ip::make_address("127.0.0.1"), 0});
+      port_ = probe.local_endpoint().port();
+    }
+    const auto prefix = test::temp_dir();
+    std::filesystem::create_directories(prefix / "logs");
+    const auto conf = prefix / "nginx.conf";
+    std::ofstream(conf) << "daemon off;\nmaster_process off;\nworker_processes 1;\npid "
+                        << (prefix / "nginx.pid").string() << ";\nerror_log "
+                        << (prefix / "logs/error.log").string()
+                        << ";\nevents { worker_connections 64; }\nhttp {\n  access_log off;\n"
+                        << "  client_body_temp_path " << prefix.string() << "/body;\n"
+                        << "  proxy_temp_path " << prefix.string() << "/proxy;\n"
+                        << "  fastcgi_temp_path " << prefix.string() << "/fastcgi;\n"
+                        << "  uwsgi_temp_path " << prefix.string() << "/uwsgi;\n"
+                        << "  scgi_temp_path " << prefix.string() << "/scgi;\n"
+                        << "  server { listen 127.0.0.1:" << port_ << "; root " << root.string()
+                        << "; }\n}\n";
+    const std::string p = prefix.string(), c = conf.string(), e = (prefix / "logs/error.log").string();
+    const char* argv[] = {"/usr/sbin/nginx", "-p", p.c_str(), "-c", c.c_str(), "-e", e.c_str(), nullptr};
+    if (posix_spawn(&pid_, argv[0], nullptr, nullptr, const_cast<char**>(argv), environ) != 0) {
+      pid_ = -1;
+      ADD_FAILURE() << "cannot start /usr/sbin/nginx (scripts/setup installs nginx-light)";
+      return;
+    }
+    for (int i = 0; i < 200; ++i) {  // up to 10 s for it to listen
+      asio::io_context io;
+      asio::ip::tcp::socket s(io);
+      boost::system::error_code ec;
+      s.connect({asio::ip::make_address("127.0.0.1"), port_}, ec);
+      if (!ec) return;
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    ADD_FAILURE() << "nginx did not listen on port " << port_;
+  }
+  ~Nginx() {
+    if (pid_ <= 0) return;
+    kill(pid_, SIGTERM);
+    int status = 0;
+    waitpid(pid_, &status, 0);
+  }
+  uint16_t port() const { return port_; }
+
+ private:
+  pid_t pid_ = -1;
+  uint16_t port_ = 0;
+};
 
 }  // namespace
 
@@ -134,4 +194,27 @@ TEST(HttpSource, ClearErrorsForBadUrlsAndMissingFiles) {
   // Nothing listening: a connect error naming the URL (port 1 is privileged and unused here).
   EXPECT_NE(error_of([] { HttpSource s("http://127.0.0.1:1/x.lods"); }).find("cannot connect"),
             std::string::npos);
+}
+
+TEST(HttpSource, ReadsAPackageFromARealNginxAndDetectsAChange) {
+  auto root = test::temp_dir();
+  auto file = root / "city.lods";
+  auto written = write_package(file, 30, 3);
+  Nginx nginx(root);
+  const std::string url = "http://127.0.0.1:" + std::to_string(nginx.port()) + "/city.lods";
+  auto source = std::make_shared<HttpSource>(url);
+  EXPECT_EQ(source->size(), written.bytes);
+  EXPECT_FALSE(source->etag().empty());  // nginx's own tag (mtime-size), used for If-Range
+  package::PackageReader remote(source);
+  package::PackageReader local = package::PackageReader::open(file);
+  for (uint32_t id = 0; id < remote.node_count(); ++id)
+    EXPECT_EQ(remote.node(id).offset, local.node(id).offset);
+  for (uint32_t p = 0; p < written.pages; ++p) EXPECT_EQ(remote.read_page(p), local.read_page(p));
+  remote.verify();
+  EXPECT_EQ(source->connections(), 1u);
+  // The file replaced under nginx (other content, other size): the next read is refused.
+  write_package(file, 31, 4);
+  std::vector<uint8_t> b(100);
+  const std::string err = error_of([&] { source->read(64, b); });
+  EXPECT_EQ(err.rfind(url + ": changed on the server", 0), 0u) << "[" << err << "]";
 }
