@@ -484,31 +484,35 @@ class Simplifier {
       }
     });
     std::fill(touched_.begin(), touched_.end(), 0);
-    order_.clear();
-    for (const Candidate& c : slots_)
-      if (c.a != kNone && std::isfinite(c.cost)) order_.push_back(c);
     // Pass limit (as meshoptimizer does): most collapses remove two triangles; allow costs up to 1.5x the one
     // that would reach the target, so that the pass order stays close to the greedy order. Only candidates
-    // under the limit are sorted.
+    // under the limit are sorted. When none of them is valid, the pass is run again without the limit (else
+    // it would stop short of the target with valid collapses left).
     auto cheaper = [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; };
-    size_t goal = (alive_triangles_ - target + 1) / 2;
-    float limit = std::numeric_limits<float>::infinity();
-    if (goal < order_.size()) {
-      std::nth_element(order_.begin(), order_.begin() + goal, order_.end(), cheaper);
-      limit = 1.5f * order_[goal].cost;
-      order_.erase(
-          std::partition(order_.begin(), order_.end(), [&](const Candidate& c) { return c.cost <= limit; }),
-          order_.end());
-    }
-    radix_sort_by_cost();
     size_t collapsed = 0;
-    for (const Candidate& c : order_) {
-      if (c.cost > limit || alive_triangles_ <= target) break;
-      Plan p;
-      if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
-      if (p.a2 != kNone && (touched_[p.a2] || touched_[p.b2])) continue;
-      place(p);
-      if (try_collapse(p)) ++collapsed;
+    for (bool limited : {true, false}) {
+      order_.clear();
+      for (const Candidate& c : slots_)
+        if (c.a != kNone && std::isfinite(c.cost)) order_.push_back(c);
+      size_t goal = (alive_triangles_ - target + 1) / 2;
+      float limit = std::numeric_limits<float>::infinity();
+      if (limited && goal < order_.size()) {
+        std::nth_element(order_.begin(), order_.begin() + goal, order_.end(), cheaper);
+        limit = 1.5f * order_[goal].cost;
+        order_.erase(
+            std::partition(order_.begin(), order_.end(), [&](const Candidate& c) { return c.cost <= limit; }),
+            order_.end());
+      }
+      radix_sort_by_cost();
+      for (const Candidate& c : order_) {
+        if (c.cost > limit || alive_triangles_ <= target) break;
+        Plan p;
+        if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
+        if (p.a2 != kNone && (touched_[p.a2] || touched_[p.b2])) continue;
+        place(p);
+        if (try_collapse(p)) ++collapsed;
+      }
+      if (collapsed > 0 || std::isinf(limit)) break;
     }
     return collapsed;
   }
