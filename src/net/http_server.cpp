@@ -9,11 +9,13 @@
 #include <boost/asio.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
 #include <cstdio>
 #include <thread>
 
 #include "core/error.hpp"
 #include "net/http_range.hpp"
+#include "net/push_session.hpp"
 
 namespace lodstream {
 
@@ -69,6 +71,10 @@ struct HttpServer::Impl {
     for (;;) {
       tcp::socket socket(asio::make_strand(io));
       co_await acceptor.async_accept(socket, use_awaitable);
+      // Answers are written whole; Nagle would hold a short final segment back by up to an ACK delay (~40
+      // ms).
+      boost::system::error_code ec;
+      socket.set_option(tcp::no_delay(true), ec);
       asio::co_spawn(socket.get_executor(), session(std::move(socket)), asio::detached);
     }
   }
@@ -92,6 +98,10 @@ struct HttpServer::Impl {
         co_await http::async_read(stream, buffer, parser, use_awaitable);
         ++requests;
         const auto& request = parser.get();
+        if (beast::websocket::is_upgrade(request)) {
+          reason = co_await push(std::move(stream), request);
+          break;
+        }
         sent += co_await respond(stream, request);
         if (!request.keep_alive()) {
           reason = "done";
@@ -101,10 +111,36 @@ struct HttpServer::Impl {
     } catch (const boost::system::system_error& e) {
       if (e.code() != http::error::end_of_stream) reason = e.code().message();
     }
-    stream.socket().shutdown(tcp::socket::shutdown_send, ec);
+    if (stream.socket().is_open()) stream.socket().shutdown(tcp::socket::shutdown_send, ec);
     std::fprintf(stderr, "serve: connection %llu from %s closed after %llu requests, %llu bytes (%s)\n",
                  (unsigned long long)id, peer.c_str(), (unsigned long long)requests, (unsigned long long)sent,
                  reason.c_str());
+  }
+
+  // Turns the connection into a push session for the package named by the target ("/NAME"); returns how the
+  // session ended.
+  awaitable<std::string> push(beast::tcp_stream stream, const http::request<http::empty_body>& request) {
+    std::string_view target(request.target().data(), request.target().size());
+    const OpenFile* file = nullptr;
+    for (const auto& f : files)
+      if (f.served.package && target.size() > 1 && target[0] == '/' &&
+          std::string(target.substr(1)) + ".lods" == f.served.name)
+        file = &f;
+    if (!file) {
+      http::response<http::string_body> response{http::status::not_found, request.version()};
+      response.body() = "no push stream at this address\n";
+      response.prepare_payload();
+      co_await http::async_write(stream, response, use_awaitable);
+      co_return "no push stream at " + std::string(target);
+    }
+    stream.expires_never();  // the WebSocket keeps its own time-outs
+    WebSocket ws(std::move(stream));
+    co_await ws.async_accept(request, use_awaitable);
+    std::string name(target.substr(1));
+    PushStats stats = co_await run_push_session(ws, name, file->served.package);
+    co_return "push session for " + name + ": " + std::to_string(stats.pages_sent) + " pages, " +
+        std::to_string(stats.bytes_sent) + " bytes, " + std::to_string(stats.views) + " views, " +
+        std::to_string(stats.acks) + " acks; " + stats.end_reason;
   }
 
   // Answers one request; returns the body bytes sent.

@@ -3,7 +3,8 @@
 // package's content hash), If-Range and If-None-Match, GET and HEAD, HTTP/1.1 keep-alive. Bodies are streamed
 // from the file in 64 KB pieces, so memory per client stays small whatever is asked for. One line is logged
 // to standard error per connection start and end. Hostile requests (huge headers, bodies, bad methods or
-// paths) get an HTTP error or a closed connection, never affecting other connections.
+// paths) get an HTTP error or a closed connection, never affecting other connections. A WebSocket upgrade at
+// "/NAME" starts a push session for that package (net/push_session.hpp).
 #pragma once
 
 #include <cstdint>
@@ -12,12 +13,16 @@
 #include <string>
 #include <vector>
 
+#include "package/reader.hpp"
+
 namespace lodstream {
 
 struct ServedFile {
   std::string name;            // served at "/" + name (for example "city.lods")
   std::filesystem::path path;  // the file; it must not change while served
   std::string etag;            // strong entity tag without quotes (the package's content hash in hex)
+  // When set, the package's push stream is a WebSocket at "/" + name without ".lods" (net/push_session.hpp).
+  std::shared_ptr<const package::PackageReader> package;
 };
 
 class HttpServer {

@@ -78,7 +78,7 @@ glm::vec3 unit(Reader& r, const char* field) {
 
 void encode_payload(Writer& w, const Hello& m) {
   w.put_string(m.package);
-  w.bytes.insert(w.bytes.end(), m.cached_hash.begin(), m.cached_hash.end());
+  w.put(m.cached_hash.low), w.put(m.cached_hash.high);
   w.put(uint32_t(m.held.size()));
   for (const auto& run : m.held) w.put(run.first), w.put(run.count);
   w.put(m.cache_budget_bytes), w.put(m.triangles_per_frame), w.put(m.viewport_width),
@@ -93,7 +93,7 @@ void encode_payload(Writer& w, const Ack& m) {
   w.put(m.last_sequence), w.put(m.bytes_received), w.put(m.client_time_s), w.put(m.echo_server_time_s);
 }
 void encode_payload(Writer& w, const Welcome& m) {
-  w.bytes.insert(w.bytes.end(), m.package_hash.begin(), m.package_hash.end());
+  w.put(m.package_hash.low), w.put(m.package_hash.high);
   w.put(m.package_bytes), w.put(m.page_count);
 }
 void encode_payload(Writer& w, const Page& m) {
@@ -110,7 +110,8 @@ constexpr Type type_of(const Message& m) {
 
 ContentHash hash(Reader& r, const char* field) {
   ContentHash h;
-  for (auto& b : h) b = r.get<uint8_t>(field);
+  h.low = r.get<uint64_t>(field);
+  h.high = r.get<uint64_t>(field);
   return h;
 }
 

@@ -6,7 +6,6 @@
 // size).
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <span>
@@ -15,6 +14,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "package/format.hpp"
 
 namespace lodstream::wire {
 
@@ -28,7 +28,7 @@ class WireError : public Error {
   using Error::Error;
 };
 
-using ContentHash = std::array<uint8_t, 16>;  // all zero: none
+using ContentHash = package::ContentHash;  // the package content hash; all zero: none
 
 // Page ids as sorted, non-overlapping half-open runs [first, first + count): what a client holds.
 struct PageRun {

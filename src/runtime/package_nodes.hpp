@@ -6,7 +6,7 @@
 
 #include "package/reader.hpp"
 #include "runtime/cache.hpp"
-#include "runtime/cut.hpp"
+#include "schedule/cut.hpp"
 
 namespace lodstream::runtime {
 

@@ -11,10 +11,24 @@
 #pragma once
 
 #include "package/index.hpp"
-#include "runtime/cut.hpp"
-#include "runtime/screen_error.hpp"
+#include "schedule/cut.hpp"
+#include "schedule/screen_error.hpp"
 
 namespace lodstream::runtime {
+
+// Selection lives in the schedule module (the server's scheduler runs it too); the client names it here.
+using schedule::Cut;
+using schedule::DrawnNode;
+using schedule::in_frustum;
+using schedule::max_scale;
+using schedule::NodeSource;
+using schedule::object_sphere;
+using schedule::ObjectState;
+using schedule::screen_error;
+using schedule::select_cut;
+using schedule::to_world;
+using schedule::View;
+using schedule::WorldSphere;
 
 // Screen area in pixels, clipped to the viewport, of the projection of `sphere`. The projection is taken as
 // the disc of radius f r / sqrt(D^2 - r^2) around the projected centre (f = focal_pixels(), D = distance of

@@ -14,36 +14,12 @@
 #include "net/http_source.hpp"
 #include "package/reader.hpp"
 #include "package/writer.hpp"
+#include "raw_package.hpp"
 #include "support/run.hpp"
 
 using namespace lodstream;
 
 namespace {
-
-// A package of raw-encoded nodes (no codec needed): `nodes` nodes of distinct bytes over several pages.
-package::WrittenPackage write_package(const std::filesystem::path& file, uint32_t nodes, uint8_t salt) {
-  package::WriterOptions options;
-  options.page_bytes = 4096;
-  options.nodes_per_index_page = 16;
-  package::PackageWriter writer(file, options);
-  std::vector<package::NodeRecord> records(nodes);
-  for (uint32_t i = 0; i < nodes; ++i) {
-    std::vector<uint8_t> bytes(1000 + i * 13);
-    for (size_t k = 0; k < bytes.size(); ++k) bytes[k] = uint8_t(k * 31 + i * 7 + salt);
-    writer.add_node(i, bytes);
-    writer.end_group();
-    records[i].encoding = package::NodeEncoding::raw;
-  }
-  package::PackageScene scene;
-  package::Representation rep;
-  rep.bounds.add(glm::vec3(0.0f));
-  rep.bounds.add(glm::vec3(1.0f));
-  rep.roots = {0};
-  scene.materials = {package::PackageMaterial{}};
-  scene.representations = {rep};
-  scene.objects = {{"o", glm::mat4(1.0f), 0}};
-  return writer.finish(scene, records, 4);
-}
 
 std::string error_of(const std::function<void()>& f) {
   try {
@@ -112,7 +88,7 @@ class Nginx {
 
 TEST(HttpSource, PackageReaderOverHttpReadsWhatTheFileHolds) {
   auto file = test::temp_dir() / "scene.lods";
-  auto written = write_package(file, 40, 0);
+  auto written = test::write_raw_package(file, 40, 0);
   ASSERT_GT(written.pages, 3u);
   ASSERT_GT(written.index_pages, 1u);
   HttpServer server("127.0.0.1", 0, {{"scene.lods", file, written.content_hash.hex()}});
@@ -155,8 +131,8 @@ TEST(HttpSource, PackageReaderOverHttpReadsWhatTheFileHolds) {
 TEST(HttpSource, DetectsAPackageChangedOnTheServerAndReconnects) {
   auto dir = test::temp_dir();
   auto first = dir / "v1.lods", second = dir / "v2.lods";
-  auto w1 = write_package(first, 20, 0);
-  auto w2 = write_package(second, 20, 1);
+  auto w1 = test::write_raw_package(first, 20, 0);
+  auto w2 = test::write_raw_package(second, 20, 1);
   ASSERT_NE(w1.content_hash, w2.content_hash);
   auto server = std::make_unique<HttpServer>(
       "127.0.0.1", 0, std::vector<ServedFile>{{"s.lods", first, w1.content_hash.hex()}});
@@ -183,7 +159,7 @@ TEST(HttpSource, DetectsAPackageChangedOnTheServerAndReconnects) {
 
 TEST(HttpSource, ClearErrorsForBadUrlsAndMissingFiles) {
   auto file = test::temp_dir() / "x.lods";
-  auto written = write_package(file, 4, 0);
+  auto written = test::write_raw_package(file, 4, 0);
   HttpServer server("127.0.0.1", 0, {{"x.lods", file, written.content_hash.hex()}});
   const std::string base = "http://127.0.0.1:" + std::to_string(server.port());
   EXPECT_EQ(error_of([] { HttpSource s("ftp://host/x.lods"); }), "ftp://host/x.lods: not an http:// URL");
@@ -199,7 +175,7 @@ TEST(HttpSource, ClearErrorsForBadUrlsAndMissingFiles) {
 TEST(HttpSource, ReadsAPackageFromARealNginxAndDetectsAChange) {
   auto root = test::temp_dir();
   auto file = root / "city.lods";
-  auto written = write_package(file, 30, 3);
+  auto written = test::write_raw_package(file, 30, 3);
   Nginx nginx(root);
   const std::string url = "http://127.0.0.1:" + std::to_string(nginx.port()) + "/city.lods";
   auto source = std::make_shared<HttpSource>(url);
@@ -213,7 +189,7 @@ TEST(HttpSource, ReadsAPackageFromARealNginxAndDetectsAChange) {
   remote.verify();
   EXPECT_EQ(source->connections(), 1u);
   // The file replaced under nginx (other content, other size): the next read is refused.
-  write_package(file, 31, 4);
+  test::write_raw_package(file, 31, 4);
   std::vector<uint8_t> b(100);
   const std::string err = error_of([&] { source->read(64, b); });
   EXPECT_EQ(err.rfind(url + ": changed on the server", 0), 0u) << "[" << err << "]";

@@ -12,7 +12,7 @@ namespace {
 Hello hello() {
   Hello h;
   h.package = "city";
-  h.cached_hash[3] = 7;
+  h.cached_hash.low = 7;
   h.held = {{0, 10}, {12, 1}, {100, 50}};
   h.cache_budget_bytes = 256u << 20;
   h.triangles_per_frame = 2'000'000;
@@ -35,7 +35,7 @@ TEST(Wire, EveryMessageRoundTrips) {
   std::vector<Message> messages{hello(),
                                 view(),
                                 Ack{42, 123456, 3.25, 3.0},
-                                Welcome{{1, 2, 3}, 99999, 17},
+                                Welcome{{1, 2}, 99999, 17},
                                 Page{5, 9, 1.5, {1, 2, 3, 4, 5}},
                                 Bye{"cache full"}};
   for (const auto& m : messages) {

@@ -4,7 +4,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "runtime/cache.hpp"
-#include "synthetic_dag.hpp"
+#include "support/synthetic_dag.hpp"
 
 using namespace lodstream;
 using namespace lodstream::runtime;

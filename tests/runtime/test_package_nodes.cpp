@@ -4,7 +4,7 @@
 #include "package/writer.hpp"
 #include "runtime/package_nodes.hpp"
 #include "support/run.hpp"
-#include "synthetic_dag.hpp"
+#include "support/synthetic_dag.hpp"
 
 using namespace lodstream;
 using namespace lodstream::runtime;

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "package/index.hpp"
-#include "runtime/cut.hpp"
+#include "schedule/cut.hpp"
 
 namespace lodstream::test {
 
@@ -96,7 +96,7 @@ struct SyntheticDag {
 };
 
 // NodeSource over the DAG with a set of unavailable and unknown nodes.
-struct TestNodes : runtime::NodeSource {
+struct TestNodes : schedule::NodeSource {
   const SyntheticDag& dag;
   std::unordered_set<uint32_t> unavailable, unknown;
   explicit TestNodes(const SyntheticDag& d) : dag(d) {}

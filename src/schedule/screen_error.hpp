@@ -15,7 +15,7 @@
 #include "core/bounds.hpp"
 #include "core/camera.hpp"
 
-namespace lodstream::runtime {
+namespace lodstream::schedule {
 
 struct WorldSphere {
   glm::dvec3 center{0.0};
@@ -50,4 +50,4 @@ double screen_error(double world_error, const WorldSphere& sphere, const View& v
 // the eye; no far plane). Conservative: a sphere near a frustum corner may be kept though outside.
 bool in_frustum(const WorldSphere& sphere, const View& view);
 
-}  // namespace lodstream::runtime
+}  // namespace lodstream::schedule

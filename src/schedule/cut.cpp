@@ -1,4 +1,4 @@
-#include "runtime/cut.hpp"
+#include "schedule/cut.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include "core/error.hpp"
 
-namespace lodstream::runtime {
+namespace lodstream::schedule {
 
 namespace {
 
@@ -208,4 +208,4 @@ Cut select_cut(const package::PackageScene& scene, const NodeSource& nodes, cons
   return cut;
 }
 
-}  // namespace lodstream::runtime
+}  // namespace lodstream::schedule

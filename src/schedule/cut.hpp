@@ -34,9 +34,9 @@
 #include <vector>
 
 #include "package/index.hpp"
-#include "runtime/screen_error.hpp"
+#include "schedule/screen_error.hpp"
 
-namespace lodstream::runtime {
+namespace lodstream::schedule {
 
 // Node records and availability as the client knows them.
 class NodeSource {
@@ -93,4 +93,4 @@ WorldSphere object_sphere(const package::PackageScene& scene, uint32_t object);
 Cut select_cut(const package::PackageScene& scene, const NodeSource& nodes, const View& view,
                const CutOptions& options);
 
-}  // namespace lodstream::runtime
+}  // namespace lodstream::schedule

@@ -3,11 +3,11 @@
 #include <fstream>
 
 #include "core/error.hpp"
-#include "runtime/camera_path.hpp"
+#include "schedule/camera_path.hpp"
 #include "support/run.hpp"
 
 using namespace lodstream;
-using runtime::parse_camera_path;
+using schedule::parse_camera_path;
 
 namespace {
 
@@ -64,12 +64,12 @@ TEST(CameraPath, VelocityIsTheSegmentSlopeAndZeroOutside) {
 TEST(CameraPath, DefaultsAndLoadFromFile) {
   auto file = test::temp_dir() / "path.json";
   std::ofstream(file) << R"({"keyframes": [{"t": 1, "eye": [1, 2, 3], "target": [0, 0, 0]}]})";
-  auto path = runtime::load_camera_path(file);
+  auto path = schedule::load_camera_path(file);
   EXPECT_FLOAT_EQ(path.fov_y_degrees(), 60.0f);
   EXPECT_EQ(path.width(), 1280);
   EXPECT_EQ(path.pose_at(0.0).eye, glm::vec3(1, 2, 3));
   EXPECT_EQ(path.pose_at(0.0).up, glm::vec3(0, 1, 0));
-  EXPECT_THROW(runtime::load_camera_path(test::temp_dir() / "missing.json"), Error);
+  EXPECT_THROW(schedule::load_camera_path(test::temp_dir() / "missing.json"), Error);
 }
 
 TEST(CameraPath, RejectsBadInputWithOneLineNamingFileAndKeyframe) {

@@ -1,9 +1,9 @@
-#include "runtime/screen_error.hpp"
+#include "schedule/screen_error.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-namespace lodstream::runtime {
+namespace lodstream::schedule {
 
 View View::of(const Camera& camera) {
   View v;
@@ -49,4 +49,4 @@ bool in_frustum(const WorldSphere& sphere, const View& view) {
   return (z * view.tan_half_x - std::abs(x)) / nx >= -r && (z * view.tan_half_y - std::abs(y)) / ny >= -r;
 }
 
-}  // namespace lodstream::runtime
+}  // namespace lodstream::schedule

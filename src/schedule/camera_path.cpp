@@ -1,4 +1,4 @@
-#include "runtime/camera_path.hpp"
+#include "schedule/camera_path.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include "core/error.hpp"
 
-namespace lodstream::runtime {
+namespace lodstream::schedule {
 
 CameraPath::CameraPath(float fov_y_degrees, int width, int height, std::vector<Keyframe> keyframes,
                        const std::string& where)
@@ -123,4 +123,4 @@ CameraPath load_camera_path(const std::filesystem::path& file) {
   return parse_camera_path(text.str(), file.string());
 }
 
-}  // namespace lodstream::runtime
+}  // namespace lodstream::schedule

@@ -3,10 +3,10 @@
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "runtime/screen_error.hpp"
+#include "schedule/screen_error.hpp"
 
 using namespace lodstream;
-using namespace lodstream::runtime;
+using namespace lodstream::schedule;
 
 namespace {
 Camera camera_at_origin_looking_down_z() {

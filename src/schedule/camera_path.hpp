@@ -11,7 +11,7 @@
 
 #include "core/camera.hpp"
 
-namespace lodstream::runtime {
+namespace lodstream::schedule {
 
 struct Keyframe {
   double t = 0.0;  // seconds
@@ -63,4 +63,4 @@ CameraPath load_camera_path(const std::filesystem::path& file);
 // The same from JSON text; `where` names the source.
 CameraPath parse_camera_path(const std::string& text, const std::string& where);
 
-}  // namespace lodstream::runtime
+}  // namespace lodstream::schedule

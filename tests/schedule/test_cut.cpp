@@ -3,11 +3,11 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/error.hpp"
-#include "runtime/cut.hpp"
-#include "synthetic_dag.hpp"
+#include "schedule/cut.hpp"
+#include "support/synthetic_dag.hpp"
 
 using namespace lodstream;
-using namespace lodstream::runtime;
+using namespace lodstream::schedule;
 using test::SyntheticDag;
 using test::TestNodes;
 
