@@ -137,7 +137,7 @@ struct HttpServer::Impl {
     WebSocket ws(std::move(stream));
     co_await ws.async_accept(request, use_awaitable);
     std::string name(target.substr(1));
-    PushStats stats = co_await run_push_session(ws, name, file->served.package);
+    PushStats stats = co_await run_push_session(ws, name, *file->served.package);
     co_return "push session for " + name + ": " + std::to_string(stats.pages_sent) + " pages, " +
         std::to_string(stats.bytes_sent) + " bytes, " + std::to_string(stats.views) + " views, " +
         std::to_string(stats.acks) + " acks; " + stats.end_reason;

@@ -44,8 +44,9 @@ std::vector<uint8_t> to_vector(const beast::flat_buffer& b) {
   return {data, data + b.size()};
 }
 
-awaitable<void> send(WebSocket& ws, const wire::Message& m) {
-  auto frame = wire::encode(m);
+// GCC 12 destroys some temporaries of a full-expression that contains co_await twice, so every message is
+// encoded into a named frame first and no co_await expression here creates an object with a destructor.
+awaitable<void> write_frame(WebSocket& ws, const std::vector<uint8_t>& frame) {
   co_await ws.async_write(asio::buffer(frame), use_awaitable);
 }
 
@@ -84,8 +85,7 @@ awaitable<void> read_loop(WebSocket& ws, std::shared_ptr<Shared> s) {
 }  // namespace
 
 awaitable<PushStats> run_push_session(WebSocket& ws, const std::string& name,
-                                      std::shared_ptr<const package::PackageReader> package,
-                                      PushOptions options) {
+                                      const package::PackageReader& package, PushOptions options) {
   auto ex = co_await asio::this_coro::executor;
   auto s = std::make_shared<Shared>(ex);
   ws.binary(true);
@@ -107,14 +107,15 @@ awaitable<PushStats> run_push_session(WebSocket& ws, const std::string& name,
     if (hello->package != name)
       throw wire::WireError("wire: hello names package '" + hello->package + "' on the stream of '" + name +
                             "'");
-    const auto& pages = package->root().pages;
-    const auto hash = package->header().content_hash;
+    const auto& pages = package.root().pages;
+    const auto hash = package.header().content_hash;
     std::vector<bool> held(pages.size(), false);
     if (hello->cached_hash == hash)
       for (const auto& run : hello->held)
         for (uint64_t p = run.first; p < uint64_t(run.first) + run.count && p < pages.size(); ++p)
           held[p] = true;
-    co_await send(ws, wire::Welcome{hash, package->source().size(), uint32_t(pages.size())});
+    const auto welcome = wire::encode(wire::Welcome{hash, package.source().size(), uint32_t(pages.size())});
+    co_await write_frame(ws, welcome);
 
     asio::co_spawn(ex, read_loop(ws, s), asio::detached);
     reader_started = true;
@@ -137,10 +138,11 @@ awaitable<PushStats> run_push_session(WebSocket& ws, const std::string& name,
       }
       if (!s->reader_running) break;
       bytes.resize(pages[page].size);
-      package->source().read(pages[page].offset, bytes);
+      package.source().read(pages[page].offset, bytes);
       ++sequence;
       s->estimator.on_send(sequence, bytes.size(), s->now());
-      co_await send(ws, wire::Page{sequence, page, s->now(), bytes});
+      const auto frame = wire::encode(wire::Page{sequence, page, s->now(), bytes});
+      co_await write_frame(ws, frame);
       ++s->stats.pages_sent;
       s->stats.bytes_sent += bytes.size();
     }
@@ -163,7 +165,8 @@ awaitable<PushStats> run_push_session(WebSocket& ws, const std::string& name,
   if (s->protocol_error) {
     // Tell the client why, then close; errors here only mean the client is already gone.
     try {
-      co_await send(ws, wire::Bye{s->stats.end_reason.substr(0, 1000)});
+      const auto bye = wire::encode(wire::Bye{s->stats.end_reason.substr(0, 1000)});
+      co_await write_frame(ws, bye);
       co_await ws.async_close(beast::websocket::close_code::policy_error, use_awaitable);
     } catch (const boost::system::system_error&) {
     }

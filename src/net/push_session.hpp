@@ -39,10 +39,11 @@ struct PushStats {
 
 using WebSocket = boost::beast::websocket::stream<boost::beast::tcp_stream>;
 
-// Runs one session on an accepted WebSocket for package `name`, read through `package`. Returns when the
-// session ends (everything sent and acknowledged and the client closed, or an error); never throws.
+// Runs one session on an accepted WebSocket for package `name`, read through `package` (both must outlive
+// the session). Returns when the session ends (everything sent and acknowledged and the client closed, or an
+// error); never throws.
 boost::asio::awaitable<PushStats> run_push_session(WebSocket& ws, const std::string& name,
-                                                   std::shared_ptr<const package::PackageReader> package,
+                                                   const package::PackageReader& package,
                                                    PushOptions options = {});
 
 }  // namespace lodstream
