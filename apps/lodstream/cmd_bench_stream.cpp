@@ -291,7 +291,7 @@ void plot(const fs::path& out, const std::vector<Policy>& policies, double windo
   plot_one("bytes", "MB received", "$2/1e6", "steps lw 2");
   const fs::path gp = out / ".plots.gp";
   write_text(gp, script);
-  const std::string cmd = "gnuplot '" + gp.string() + "' 2>&1";
+  const std::string cmd = "gnuplot '" + gp.string() + "' 1>&2";  // stdout is --json's
   if (std::system(cmd.c_str()) != 0) {
     std::fprintf(
         stderr, "lodstream: warning: gnuplot failed or is missing (apt-get install gnuplot-nox): no plots\n");

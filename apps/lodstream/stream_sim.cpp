@@ -202,7 +202,8 @@ SimResult simulate(const PackageFacts& package, const schedule::CameraPath& path
                                  ? std::max<size_t>(1, size_t(std::lround(options.sample_every_s * fps)))
                                  : 0;
   auto sampled = [&](size_t k) {
-    if (sample_step && k % sample_step == 0) return true;
+    if (!sample_step) return false;
+    if (k % sample_step == 0) return true;
     for (double s : {1.0, 2.0, 5.0})
       if (k == size_t(std::lround(s * fps))) return true;
     return false;
@@ -274,7 +275,7 @@ SimResult simulate(const PackageFacts& package, const schedule::CameraPath& path
     row.frame_ms = options.cost.frame_ms(row.triangles);
     result.frames.push_back(row);
     const bool last = k == last_frame || (k >= path_frames && row.converged);
-    if (sampled(k) || last) result.samples.push_back({k, camera, cut.drawn});
+    if (sampled(k) || (last && sample_step)) result.samples.push_back({k, camera, cut.drawn});
     if (last) break;
   }
   return result;

@@ -82,8 +82,8 @@ struct SimOptions {
   double fps = 30.0;
   double settle_s = 10.0;
   CostModel cost;
-  // Frames whose cut is kept for image metrics: every `sample_every_s` (0: none), plus those at 1, 2 and 5 s
-  // and the last one.
+  // Frames whose cut is kept for image metrics: every `sample_every_s`, plus those at 1, 2 and 5 s and the
+  // last one; none when 0.
   double sample_every_s = 1.0;
 };
 
