@@ -36,6 +36,7 @@ struct OpenFile {
   ServedFile served;
   int fd = -1;
   uint64_t size = 0;
+  std::shared_ptr<const PushPackage> push;  // its push stream's package (records loaded once), or null
 };
 
 // A response body: literal strings and ranges of the file, sent in order.
@@ -44,6 +45,14 @@ struct Piece {
   ByteRange range{};
   bool is_range = false;
 };
+
+// The log line of an ended push session.
+std::string session_line(const std::string& name, const PushStats& stats) {
+  const PushCounters& c = stats.counters;
+  return "push session for " + name + ": " + std::to_string(c.pages_sent) + " pages (" +
+         std::to_string(c.index_pages_sent) + " index), " + std::to_string(c.bytes_sent) + " bytes, " +
+         std::to_string(c.views) + " views, " + std::to_string(c.acks) + " acks; " + stats.end_reason;
+}
 
 }  // namespace
 
@@ -123,7 +132,7 @@ struct HttpServer::Impl {
     std::string_view target(request.target().data(), request.target().size());
     const OpenFile* file = nullptr;
     for (const auto& f : files)
-      if (f.served.package && target.size() > 1 && target[0] == '/' &&
+      if (f.push && target.size() > 1 && target[0] == '/' &&
           std::string(target.substr(1)) + ".lods" == f.served.name)
         file = &f;
     if (!file) {
@@ -136,11 +145,10 @@ struct HttpServer::Impl {
     stream.expires_never();  // the WebSocket keeps its own time-outs
     WebSocket ws(std::move(stream));
     co_await ws.async_accept(request, use_awaitable);
-    std::string name(target.substr(1));
-    PushStats stats = co_await run_push_session(ws, name, file->served.package);
-    co_return "push session for " + name + ": " + std::to_string(stats.pages_sent) + " pages, " +
-        std::to_string(stats.bytes_sent) + " bytes, " + std::to_string(stats.views) + " views, " +
-        std::to_string(stats.acks) + " acks; " + stats.end_reason;
+    const PushOptions
+        options;  // (constructed outside the co_await: GCC 12 rejects its default argument there)
+    PushStats stats = co_await run_push_session(ws, file->push, options);
+    co_return session_line(file->push->name, stats);
   }
 
   // Answers one request; returns the body bytes sent.
@@ -228,11 +236,18 @@ struct HttpServer::Impl {
 HttpServer::HttpServer(const std::string& host, uint16_t port, std::vector<ServedFile> files, int threads)
     : impl_(std::make_unique<Impl>()) {
   for (auto& served : files) {
-    OpenFile f{std::move(served)};
+    OpenFile f{std::move(served), -1, 0, nullptr};
     f.fd = open(f.served.path.c_str(), O_RDONLY | O_CLOEXEC);
     if (f.fd < 0) throw Error(f.served.path.string() + ": cannot open for serving");
     f.size = std::filesystem::file_size(f.served.path);
     impl_->files.push_back(std::move(f));
+    OpenFile& added = impl_->files.back();
+    if (added.served.package) {
+      const std::string& name = added.served.name;
+      const bool lods = name.size() > 5 && name.ends_with(".lods");
+      added.push = std::make_shared<const PushPackage>(lods ? name.substr(0, name.size() - 5) : name,
+                                                       added.served.package);
+    }
   }
   boost::system::error_code ec;
   auto address = asio::ip::make_address(host, ec);

@@ -8,10 +8,10 @@
 #include <boost/beast/core.hpp>
 #include <boost/beast/websocket.hpp>
 #include <chrono>
+#include <cmath>
 #include <vector>
 
 #include "net/wire.hpp"
-#include "schedule/link_estimator.hpp"
 
 namespace lodstream {
 
@@ -23,18 +23,18 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-// State shared by the session's writer (this coroutine) and its reader (a second coroutine on the same
+// State shared by the session's writer (run_push_session) and its reader (a second coroutine on the same
 // strand).
 struct Shared {
-  explicit Shared(const asio::any_io_executor& ex) : wake(ex), reader_done(ex) {}
-  schedule::LinkEstimator estimator;
-  asio::steady_timer wake;         // cancelled when an acknowledgement arrives or the reader stops
+  Shared(const asio::any_io_executor& ex, std::shared_ptr<const PushPackage> package,
+         const PushProtocolOptions& options)
+      : protocol(std::move(package), options), wake(ex), reader_done(ex) {}
+  PushProtocol protocol;
+  asio::steady_timer wake;         // cancelled when a message arrives or the reader stops
   asio::steady_timer reader_done;  // cancelled when the reader coroutine has returned
   bool reader_running = true;
   std::string reader_error;     // why the reader stopped ("" : the client closed)
   bool protocol_error = false;  // the session ends for a reason the client should be told (a Bye)
-  uint32_t acked = 0;
-  PushStats stats;
   Clock::time_point start = Clock::now();
   double now() const { return std::chrono::duration<double>(Clock::now() - start).count(); }
 };
@@ -44,6 +44,12 @@ std::vector<uint8_t> to_vector(const beast::flat_buffer& b) {
   return {data, data + b.size()};
 }
 
+awaitable<wire::Message> receive(WebSocket& ws) {
+  beast::flat_buffer buffer;
+  co_await ws.async_read(buffer, use_awaitable);
+  co_return wire::decode(to_vector(buffer));
+}
+
 awaitable<void> send(WebSocket& ws, const wire::Message& m) {
   auto frame = wire::encode(m);
   co_await ws.async_write(asio::buffer(frame), use_awaitable);
@@ -51,25 +57,12 @@ awaitable<void> send(WebSocket& ws, const wire::Message& m) {
 
 awaitable<void> read_loop(WebSocket& ws, std::shared_ptr<Shared> s) {
   try {
-    for (;;) {
-      beast::flat_buffer buffer;
-      co_await ws.async_read(buffer, use_awaitable);
-      wire::Message m = wire::decode(to_vector(buffer));
-      if (auto* ack = std::get_if<wire::Ack>(&m)) {
-        s->estimator.on_ack(ack->last_sequence, s->now());
-        s->acked = std::max(s->acked, ack->last_sequence);
-        ++s->stats.acks;
-        s->wake.cancel();
-      } else if (std::holds_alternative<wire::ViewUpdate>(m)) {
-        ++s->stats.views;
-      } else if (auto* bye = std::get_if<wire::Bye>(&m)) {
-        s->reader_error = "client said bye: " + bye->reason;
-        break;
-      } else {
-        throw wire::WireError(std::string("wire: unexpected ") + wire::type_name(m) +
-                              " message from a client");
-      }
+    while (!s->protocol.ended()) {
+      wire::Message m = co_await receive(ws);
+      s->protocol.on_message(m, s->now());
+      s->wake.cancel();
     }
+    s->reader_error = "client said bye";
   } catch (const wire::WireError& e) {
     s->reader_error = e.what();
     s->protocol_error = true;
@@ -81,89 +74,75 @@ awaitable<void> read_loop(WebSocket& ws, std::shared_ptr<Shared> s) {
   s->reader_done.cancel();
 }
 
+// Waits until the reader wakes the writer or `deadline_s` (session time; +inf: no deadline) passes.
+awaitable<void> wait(Shared& s, double deadline_s) {
+  if (std::isinf(deadline_s))
+    s.wake.expires_at(Clock::time_point::max());
+  else
+    s.wake.expires_at(s.start + std::chrono::duration_cast<Clock::duration>(
+                                    std::chrono::duration<double>(deadline_s + 1e-3)));
+  boost::system::error_code ec;
+  co_await s.wake.async_wait(asio::redirect_error(use_awaitable, ec));
+}
+
 }  // namespace
 
-awaitable<PushStats> run_push_session(WebSocket& ws, const std::string& name,
-                                      std::shared_ptr<const package::PackageReader> package,
+awaitable<PushStats> run_push_session(WebSocket& ws, std::shared_ptr<const PushPackage> package,
                                       PushOptions options) {
   auto ex = co_await asio::this_coro::executor;
-  auto s = std::make_shared<Shared>(ex);
+  const package::PackageReader& reader = *package->reader;
+  auto s = std::make_shared<Shared>(ex, package, options.protocol);
   ws.binary(true);
   ws.read_message_max(wire::kMaxMessageBytes);
   ws.set_option(beast::websocket::stream_base::timeout::suggested(beast::role_type::server));
-  // Keep the kernel's unsent queue short so that what waits to be sent waits here, where it can be
+  // Keep the kernel's unsent queue short so that what waits to be sent waits in the protocol, where it can be
   // re-ordered.
   int lowat = options.notsent_lowat_bytes;
   setsockopt(beast::get_lowest_layer(ws).socket().native_handle(), IPPROTO_TCP, TCP_NOTSENT_LOWAT, &lowat,
              sizeof lowat);
   bool reader_started = false;
+  PushStats stats;
   try {
-    beast::flat_buffer buffer;
-    co_await ws.async_read(buffer, use_awaitable);
-    wire::Message first = wire::decode(to_vector(buffer));
-    auto* hello = std::get_if<wire::Hello>(&first);
-    if (!hello)
-      throw wire::WireError(std::string("wire: expected hello first, got ") + wire::type_name(first));
-    if (hello->package != name)
-      throw wire::WireError("wire: hello names package '" + hello->package + "' on the stream of '" + name +
-                            "'");
-    const auto& pages = package->root().pages;
-    const auto hash = package->header().content_hash;
-    std::vector<bool> held(pages.size(), false);
-    if (hello->cached_hash == hash)
-      for (const auto& run : hello->held)
-        for (uint64_t p = run.first; p < uint64_t(run.first) + run.count && p < pages.size(); ++p)
-          held[p] = true;
-    co_await send(ws, wire::Welcome{hash, package->source().size(), uint32_t(pages.size())});
-
+    wire::Message first = co_await receive(ws);
+    const std::optional<wire::Message> welcome = s->protocol.on_message(first, s->now());
+    if (welcome) co_await send(ws, *welcome);
     asio::co_spawn(ex, read_loop(ws, s), asio::detached);
     reader_started = true;
-    uint32_t sequence = 0;
     std::vector<uint8_t> bytes;
-    for (uint32_t page = 0; page < pages.size() && s->reader_running; ++page) {
-      if (held[page]) continue;
-      // Wait while the window is full; a client that acknowledges nothing for ack_timeout_s is dropped.
-      while (s->reader_running &&
-             double(s->estimator.bytes_in_flight()) >=
-                 std::max(2.0 * s->estimator.bdp_bytes(), double(options.min_window_bytes))) {
-        uint32_t acked_before = s->acked;
-        s->wake.expires_after(std::chrono::duration_cast<Clock::duration>(
-            std::chrono::duration<double>(options.ack_timeout_s)));
-        boost::system::error_code ec;
-        co_await s->wake.async_wait(asio::redirect_error(use_awaitable, ec));
-        if (!ec && s->acked == acked_before)
-          throw wire::WireError("the client acknowledged nothing for " +
-                                std::to_string(options.ack_timeout_s) + " s");
+    while (s->reader_running) {
+      while (s->reader_running) {
+        auto next = s->protocol.next_page(s->now());
+        if (!next) break;
+        const auto& root = reader.root();
+        const package::Range& range = next->page.kind == schedule::PageKind::data
+                                          ? root.pages[next->page.id]
+                                          : root.index_pages[next->page.id].range;
+        bytes.resize(range.size);
+        reader.source().read(range.offset, bytes);
+        // A named message, not a temporary in the co_await expression (GCC 12 destroys those twice).
+        const wire::Message page =
+            wire::Page{next->sequence, next->page.id, next->server_time_s, bytes, next->page.kind};
+        co_await send(ws, page);
       }
       if (!s->reader_running) break;
-      bytes.resize(pages[page].size);
-      package->source().read(pages[page].offset, bytes);
-      ++sequence;
-      s->estimator.on_send(sequence, bytes.size(), s->now());
-      co_await send(ws, wire::Page{sequence, page, s->now(), bytes});
-      ++s->stats.pages_sent;
-      s->stats.bytes_sent += bytes.size();
+      // Nothing to send now: wait for an acknowledgement, a view or the acknowledgement deadline.
+      co_await wait(*s, s->protocol.ack_deadline());
+      s->protocol.check_timeout(s->now());
     }
-    // Everything is sent: the session stays open (the client keeps sending views) until the client closes.
-    if (s->reader_running) {
-      s->reader_done.expires_at(Clock::time_point::max());
-      boost::system::error_code ec;
-      co_await s->reader_done.async_wait(asio::redirect_error(use_awaitable, ec));
-    }
-    s->stats.end_reason = s->reader_error.empty() ? "closed by client" : s->reader_error;
-    if (!s->reader_running && !s->reader_error.empty()) s->stats.end_reason = s->reader_error;
+    stats.end_reason = s->reader_error.empty() ? "closed by client" : s->reader_error;
   } catch (const wire::WireError& e) {
-    s->stats.end_reason = e.what();
+    stats.end_reason = e.what();
     s->protocol_error = true;
   } catch (const Error& e) {  // the package could not be read
-    s->stats.end_reason = e.what();
+    stats.end_reason = e.what();
   } catch (const boost::system::system_error& e) {
-    s->stats.end_reason = e.code().message();
+    stats.end_reason = e.code().message();
   }
   if (s->protocol_error) {
     // Tell the client why, then close; errors here only mean the client is already gone.
     try {
-      co_await send(ws, wire::Bye{s->stats.end_reason.substr(0, 1000)});
+      const wire::Message bye = wire::Bye{stats.end_reason.substr(0, 1000)};
+      co_await send(ws, bye);
       co_await ws.async_close(beast::websocket::close_code::policy_error, use_awaitable);
     } catch (const boost::system::system_error&) {
     }
@@ -174,7 +153,8 @@ awaitable<PushStats> run_push_session(WebSocket& ws, const std::string& name,
     s->reader_done.expires_at(Clock::time_point::max());
     co_await s->reader_done.async_wait(asio::redirect_error(use_awaitable, ec));
   }
-  co_return s->stats;
+  stats.counters = s->protocol.counters();
+  co_return stats;
 }
 
 }  // namespace lodstream

@@ -76,11 +76,31 @@ glm::vec3 unit(Reader& r, const char* field) {
   return v;
 }
 
+void put_runs(Writer& w, const std::vector<PageRun>& runs) {
+  w.put(uint32_t(runs.size()));
+  for (const auto& run : runs) w.put(run.first), w.put(run.count);
+}
+
+std::vector<PageRun> get_runs(Reader& r) {
+  uint32_t count = r.get<uint32_t>("held run count");
+  if (count > r.remaining() / 8) r.fail("held run count", "is larger than the message");
+  std::vector<PageRun> runs(count);
+  uint64_t end = 0;
+  for (auto& run : runs) {
+    run.first = r.get<uint32_t>("held run");
+    run.count = r.get<uint32_t>("held run");
+    if (run.count == 0 || run.first < end || uint64_t(run.first) + run.count > UINT32_MAX)
+      r.fail("held runs", "must be non-empty, sorted and non-overlapping");
+    end = uint64_t(run.first) + run.count;
+  }
+  return runs;
+}
+
 void encode_payload(Writer& w, const Hello& m) {
   w.put_string(m.package);
   w.put(m.cached_hash.low), w.put(m.cached_hash.high);
-  w.put(uint32_t(m.held.size()));
-  for (const auto& run : m.held) w.put(run.first), w.put(run.count);
+  put_runs(w, m.held);
+  put_runs(w, m.held_index);
   w.put(m.cache_budget_bytes), w.put(m.triangles_per_frame), w.put(m.viewport_width),
       w.put(m.viewport_height);
 }
@@ -97,7 +117,7 @@ void encode_payload(Writer& w, const Welcome& m) {
   w.put(m.package_bytes), w.put(m.page_count);
 }
 void encode_payload(Writer& w, const Page& m) {
-  w.put(m.sequence), w.put(m.page_id), w.put(m.server_time_s);
+  w.put(m.sequence), w.put(m.page_id), w.put(uint8_t(m.kind)), w.put(m.server_time_s);
   w.put_bytes(m.bytes);
 }
 void encode_payload(Writer& w, const Bye& m) {
@@ -161,17 +181,8 @@ Message decode(std::span<const uint8_t> frame) {
       m.package = r.string("package", kMaxNameBytes);
       if (m.package.empty()) r.fail("package", "is empty");
       m.cached_hash = hash(r, "cached hash");
-      uint32_t runs = r.get<uint32_t>("held run count");
-      if (runs > r.remaining() / 8) r.fail("held run count", "is larger than the message");
-      m.held.resize(runs);
-      uint64_t end = 0;
-      for (auto& run : m.held) {
-        run.first = r.get<uint32_t>("held run");
-        run.count = r.get<uint32_t>("held run");
-        if (run.count == 0 || run.first < end || uint64_t(run.first) + run.count > UINT32_MAX)
-          r.fail("held runs", "must be non-empty, sorted and non-overlapping");
-        end = uint64_t(run.first) + run.count;
-      }
+      m.held = get_runs(r);
+      m.held_index = get_runs(r);
       m.cache_budget_bytes = r.get<uint64_t>("cache budget");
       m.triangles_per_frame = r.get<uint32_t>("triangles per frame");
       viewport(r, m.viewport_width, m.viewport_height);
@@ -215,6 +226,9 @@ Message decode(std::span<const uint8_t> frame) {
       Page m;
       m.sequence = r.get<uint32_t>("sequence");
       m.page_id = r.get<uint32_t>("page id");
+      const uint8_t kind = r.get<uint8_t>("page kind");
+      if (kind > uint8_t(PageKind::index)) r.fail("page kind", std::to_string(kind) + " is unknown");
+      m.kind = PageKind(kind);
       m.server_time_s = r.get<double>("server time");
       auto bytes = r.bytes("bytes", kMaxMessageBytes);
       m.bytes.assign(bytes.begin(), bytes.end());

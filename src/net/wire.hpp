@@ -15,10 +15,12 @@
 
 #include "core/error.hpp"
 #include "package/format.hpp"
+#include "schedule/page_scheduler.hpp"
 
 namespace lodstream::wire {
 
-constexpr uint16_t kProtocolVersion = 1;
+// 2: pages carry their kind (data or index page), hello lists held index pages too.
+constexpr uint16_t kProtocolVersion = 2;
 constexpr size_t kHeaderBytes = 8;
 constexpr size_t kMaxMessageBytes = 16u << 20;  // larger frames are refused before they are read
 constexpr size_t kMaxNameBytes = 256;
@@ -28,7 +30,8 @@ class WireError : public Error {
   using Error::Error;
 };
 
-using ContentHash = package::ContentHash;  // the package content hash; all zero: none
+using ContentHash = package::ContentHash;
+using PageKind = schedule::PageKind;  // the package content hash; all zero: none
 
 // Page ids as sorted, non-overlapping half-open runs [first, first + count): what a client holds.
 struct PageRun {
@@ -40,7 +43,8 @@ struct PageRun {
 struct Hello {
   std::string package;        // NAME, as in ws://HOST:PORT/NAME
   ContentHash cached_hash{};  // content hash of the package the held pages came from (zero: nothing cached)
-  std::vector<PageRun> held;  // pages the client already holds (ignored when the hash differs)
+  std::vector<PageRun> held;  // data pages the client already holds (ignored when the hash differs)
+  std::vector<PageRun> held_index;  // index pages it holds (likewise)
   uint64_t cache_budget_bytes = 0;
   uint32_t triangles_per_frame = 0;
   uint16_t viewport_width = 0, viewport_height = 0;
@@ -74,12 +78,14 @@ struct Welcome {
   uint32_t page_count = 0;
 };
 
-// Server → client: one page's bytes, exactly as stored in the package at its offset.
+// Server → client: one page's bytes, exactly as stored in the package at its offset: a data page
+// (root().pages[page_id]) or an index page of node records (root().index_pages[page_id]).
 struct Page {
   uint32_t sequence = 0;  // 1, 2, 3… within the session
   uint32_t page_id = 0;
   double server_time_s = 0;
   std::vector<uint8_t> bytes;
+  PageKind kind = PageKind::data;
 };
 
 // Either direction: the session ends, with the reason.

@@ -12,6 +12,7 @@
 
 #include "package/index.hpp"
 #include "schedule/cut.hpp"
+#include "schedule/screen_area.hpp"
 #include "schedule/screen_error.hpp"
 
 namespace lodstream::runtime {
@@ -24,18 +25,12 @@ using schedule::max_scale;
 using schedule::NodeSource;
 using schedule::object_sphere;
 using schedule::ObjectState;
+using schedule::projected_area;
 using schedule::screen_error;
 using schedule::select_cut;
 using schedule::to_world;
 using schedule::View;
 using schedule::WorldSphere;
-
-// Screen area in pixels, clipped to the viewport, of the projection of `sphere`. The projection is taken as
-// the disc of radius f r / sqrt(D^2 - r^2) around the projected centre (f = focal_pixels(), D = distance of
-// the centre; exact on the view axis, slightly small off it, where the true outline is an ellipse); clipping
-// integrates the disc's chords over 256 strips (relative error below 1e-3). A sphere that reaches the plane
-// through the eye covers the whole viewport (width * height); one entirely behind it covers 0.
-double projected_area(const WorldSphere& sphere, const View& view);
 
 struct FrameQuality {
   double pixel_error_max = 0.0;   // 0 when nothing is drawn

@@ -5,6 +5,7 @@
 #include <boost/beast/websocket.hpp>
 #include <map>
 #include <memory>
+#include <set>
 
 #include "net/http_server.hpp"
 #include "net/wire.hpp"
@@ -36,18 +37,23 @@ class PushClient {
     auto data = static_cast<const uint8_t*>(buffer.data().data());
     return wire::decode(std::span<const uint8_t>(data, buffer.size()));
   }
-  // Receives pages until `count` have arrived, acknowledging each; returns them by page id.
+  // Receives pages until `count` data pages have arrived, acknowledging each page (index pages too); returns
+  // the data pages by page id.
   std::map<uint32_t, std::vector<uint8_t>> receive_pages(size_t count) {
     std::map<uint32_t, std::vector<uint8_t>> pages;
-    for (size_t i = 0; i < count; ++i) {
+    for (size_t i = 0; pages.size() < count; ++i) {
       wire::Message m = receive();
       auto* page = std::get_if<wire::Page>(&m);
       if (!page) {
         ADD_FAILURE() << "expected a page, got " << wire::type_name(m);
         break;
       }
-      EXPECT_TRUE(pages.emplace(page->page_id, page->bytes).second) << "page " << page->page_id << " twice";
       received_ += page->bytes.size();
+      if (page->kind == wire::PageKind::index) {
+        EXPECT_TRUE(index_pages_.insert(page->page_id).second) << "index page " << page->page_id << " twice";
+      } else {
+        EXPECT_TRUE(pages.emplace(page->page_id, page->bytes).second) << "page " << page->page_id << " twice";
+      }
       send(wire::Ack{page->sequence, received_, 0.001 * double(i), page->server_time_s});
     }
     return pages;
@@ -58,6 +64,7 @@ class PushClient {
   asio::io_context io_;
   beast::websocket::stream<tcp::socket> ws_;
   uint64_t received_ = 0;
+  std::set<uint32_t> index_pages_;
 };
 
 struct PushServer {
@@ -142,7 +149,8 @@ TEST(PushSession, AMalformedMessageEndsOnlyThatSession) {
   auto first = good.receive_pages(2);
 
   PushClient bad(s.server.port(), "/scene");
-  bad.send_raw({1, 0, 99, 0, 0, 0, 0, 0});  // version 1, unknown type 99, empty payload
+  bad.send_raw(
+      {wire::kProtocolVersion, 0, 99, 0, 0, 0, 0, 0});  // this version, unknown type 99, empty payload
   wire::Message m = bad.receive();
   auto* bye = std::get_if<wire::Bye>(&m);
   ASSERT_NE(bye, nullptr) << wire::type_name(m);

@@ -1,0 +1,117 @@
+// The server side of a push session as a state machine without I/O (DESIGN.md, Serving and the wire; seed 003
+// §5): it is fed the client's messages with the time they arrived and asked what to send now. The WebSocket
+// session (push_session.hpp) is a thin shell around it; the benchmark's simulator drives the same class on a
+// virtual clock over a simulated link.
+//
+// Protocol: the first message must be a Hello naming this package (answered by a Welcome); then ViewUpdates,
+// Acks and finally a Bye or the end of the connection. Pages go out in the scheduler's order
+// (schedule/page_scheduler.hpp): benefit per byte over the views predicted from the latest ViewUpdate
+// (schedule/motion.hpp, horizons measured from the present plus half a round trip, the time a page sent now
+// takes to arrive), index pages before the data pages that need their records; never a page the client holds
+// (Hello's held runs, when its hash is this package's) or was sent. At most `window_bdp` estimated
+// bandwidth-delay products (schedule::LinkEstimator, fed by the acknowledgements) are in flight, at least
+// `min_window_bytes`; so what waits, waits here, where a new view re-orders it: the plan is dropped on every
+// ViewUpdate and re-made from the new prediction. When the scheduler has nothing to send (no view yet, or
+// every predicted view's ideal cut sent) and `fill_when_idle` is set, the rest of the package follows in file
+// order (index pages first), up to the client's cache budget: seed 003's "coffee break".
+//
+// Time is the caller's (seconds on any monotonic clock). Cost: a plan is one PageScheduler::next (one cut per
+// predicted view) for a window's worth of pages.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "net/wire.hpp"
+#include "package/reader.hpp"
+#include "schedule/link_estimator.hpp"
+#include "schedule/motion.hpp"
+#include "schedule/package_records.hpp"
+#include "schedule/page_scheduler.hpp"
+
+namespace lodstream {
+
+// What every session of one package shares: the reader and all node records. Immutable.
+struct PushPackage {
+  std::string name;  // NAME of ws://HOST:PORT/NAME
+  std::shared_ptr<const package::PackageReader> reader;
+  schedule::PackageRecords records;
+
+  // Loads the records (one read of every index page). Throws lodstream::Error when the index is unreadable.
+  PushPackage(std::string name, std::shared_ptr<const package::PackageReader> reader);
+};
+
+struct PushProtocolOptions {
+  double ack_timeout_s = 30.0;          // pages in flight and nothing acknowledged for this long: the end
+  size_t min_window_bytes = 64 * 1024;  // in flight at least this much (before the first estimates)
+  double window_bdp = 2.0;              // in flight at most this many bandwidth-delay products
+  double tau = 1.0;                     // target pixel error of the client's cut
+  schedule::PredictionHorizons horizons;
+  bool fill_when_idle = true;
+};
+
+// A page the shell is to send now: read `page`'s stored bytes and send them as wire::Page{sequence,
+// page.id, server_time_s, bytes, page.kind}.
+struct PageToSend {
+  uint32_t sequence = 0;
+  schedule::PageRef page;
+  double server_time_s = 0.0;
+};
+
+struct PushCounters {
+  uint64_t pages_sent = 0, bytes_sent = 0, index_pages_sent = 0, views = 0, acks = 0;
+};
+
+class PushProtocol {
+ public:
+  PushProtocol(std::shared_ptr<const PushPackage> package, PushProtocolOptions options = {});
+
+  // Feeds one message from the client, received at `now_s`. Returns what to send at once (the Welcome
+  // answering the Hello), if anything. A Bye from the client ends the session (ended() is true). Throws
+  // wire::WireError on a protocol violation (no Hello first, another package's name, a second Hello, a
+  // message only servers send); the shell then sends a Bye with the reason and closes.
+  std::optional<wire::Message> on_message(const wire::Message& message, double now_s);
+
+  // The next page to send at `now_s`, or nothing while the window is full or nothing is left to send. The
+  // page counts as sent (in flight, never sent again) from this call on.
+  std::optional<PageToSend> next_page(double now_s);
+
+  // The time by which an acknowledgement must arrive (pages in flight, nothing acknowledged since
+  // ack_timeout_s before it), or +inf. check_timeout throws wire::WireError once `now_s` is past it.
+  double ack_deadline() const;
+  void check_timeout(double now_s) const;
+
+  bool welcomed() const { return welcomed_; }
+  bool ended() const { return ended_; }  // the client said Bye
+  // Every page of the package has been sent or was held (nothing will ever be sent again).
+  bool everything_sent() const { return remaining_ == 0; }
+  const PushCounters& counters() const { return counters_; }
+  const schedule::LinkEstimator& link() const { return link_; }
+  const schedule::PageScheduler& scheduler() const { return scheduler_; }
+  uint64_t window_bytes() const;
+
+ private:
+  void plan(double now_s, uint64_t bytes);
+  void mark_sent(const schedule::PageRef& page);
+
+  std::shared_ptr<const PushPackage> package_;
+  PushProtocolOptions options_;
+  schedule::PageScheduler scheduler_;
+  schedule::LinkEstimator link_;
+  bool welcomed_ = false, ended_ = false;
+  uint64_t cache_budget_ = 0, held_bytes_ = 0;
+  size_t remaining_ = 0;  // pages neither held nor sent
+  std::optional<schedule::ViewSample> view_;
+  double view_received_s_ = 0.0;
+  std::deque<schedule::PageRef> planned_;
+  bool plan_converged_ = false;  // the scheduler had nothing for the current views
+  uint32_t sequence_ = 0, acked_ = 0;
+  double last_progress_s_ = 0.0;  // last ack (or first send after an idle period)
+  PushCounters counters_;
+};
+
+}  // namespace lodstream

@@ -1,0 +1,236 @@
+#include "schedule/page_scheduler.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <tuple>
+
+#include "core/error.hpp"
+#include "schedule/screen_area.hpp"
+
+namespace lodstream::schedule {
+
+namespace {
+
+// Availability as the scheduler plans it: a node is available when its data page is held or chosen.
+class Planned final : public NodeSource {
+ public:
+  Planned(const NodeSource& records, const std::vector<bool>& data) : records_(records), data_(data) {}
+  const package::NodeRecord* record(uint32_t id) const override { return records_.record(id); }
+  bool available(uint32_t id) const override {
+    const package::NodeRecord* r = records_.record(id);
+    return r && data_[r->page];
+  }
+
+ private:
+  const NodeSource& records_;
+  const std::vector<bool>& data_;
+};
+
+// min(1, tau / e): a node's accuracy in the benefit ratio (DESIGN.md, Measuring quality).
+double accuracy(double tau, double error_px) {
+  return error_px > 0.0 ? std::min(1.0, tau / error_px) : 1.0;
+}
+
+// A group exchange of some view's ideal cut: P (empty for an object's roots) is replaced by G.
+struct Exchange {
+  uint32_t object = 0;
+  std::vector<uint32_t> p, g;
+  double benefit = 0.0;    // summed over the weighted views
+  double secondary = 0.0;  // the largest weighted e_P: the order among exchanges of no benefit
+  bool done = false;
+};
+
+// The pages chosen so far (held ones included) and the order they were chosen in.
+struct Plan {
+  const PageScheduler& scheduler;
+  const NodeSource& records;
+  std::vector<bool> data, index;
+  std::vector<PageRef> order;
+  uint64_t bytes = 0;
+  const ScheduleOptions& options;
+
+  bool full() const {
+    return !order.empty() && (bytes >= options.max_bytes || order.size() >= options.max_pages);
+  }
+  void add(PageKind kind, uint32_t id) {
+    std::vector<bool>& set = kind == PageKind::data ? data : index;
+    if (set[id] || full()) return;
+    set[id] = true;
+    order.push_back(scheduler.page(kind, id));
+    bytes += order.back().bytes;
+  }
+  void add_record(uint32_t node) {
+    const uint32_t page = scheduler.index_page_of(node);
+    if (page != package::kNone) add(PageKind::index, page);
+  }
+  // Bytes the exchange still needs: index pages of P's and G's records, data pages of G.
+  uint64_t cost(const Exchange& e) const {
+    std::vector<PageRef> pages;
+    auto need = [&](PageKind kind, uint32_t id) {
+      const std::vector<bool>& set = kind == PageKind::data ? data : index;
+      if (!set[id] && std::find(pages.begin(), pages.end(), PageRef{kind, id, 0}) == pages.end())
+        pages.push_back({kind, id, 0});
+    };
+    for (const auto* ids : {&e.p, &e.g})
+      for (uint32_t n : *ids)
+        if (uint32_t page = scheduler.index_page_of(n); page != package::kNone) need(PageKind::index, page);
+    for (uint32_t n : e.g) need(PageKind::data, records.record(n)->page);
+    uint64_t sum = 0;
+    for (const PageRef& p : pages) sum += scheduler.page(p.kind, p.id).bytes;
+    return sum;
+  }
+  bool eligible(const Exchange& e) const {
+    return std::all_of(e.p.begin(), e.p.end(), [&](uint32_t n) { return data[records.record(n)->page]; });
+  }
+};
+
+double view_area(const package::PackageScene& scene, const Cut& cut, const View& view) {
+  double total = 0.0;
+  for (uint32_t o = 0; o < scene.objects.size(); ++o)
+    if (cut.objects[o] != ObjectState::culled) total += projected_area(object_sphere(scene, o), view);
+  return total > 0.0 ? total : 1.0;
+}
+
+// Adds view `v`'s exchanges (from its cut's missing nodes) to `exchanges`; unknown records go to
+// `unknown` (node -> the largest weighted error their arrival may remove).
+void collect(const package::PackageScene& scene, const NodeSource& records, const Cut& cut,
+             const WeightedView& v, double tau, std::map<uint64_t, Exchange>& exchanges,
+             std::map<uint32_t, double>& unknown) {
+  const double total = view_area(scene, cut, v.view);
+  std::vector<uint64_t> seen;
+  for (const MissingNode& m : cut.missing) {
+    if (!m.record_known) {
+      double& priority = unknown[m.node];
+      priority = std::max(priority, v.weight * std::min(m.parent_error_px, 1e300));
+      continue;
+    }
+    const package::NodeRecord& r = *records.record(m.node);
+    const package::ObjectRecord& object = scene.objects[m.object];
+    const double scale = max_scale(object.transform);
+    const bool root = r.parents.empty();
+    const uint64_t key = uint64_t(m.object) << 32 |
+                         (root ? package::kNone : *std::min_element(r.parents.begin(), r.parents.end()));
+    if (std::find(seen.begin(), seen.end(), key) != seen.end()) continue;
+    seen.push_back(key);
+    Exchange e;
+    e.object = m.object;
+    if (root) {
+      e.g = scene.representations[object.representation].roots;
+    } else {
+      e.p = r.parents;
+      std::sort(e.p.begin(), e.p.end());
+      e.g = records.record(e.p[0])->children;
+    }
+    double e_g = 0.0;
+    bool known = true;
+    for (uint32_t n : e.g) {
+      const package::NodeRecord* gr = records.record(n);
+      if (!gr) {
+        known = false;
+        break;
+      }
+      e_g = std::max(e_g, screen_error(double(gr->error) * scale,
+                                       to_world(gr->sphere, object.transform, scale), v.view));
+    }
+    if (!known) continue;  // its unknown records are in `unknown`
+    const double area = root ? projected_area(object_sphere(scene, m.object), v.view)
+                             : projected_area(to_world(r.parent_sphere, object.transform, scale), v.view);
+    const double gain = accuracy(tau, e_g) - (root ? 0.0 : accuracy(tau, m.parent_error_px));
+    auto [it, inserted] = exchanges.try_emplace(key, std::move(e));
+    it->second.benefit += v.weight * area * gain / total;
+    it->second.secondary = std::max(it->second.secondary, v.weight * std::min(m.parent_error_px, 1e300));
+  }
+}
+
+}  // namespace
+
+PageScheduler::PageScheduler(const package::RootIndex& root)
+    : root_(&root), data_held_(root.pages.size(), false), index_held_(root.index_pages.size(), false) {}
+
+void PageScheduler::set_held(PageKind kind, uint32_t id, bool held) {
+  std::vector<bool>& set = kind == PageKind::data ? data_held_ : index_held_;
+  if (id >= set.size())
+    throw Error(std::string(kind == PageKind::data ? "data" : "index") + " page " + std::to_string(id) +
+                " does not exist (" + std::to_string(set.size()) + " pages)");
+  set[id] = held;
+}
+
+bool PageScheduler::held(PageKind kind, uint32_t id) const {
+  const std::vector<bool>& set = kind == PageKind::data ? data_held_ : index_held_;
+  return id < set.size() && set[id];
+}
+
+bool PageScheduler::record_held(uint32_t id) const {
+  const uint32_t page = index_page_of(id);
+  return page == package::kNone || index_held_[page];
+}
+
+PageRef PageScheduler::page(PageKind kind, uint32_t id) const {
+  return {kind, id, kind == PageKind::data ? root_->pages[id].size : root_->index_pages[id].range.size};
+}
+
+uint32_t PageScheduler::index_page_of(uint32_t id) const {
+  if (id < root_->root_nodes.size()) return package::kNone;
+  auto it = std::upper_bound(root_->index_pages.begin(), root_->index_pages.end(), id,
+                             [](uint32_t v, const package::IndexPage& p) { return v < p.first_node; });
+  return uint32_t(it - root_->index_pages.begin()) - 1;
+}
+
+std::vector<PageRef> PageScheduler::next(const package::PackageScene& scene, const NodeSource& records,
+                                         std::span<const WeightedView> views,
+                                         const ScheduleOptions& options) const {
+  Plan plan{*this, records, data_held_, index_held_, {}, 0, options};
+  const Planned planned(records, data_held_);
+  std::map<uint64_t, Exchange> exchanges;
+  std::map<uint32_t, double> unknown;
+  for (const WeightedView& v : views)
+    collect(scene, records, select_cut(scene, planned, v.view, {options.tau}), v, options.tau, exchanges,
+            unknown);
+
+  // Records first: nothing below an unknown record can be ranked.
+  std::vector<std::pair<double, uint32_t>> by_priority;
+  for (auto [node, priority] : unknown) by_priority.push_back({-priority, node});
+  std::sort(by_priority.begin(), by_priority.end());
+  for (auto [priority, node] : by_priority) plan.add_record(node);
+
+  // Greedy by benefit per byte among the eligible exchanges.
+  while (!plan.full()) {
+    Exchange* best = nullptr;
+    double best_ratio = 0.0, best_secondary = 0.0;
+    for (auto& [key, e] : exchanges) {
+      if (e.done || !plan.eligible(e)) continue;
+      const uint64_t cost = plan.cost(e);
+      if (cost == 0) {
+        e.done = true;
+        continue;
+      }
+      const double ratio = e.benefit / double(cost), secondary = e.secondary / double(cost);
+      if (!best || std::tie(ratio, secondary) > std::tie(best_ratio, best_secondary)) {
+        best = &e;
+        best_ratio = ratio;
+        best_secondary = secondary;
+      }
+    }
+    if (!best) break;
+    for (const auto* ids : {&best->p, &best->g})
+      for (uint32_t n : *ids) plan.add_record(n);
+    for (uint32_t n : best->g) plan.add(PageKind::data, records.record(n)->page);
+  }
+  return plan.order;
+}
+
+std::vector<PageRef> PageScheduler::next_sse(const package::PackageScene& scene, const NodeSource& records,
+                                             const View& view, const ScheduleOptions& options) const {
+  Plan plan{*this, records, data_held_, index_held_, {}, 0, options};
+  const Planned planned(records, data_held_);
+  const Cut cut = select_cut(scene, planned, view, {options.tau});
+  for (const MissingNode& m : cut.missing) {
+    plan.add_record(m.node);
+    if (m.record_known) plan.add(PageKind::data, records.record(m.node)->page);
+    if (plan.full()) break;
+  }
+  return plan.order;
+}
+
+}  // namespace lodstream::schedule

@@ -1,0 +1,86 @@
+// The page scheduler (DESIGN.md, Serving and the wire; seed 003 §5, "greedy by benefit per byte"): which
+// pages of a package to transfer next, for a client whose views are known (the current one and predicted
+// ones). The same code runs in the push server (per session), in a pulling client and in the benchmark's
+// simulator; it is pure computation.
+//
+// Unit of benefit: a group exchange (schedule/cut.hpp) of a view's ideal cut whose G is not all held. Its
+// benefit is what drawing G instead of P adds to the view's benefit ratio (DESIGN.md, Measuring quality),
+// summed over the weighted views:
+//   benefit = sum_v w_v * A(P) * (min(1, tau / e_G) - min(1, tau / e_P)) / sum_i A_i,
+// A(P) the clipped screen area of P's bounding sphere (for an object's roots: their own spheres; P is then
+// "nothing drawn", whose accuracy is 0), e_P the projected error of P, e_G the largest projected error of G's
+// members, sum_i A_i the screen area of the objects in view v's frustum. Its cost is the stored bytes of the
+// pages it still needs: the data pages of G's members and the index pages of the records of P and G that are
+// not held. Greedy (seed 003, E11): the exchange with the largest benefit / cost goes first; its pages are
+// then counted as held, which may make further exchanges eligible (an exchange is eligible once all of P is
+// held or scheduled: it refines what will be drawn) or cheaper (pages shared). Exchanges of no benefit (no
+// screen area: outside the viewport) still come, after all others, by e_P per byte, so that a view's ideal
+// cut is always reached. Where the records the scheduler sees are unknown (a pulling client that has not
+// fetched an index page yet), the index page comes first, by the projected error its arrival may remove.
+//
+// Cost: one select_cut per view, then O(E log E + E * picks) over the E exchanges of the views' ideal cuts.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "package/index.hpp"
+#include "schedule/cut.hpp"
+#include "schedule/motion.hpp"
+
+namespace lodstream::schedule {
+
+enum class PageKind : uint8_t { data = 0, index = 1 };
+
+// One page to transfer: a data page (root().pages) or an index page (root().index_pages), with its stored
+// size.
+struct PageRef {
+  PageKind kind = PageKind::data;
+  uint32_t id = 0;
+  uint32_t bytes = 0;
+  bool operator==(const PageRef&) const = default;
+};
+
+struct ScheduleOptions {
+  double tau = 1.0;                 // target pixel error
+  uint64_t max_bytes = UINT64_MAX;  // stop once the pages chosen add up to this much (at least one page)
+  size_t max_pages = SIZE_MAX;
+};
+
+class PageScheduler {
+ public:
+  // The package's page tables (sizes, index-page coverage); `root` must outlive the scheduler.
+  explicit PageScheduler(const package::RootIndex& root);
+
+  // Marks a page held (arrived, or sent and in flight: never scheduled again) or not held (evicted).
+  void set_held(PageKind kind, uint32_t id, bool held = true);
+  bool held(PageKind kind, uint32_t id) const;
+  // Whether node `id`'s record is held by the client (in the root index or in a held index page).
+  bool record_held(uint32_t id) const;
+  // Whether node `id`'s data page is held.
+  bool node_held(const package::NodeRecord& record) const { return held(PageKind::data, record.page); }
+  PageRef page(PageKind kind, uint32_t id) const;
+  // The index page that holds node `id`'s record, or package::kNone for the root index.
+  uint32_t index_page_of(uint32_t id) const;
+
+  // The next pages to transfer in benefit-per-byte order for `views` (their weights as given), never a held
+  // page. `records` gives the node records the scheduler can see (all of them in a server; those arrived in
+  // a pulling client); its available() is not used: availability is this scheduler's held set. Empty when
+  // every view's ideal cut is held.
+  std::vector<PageRef> next(const package::PackageScene& scene, const NodeSource& records,
+                            std::span<const WeightedView> views, const ScheduleOptions& options) const;
+
+  // The `sse-pull` baseline (DESIGN.md, Measuring quality; what Cesium and Nexus clients do): the pages of
+  // the nodes that `view`'s ideal cut misses, in decreasing order of the projected error their arrival
+  // removes (select_cut's `missing` order), the index page first where a record is unknown; no prediction, no
+  // byte cost. Never a held page.
+  std::vector<PageRef> next_sse(const package::PackageScene& scene, const NodeSource& records,
+                                const View& view, const ScheduleOptions& options) const;
+
+ private:
+  const package::RootIndex* root_;
+  std::vector<bool> data_held_, index_held_;
+};
+
+}  // namespace lodstream::schedule
