@@ -37,7 +37,8 @@ namespace {
 namespace fs = std::filesystem;
 
 struct StreamArgs {
-  std::string input, path, link = "bandwidth=10mbit,rtt=80ms", policies = "full,sse-pull,sse-pull-3", out;
+  std::string input, path, link = "bandwidth=10mbit,rtt=80ms",
+                           policies = "full,sse-pull,sse-pull-3,push,oracle", out;
   std::string up = "0,1,0", size = "1280x720";
   double tau = 1.0, settle_s = 10.0, sample_every_s = 1.0;
   bool real = false, json = false;
@@ -449,7 +450,7 @@ const bool registered = register_bench(
        sub.add_flag("--json", args->json, "print summary.json's object");
        sub.footer(
            "Example:\n  lodstream bench stream out/motorBike.lods --path gen:fly --up 0,0,1 --link "
-           "bandwidth=10mbit,rtt=80ms --policy full,sse-pull,sse-pull-3 --out out/stream");
+           "bandwidth=10mbit,rtt=80ms --out out/stream");
        return [args] { return run_bench_stream(*args); };
      }});
 

@@ -13,13 +13,23 @@
 // Policies (DESIGN.md):
 //   full        after the root index, one request for every data page holding a finest-level node (a node
 //   with
-//               no children), in file order; nothing is drawn until all have arrived, then the finest cut
-//               (every finest node of every object in the frustum);
+//               no children), in file order, answered as one stream; nothing is drawn until all have arrived,
+//               then the finest cut (every finest node of every object in the frustum);
 //   sse-pull    each frame, the current cut's missing nodes in its order (decreasing projected error of what
 //               their arrival replaces; an unknown record asks for its index page) give the pages to request,
 //               up to 20 requests outstanding (cesium-native's default);
-//   sse-pull-3  the same with 3 (Nexus's default).
-// `push` and `oracle` need the server-side scheduler (schedule/page_scheduler.hpp), not merged yet.
+//   sse-pull-3  the same with 3 (Nexus's default);
+//   push        a WebSocket (its upgrade costs one request and answer, alongside the root index's request),
+//               then hello, a view update every frame (pose, and velocities measured over the last frame) and
+//               an ack per frame for the pages that arrived; the server is the real sans-I/O protocol core
+//               (net/push_protocol.hpp: PageScheduler over predicted views, window from its link estimator,
+//               file-order fill when idle), fed each message at the time it reaches the server;
+//   oracle      the same PageScheduler with the same horizons and weights, given the path's true future views
+//               (from half an RTT ahead) and the true link: each frame it tops the bytes in flight up to the
+//               push server's window (window_bdp bandwidth-delay products); it starts when a push hello would
+//               reach the server (1.5 RTT) and sends nothing once the views' ideal cuts are sent (no fill).
+// Pushed pages cost their wire::Page message in a WebSocket frame; client messages their encoded size in a
+// masked frame.
 //
 // Frame time is the cost model's prediction (CostModel), so runs are reproducible; frames stay on the fixed
 // 1/fps timeline whatever that prediction is. After the path's last key frame the client keeps the last pose
@@ -28,6 +38,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -71,8 +82,9 @@ struct PackageFacts {
   std::vector<uint32_t> page_bytes;                 // stored size of each data page
   uint64_t root_fetch_bytes = 0;                    // the first suffix request's answer
   std::vector<std::vector<uint32_t>> finest_nodes;  // per representation: its nodes with no children
+  std::shared_ptr<const package::PackageReader> reader;  // every index page loaded (the push server's)
 
-  // Reads every index page of `reader` (one read each).
+  // Reads every index page of `reader` (one read each) and keeps a copy of it.
   static PackageFacts of(package::PackageReader& reader);
 };
 
@@ -110,9 +122,12 @@ struct SimResult {
   std::vector<FrameSample> samples;
 };
 
-// Runs one policy. Throws lodstream::Error for a policy this build cannot run (push, oracle).
+// Runs one policy.
 SimResult simulate(const PackageFacts& package, const schedule::CameraPath& path, Policy policy,
                    const SimOptions& options);
+
+// The data pages holding finest-level nodes, sorted (file order): what `full` fetches.
+std::vector<uint32_t> finest_pages(const PackageFacts& package);
 
 // The finest cut for `view`: every finest-level node (no children) of every object in the frustum, each with
 // its projected error. What `full` draws and what image metrics compare against.

@@ -15,7 +15,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string> kPolicies{"full", "sse-pull", "sse-pull-3"};
+const std::vector<std::string> kPolicies{"full", "sse-pull", "sse-pull-3", "push", "oracle"};
 const char* kHeader = "t,bytes,nodes,triangles,pixel_error_max,pixel_error_mean,benefit_ratio,frame_ms";
 
 std::string slurp(const fs::path& p) {
