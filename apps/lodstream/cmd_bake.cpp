@@ -39,7 +39,6 @@ struct BakeArgs {
   std::string output;
   bool json = false;
   uint32_t normal_bits = 10;
-  int zstd_level = WriterOptions{}.zstd_level;
 };
 
 uint64_t peak_rss_bytes() {
@@ -210,9 +209,7 @@ int run_bake(const BakeArgs& args) {
   });
 
   // Encode (parallel, a batch of page groups at a time) and write (serial).
-  WriterOptions writer_options;
-  writer_options.zstd_level = args.zstd_level;
-  PackageWriter writer(args.output, writer_options);
+  PackageWriter writer(args.output);
   const NodeCodec& codec = default_node_codec();
   NodeSizeBreakdown breakdown;
   size_t first = 0;
@@ -305,8 +302,6 @@ const bool registered = register_command(
            ->required();
        sub.add_option("-o,--output", args->output, "the package to write (.lods)")->required();
        sub.add_option("--normal-bits", args->normal_bits, "octahedral normal bits per component (4..16)");
-       sub.add_option("--zstd-level", args->zstd_level, "zstd level of the pages (1..22)")
-           ->check(CLI::Range(1, 22));
        sub.add_flag("--json", args->json,
                     "print one JSON object: input_triangles, objects, nodes, pages, levels, bytes, time_s, "
                     "peak_rss_bytes");

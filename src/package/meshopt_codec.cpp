@@ -16,26 +16,21 @@ namespace lodstream::package {
 
 namespace {
 
-constexpr uint8_t kFormat = 2;
-constexpr uint32_t kNormals = 1, kUvs = 2, kColors = 4, kVertexData = 8, kWidePositions = 16, kPredicted = 32,
-                   kAllFlags = 63;
-constexpr uint32_t kNoVertex = UINT32_MAX;
-constexpr uint32_t kPredictionWindow = 16;  // earlier triangles searched for a parallelogram
+constexpr uint8_t kFormat = 1;
+constexpr uint32_t kNormals = 1, kUvs = 2, kColors = 4, kVertexData = 8, kWidePositions = 16, kAllFlags = 31;
 constexpr size_t kMaxVertices = 65536;
 constexpr uint32_t kMaxShift = 24;
 constexpr int64_t kMaxGridCoordinate = int64_t(1) << 30;
 
-// Byte offsets of each attribute inside the interleaved vertex record (positions only without kPredicted;
-// predicted ones are byte planes of `plane_bytes` per vertex ahead of the records).
+// Byte offsets of each attribute inside the interleaved vertex record.
 struct Layout {
   size_t position = 0, normal = 0, uv = 0, color = 0, data = 0, stride = 0;
-  size_t position_size = 0, normal_size = 0, plane_bytes = 0;
+  size_t position_size = 0, normal_size = 0;
 };
 
 Layout layout_for(uint32_t flags, uint32_t normal_bits) {
   Layout l;
-  const size_t position_bytes = (flags & kWidePositions) ? 12 : 6;
-  (flags & kPredicted ? l.plane_bytes : l.position_size) = position_bytes;
+  l.position_size = (flags & kWidePositions) ? 12 : 6;
   l.normal_size = (flags & kNormals) ? (normal_bits <= 8 ? 2 : 4) : 0;
   size_t at = l.position_size;
   l.normal = at, at += l.normal_size;
@@ -122,64 +117,6 @@ class BitWriter {
   std::vector<uint8_t>& out_;
   uint32_t bit_ = 0;
 };
-
-// Which decoded vertices predict vertex v (all numbered below v, so a decoder in vertex order has them):
-// position(a) + position(b) - position(c) (parallelogram), position(a) alone (b = c = kNoVertex), or the
-// node's cmin (a = kNoVertex). See the header for the rule.
-struct Prediction {
-  uint32_t a = kNoVertex, b = kNoVertex, c = kNoVertex;
-};
-
-std::vector<Prediction> predictions(std::span<const uint32_t> indices, uint32_t vertices) {
-  std::vector<uint32_t> first_triangle(vertices, kNoVertex);
-  const uint32_t triangles = uint32_t(indices.size() / 3);
-  for (uint32_t t = 0; t < triangles; ++t)
-    for (int k = 0; k < 3; ++k)
-      if (uint32_t& f = first_triangle[indices[3 * t + k]]; f == kNoVertex) f = t;
-  std::vector<Prediction> out(vertices);
-  for (uint32_t v = 0; v < vertices; ++v) {
-    Prediction& p = out[v];
-    const uint32_t t = first_triangle[v];
-    if (t == kNoVertex) {
-      if (v > 0) p.a = v - 1;
-      continue;
-    }
-    const uint32_t* tri = &indices[3 * size_t(t)];
-    const int k = tri[0] == v ? 0 : (tri[1] == v ? 1 : 2);
-    const uint32_t o1 = tri[(k + 1) % 3], o2 = tri[(k + 2) % 3];
-    if (o1 < v && o2 < v) {
-      p.a = o1;
-      // The triangle across edge o1-o2 among the last few: it holds o2 -> o1, its third corner is opposite v.
-      for (uint32_t back = 1; back <= kPredictionWindow && back <= t; ++back) {
-        const uint32_t* u = &indices[3 * size_t(t - back)];
-        for (int j = 0; j < 3; ++j)
-          if (u[j] == o2 && u[(j + 1) % 3] == o1 && u[(j + 2) % 3] < v) {
-            p.b = o2, p.c = u[(j + 2) % 3];
-            break;
-          }
-        if (p.b != kNoVertex) break;
-      }
-    } else if (o1 < v || o2 < v) {
-      p.a = o1 < v ? o1 : o2;
-    } else if (v > 0) {
-      p.a = v - 1;
-    }
-  }
-  return out;
-}
-
-int64_t predicted(const Prediction& p, const int64_t* c, int axis, int64_t cmin) {
-  if (p.a == kNoVertex) return cmin;
-  const int64_t base = c[3 * size_t(p.a) + axis];
-  return p.b == kNoVertex ? base : base + c[3 * size_t(p.b) + axis] - c[3 * size_t(p.c) + axis];
-}
-
-uint64_t zigzag(int64_t v) {
-  return (static_cast<uint64_t>(v) << 1) ^ static_cast<uint64_t>(v >> 63);
-}
-int64_t unzigzag(uint64_t u) {
-  return static_cast<int64_t>(u >> 1) ^ -static_cast<int64_t>(u & 1);
-}
 
 }  // namespace
 
@@ -268,42 +205,13 @@ std::vector<uint8_t> MeshoptCodec::encode(const NodeGeometry& g, const PositionG
   }
   const glm::vec2 uv_extent = uv_max - uv_min;
 
-  // Index stream first: position prediction follows the triangle order the decoder will see (the index
-  // codec may rotate triangles), so the encoder decodes its own stream.
-  std::vector<uint8_t> index_stream(meshopt_encodeIndexBufferBound(indices.size(), vertex_end));
-  index_stream.resize(
-      meshopt_encodeIndexBuffer(index_stream.data(), index_stream.size(), indices.data(), indices.size()));
-  // Stored position values: zigzag(c - prediction) for nodes that stand alone (first_vertex 0), else c -
-  // cmin.
-  std::vector<uint64_t> stored(3 * V);
-  if (g.first_vertex == 0 && V > 0) {
-    std::vector<uint32_t> seen(indices.size());
-    if (meshopt_decodeIndexBuffer(seen.data(), seen.size(), sizeof(uint32_t), index_stream.data(),
-                                  index_stream.size()) != 0)
-      invalid("index codec round trip failed");
-    const std::vector<Prediction> pred = predictions(seen, uint32_t(V));
-    uint64_t largest = 0;
-    for (size_t v = 0; v < V; ++v)
-      for (int a = 0; a < 3; ++a) {
-        stored[3 * v + a] = zigzag(c[3 * v + a] - predicted(pred[v], c.data(), a, cmin[a]));
-        largest = std::max(largest, stored[3 * v + a]);
-      }
-    if (largest <= UINT32_MAX) {
-      flags |= kPredicted;
-      flags = largest > 65535 ? flags | kWidePositions : flags & ~kWidePositions;
-    }
-  }
-  if (!(flags & kPredicted))
-    for (size_t v = 0; v < V; ++v)
-      for (int a = 0; a < 3; ++a) stored[3 * v + a] = static_cast<uint64_t>(c[3 * v + a] - cmin[a]);
-
   const Layout L = layout_for(flags, g.normal_bits);
   std::vector<uint8_t> records(V * L.stride, 0);
   for (size_t v = 0; v < V; ++v) {
     uint8_t* r = records.data() + v * L.stride;
     const uint32_t old = order[v];
-    for (int a = 0; a < 3 && L.position_size > 0; ++a) {
-      const uint64_t s = stored[3 * v + a];
+    for (int a = 0; a < 3; ++a) {
+      uint64_t s = static_cast<uint64_t>(c[3 * v + a] - cmin[a]);
       if (flags & kWidePositions) {
         put(r + 4 * a, static_cast<uint32_t>(s));
       } else {
@@ -334,20 +242,9 @@ std::vector<uint8_t> MeshoptCodec::encode(const NodeGeometry& g, const PositionG
     if (flags & kVertexData) put(r + L.data, g.vertex_data[old]);
   }
 
-  // Predicted positions: byte planes (byte b of axis a of every vertex: plane b * 3 + a), which zstd's
-  // entropy stage codes well (meshopt's vertex codec would delta-code the residuals again); then the records.
-  const size_t planes = L.plane_bytes * V;
-  std::vector<uint8_t> vertex_stream(planes);
-  for (size_t v = 0; v < V && planes > 0; ++v)
-    for (int a = 0; a < 3; ++a)
-      for (size_t b = 0; b < L.plane_bytes / 3; ++b)
-        vertex_stream[(b * 3 + a) * V + v] = static_cast<uint8_t>(stored[3 * v + a] >> (8 * b));
-  if (L.stride > 0) {
-    vertex_stream.resize(planes + meshopt_encodeVertexBufferBound(V, L.stride));
-    vertex_stream.resize(planes + meshopt_encodeVertexBuffer(vertex_stream.data() + planes,
-                                                             vertex_stream.size() - planes, records.data(), V,
-                                                             L.stride));
-  }
+  std::vector<uint8_t> vertex_stream(meshopt_encodeVertexBufferBound(V, L.stride));
+  vertex_stream.resize(
+      meshopt_encodeVertexBuffer(vertex_stream.data(), vertex_stream.size(), records.data(), V, L.stride));
   std::vector<uint8_t> locked_stream;
   if (k > 0) {
     locked_stream.resize((V + 7) / 8, 0);
@@ -363,6 +260,10 @@ std::vector<uint8_t> MeshoptCodec::encode(const NodeGeometry& g, const PositionG
       }
     }
   }
+  std::vector<uint8_t> index_stream(meshopt_encodeIndexBufferBound(indices.size(), vertex_end));
+  index_stream.resize(
+      meshopt_encodeIndexBuffer(index_stream.data(), index_stream.size(), indices.data(), indices.size()));
+
   ByteWriter w;
   w.u8(kFormat);
   w.u8(static_cast<uint8_t>(flags));
@@ -390,14 +291,9 @@ DecodedNode MeshoptCodec::decode(std::span<const uint8_t> bytes, const PositionG
   const size_t V = p.vertices, T = p.triangles;
   const Layout L = layout_for(p.flags, p.normal_bits);
 
-  const size_t planes = L.plane_bytes * V;
-  if (p.vertex_stream.size() < planes)
-    throw Error(where + ": vertex stream shorter than its position planes");
-  const std::span<const uint8_t> record_stream = p.vertex_stream.subspan(planes);
   std::vector<uint8_t> records(V * L.stride);
-  if (L.stride == 0 ? !record_stream.empty()
-                    : meshopt_decodeVertexBuffer(records.data(), V, L.stride, record_stream.data(),
-                                                 record_stream.size()) != 0) {
+  if (meshopt_decodeVertexBuffer(records.data(), V, L.stride, p.vertex_stream.data(),
+                                 p.vertex_stream.size()) != 0) {
     throw Error(where + ": corrupted vertex stream");
   }
   DecodedNode out;
@@ -430,49 +326,25 @@ DecodedNode MeshoptCodec::decode(std::span<const uint8_t> bytes, const PositionG
     residuals = locked_bits + (V + 7) / 8;
   }
 
-  // Grid coordinates c: cmin + stored, or (kPredicted) prediction + unzigzag(stored), checked to stay in the
-  // grid's range so that a hostile chain of predictions cannot overflow.
-  const bool wide = p.flags & kWidePositions;
-  auto stored = [&](size_t v, int a) -> uint64_t {
-    if (planes > 0) {
-      uint64_t value = 0;
-      for (size_t b = 0; b < L.plane_bytes / 3; ++b)
-        value |= uint64_t(p.vertex_stream[(b * 3 + a) * V + v]) << (8 * b);
-      return value;
-    }
-    const uint8_t* r = records.data() + v * L.stride;
-    return wide ? get<uint32_t>(r + 4 * a) : get<uint16_t>(r + 2 * a);
-  };
-  std::vector<int64_t> c(3 * V);
-  if (p.flags & kPredicted) {
-    if (p.first_vertex != 0) throw Error(where + ": predicted positions in a chunk that is not standalone");
-    const std::vector<Prediction> pred = predictions(m.indices, uint32_t(V));
-    for (size_t v = 0; v < V; ++v)
-      for (int a = 0; a < 3; ++a) {
-        const int64_t value = predicted(pred[v], c.data(), a, p.cmin[a]) + unzigzag(stored(v, a));
-        if (value < -kMaxGridCoordinate * 2 || value > kMaxGridCoordinate * 2)
-          throw Error(where + ": predicted position out of the grid's range");
-        c[3 * v + a] = value;
-      }
-  } else {
-    for (size_t v = 0; v < V; ++v)
-      for (int a = 0; a < 3; ++a) c[3 * v + a] = p.cmin[a] + int64_t(stored(v, a));
-  }
-
-  // Positions: p = origin + q * step with q = c * 2^k (+ the k low bits of a locked vertex). One expression
-  // for every path, so that equal q give bit-identical positions.
+  // Positions: p = origin + q * step with q = (cmin + stored) * 2^k (+ the k low bits of a locked vertex).
+  // One expression for every path, so that equal q give bit-identical positions.
   m.positions.resize(V);
+  const bool wide = p.flags & kWidePositions;
+  auto stored = [&](size_t v, int a) -> int64_t {
+    const uint8_t* r = records.data() + v * L.stride;
+    return wide ? int64_t(get<uint32_t>(r + 4 * a)) : int64_t(get<uint16_t>(r + 2 * a));
+  };
   auto position = [&](int a, int64_t q) { return grid.origin[a] + static_cast<float>(q) * grid.step; };
   if (k == 0) {
     for (size_t v = 0; v < V; ++v) {
-      for (int a = 0; a < 3; ++a) m.positions[v][a] = position(a, c[3 * v + a]);
+      for (int a = 0; a < 3; ++a) m.positions[v][a] = position(a, p.cmin[a] + stored(v, a));
     }
   } else {
     size_t residual_bit = 0;
     for (size_t v = 0; v < V; ++v) {
       const bool locked = (locked_bits[v / 8] >> (v % 8)) & 1;
       for (int a = 0; a < 3; ++a) {
-        int64_t q = c[3 * v + a] * (int64_t(1) << k);
+        int64_t q = (p.cmin[a] + stored(v, a)) * (int64_t(1) << k);
         if (locked) {
           uint32_t low = 0;
           for (uint32_t b = 0; b < k; ++b, ++residual_bit) {

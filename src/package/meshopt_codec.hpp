@@ -1,25 +1,15 @@
-// The node codec (id 2; id 1 stored c - cmin without prediction): quantization + meshoptimizer 0.18's vertex
-// and index codecs; zstd is applied later, per page, by the writer.
+// The first node codec (id 1): quantization + meshoptimizer 0.18's vertex and index codecs; zstd is applied
+// later, per page, by the writer.
 //
 // Bytes of a node:
-//   u8 format (2), u8 flags (1 normals, 2 uvs, 4 colors, 8 vertex_data, 16 wide positions, 32 predicted
-//   positions), u8 position_shift k, u8 normal_bits; varint vertex count V (≤ 65536), varint triangle count T, varint first_vertex; svarint
+//   u8 format (1), u8 flags (1 normals, 2 uvs, 4 colors, 8 vertex_data, 16 wide positions), u8 position_shift
+//   k, u8 normal_bits; varint vertex count V (≤ 65536), varint triangle count T, varint first_vertex; svarint
 //   cmin[3]; [uvs: f32 uv_min[2], f32 uv_extent[2]]; varint size of the vertex, locked and index streams; the
 //   streams.
-// Vertex stream: with flag 32 (every node with first_vertex 0) the positions come first as byte planes
-//   (byte b of axis a of every vertex is plane 3b + a; 2 bytes per value, 4 with flag 16), each value
-//   zigzag(c - prediction): vertices are decoded in order after the triangles, and vertex v is predicted from
-//   vertices below v through its first triangle t (in decoded order): the parallelogram o1 + o2 - o when both
-//   other corners o1, o2 precede v and one of the 16 triangles before t holds the edge o2 -> o1 with a third
-//   corner o below v (Touma & Gotsman's rule; meshopt's vertex-cache order makes that triangle recent), else
-//   the one preceding corner, else vertex v - 1, else cmin. On refined_elephant's DAG 94 % of vertices get a
-//   parallelogram and residuals take 3.5 bits per coordinate; planes leave their entropy coding to zstd
-//   (meshopt's vertex codec would delta-code the residuals again). Then meshopt_encodeVertexBuffer over ONE
-//   interleaved record per vertex (meshopt codes each byte column on its own, so interleaving costs nothing
-//   and saves a per-stream tail): without flag 32 the position c - cmin as u16x3 (u32x3 when the node spans
-//   more than 65536 coarse steps), octahedral normal s8x2 (bits ≤ 8) or s16x2, UV u16x2 unorm over the
-//   node's UV box, colour RGBA8 unorm, vertex_data u32; zero padding to a multiple of 4 (no records when
-//   nothing is left in them).
+// Vertex stream: meshopt_encodeVertexBuffer over ONE interleaved record per vertex (meshopt codes each byte
+//   column on its own, so interleaving costs nothing and saves a per-stream tail): position c - cmin as u16x3
+//   (u32x3 when the node spans more than 65536 coarse steps), octahedral normal s8x2 (bits ≤ 8) or s16x2, UV
+//   u16x2 unorm over the node's UV box, colour RGBA8 unorm, vertex_data u32; zero padding to a multiple of 4.
 // Locked stream (only when k > 0): a bit per vertex (locked or not), then the k low bits of x, y, z of each
 //   locked vertex, packed LSB first.
 // Index stream: meshopt_encodeIndexBuffer (format version 1) of the triangles.
@@ -39,7 +29,7 @@ namespace lodstream::package {
 
 class MeshoptCodec final : public NodeCodec {
  public:
-  static constexpr uint32_t kId = 2;
+  static constexpr uint32_t kId = 1;
   MeshoptCodec();
   uint32_t id() const override { return kId; }
   std::vector<uint8_t> encode(const NodeGeometry& geometry, const PositionGrid& grid) const override;
