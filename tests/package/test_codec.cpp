@@ -112,10 +112,9 @@ TEST(MeshoptCodec, WidePositionRangeStaysExact) {
   }
 }
 
-TEST(MeshoptCodec, PredictedPositionsDecodeExactlyOnTheGrid) {
-  // Positions are stored as residuals of a prediction from earlier vertices: a decoder that predicts
-  // differently from the encoder drifts. Every decoded position must be the grid value of an input vertex,
-  // bit for bit, on a smooth mesh (parallelograms), a noisy one (large residuals) and a shifted node.
+TEST(MeshoptCodec, PositionsDecodeExactlyOnTheGrid) {
+  // Every decoded position must be the grid value of an input vertex, bit for bit (free vertices rounded to
+  // the node's shift), on a smooth mesh, a noisy one (large deltas between neighbours) and a shifted node.
   Mesh smooth = sphere(1.0f, 10, 12);
   Mesh noisy = smooth;
   std::mt19937 rng(7);
@@ -128,7 +127,7 @@ TEST(MeshoptCodec, PredictedPositionsDecodeExactlyOnTheGrid) {
       g.mesh = m;
       g.position_shift = shift;
       const MeshoptCodec codec;
-      const DecodedNode d = codec.decode(codec.encode(g, pg), pg, "predicted");
+      const DecodedNode d = codec.decode(codec.encode(g, pg), pg, "grid");
       ASSERT_EQ(d.mesh.vertex_count(), m->vertex_count());
       ASSERT_EQ(d.mesh.triangle_count(), m->triangle_count());
       std::vector<glm::vec3> expected;
