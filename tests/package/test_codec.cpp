@@ -2,6 +2,7 @@
 // position ranges, and robustness against corrupted node bytes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -109,6 +110,40 @@ TEST(MeshoptCodec, WidePositionRangeStaysExact) {
     for (const glm::vec3& o : m.positions) nearest = std::min(nearest, glm::length(p - o));
     EXPECT_LE(nearest, pg.step);
   }
+}
+
+TEST(MeshoptCodec, PositionsDecodeExactlyOnTheGrid) {
+  // Every decoded position must be the grid value of an input vertex, bit for bit (free vertices rounded to
+  // the node's shift), on a smooth mesh, a noisy one (large deltas between neighbours) and a shifted node.
+  Mesh smooth = sphere(1.0f, 10, 12);
+  Mesh noisy = smooth;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> jitter(-0.3f, 0.3f);
+  for (glm::vec3& p : noisy.positions) p += glm::vec3(jitter(rng), jitter(rng), jitter(rng));
+  for (const Mesh* m : {&smooth, &noisy})
+    for (uint32_t shift : {0u, 3u}) {
+      const PositionGrid pg = PositionGrid::for_bounds(m->bounds(), 14);
+      NodeGeometry g;
+      g.mesh = m;
+      g.position_shift = shift;
+      const MeshoptCodec codec;
+      const DecodedNode d = codec.decode(codec.encode(g, pg), pg, "grid");
+      ASSERT_EQ(d.mesh.vertex_count(), m->vertex_count());
+      ASSERT_EQ(d.mesh.triangle_count(), m->triangle_count());
+      std::vector<glm::vec3> expected;
+      for (const glm::vec3& p : m->positions) {
+        glm::vec3 e;
+        for (int a = 0; a < 3; ++a) {
+          const double q = std::round((double(p[a]) - double(pg.origin[a])) / double(pg.step));
+          const double c = shift == 0 ? q : std::floor((q + double(1 << (shift - 1))) / double(1 << shift));
+          e[a] = pg.origin[a] + float(int64_t(c) << shift) * pg.step;
+        }
+        expected.push_back(e);
+      }
+      for (const glm::vec3& p : d.mesh.positions)
+        EXPECT_NE(std::find(expected.begin(), expected.end(), p), expected.end())
+            << "decoded position (" << p.x << ", " << p.y << ", " << p.z << ") is no input's grid value";
+    }
 }
 
 TEST(MeshoptCodec, CorruptedNodeBytesGiveErrorsOrValidMeshes) {
