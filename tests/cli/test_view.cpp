@@ -12,6 +12,7 @@
 #include <sstream>
 #include <thread>
 
+#include "baked.hpp"
 #include "net/wire.hpp"
 #include "support/nginx.hpp"
 #include "support/run.hpp"
@@ -19,18 +20,6 @@
 using namespace lodstream;
 
 namespace {
-
-// refined_elephant baked once per test process.
-const std::filesystem::path& elephant_package() {
-  static const std::filesystem::path file = [] {
-    auto out = test::temp_dir() / "elephant.lods";
-    auto r =
-        test::run_lodstream({"bake", test::data_file("refined_elephant.off").string(), "-o", out.string()});
-    EXPECT_EQ(r.status, 0) << r.err;
-    return out;
-  }();
-  return file;
-}
 
 // A camera path: from `from` to `to` (looking at the origin) over `seconds` (0: a fixed camera at `to`).
 std::filesystem::path camera_path(glm::vec3 from, glm::vec3 to, double seconds) {
@@ -86,7 +75,7 @@ void expect_converged(const ViewRun& v, const std::string& mode) {
 }
 
 struct Server {
-  test::BackgroundProcess process{{"serve", elephant_package().string(), "--port", "0"}};
+  test::BackgroundProcess process{{"serve", test::elephant_package().string(), "--port", "0"}};
   uint16_t port = 0;
   Server() {
     std::string line = process.read_line();
@@ -100,7 +89,7 @@ struct Server {
 }  // namespace
 
 TEST(View, ALocalFileConvergesForAFixedCamera) {
-  const auto v = view(elephant_package().string(), camera_path({}, {0.0f, 0.2f, 1.5f}, 0));
+  const auto v = view(test::elephant_package().string(), camera_path({}, {0.0f, 0.2f, 1.5f}, 0));
   expect_converged(v, "file");
 }
 
@@ -110,7 +99,7 @@ TEST(View, PullsFromServeAndFromNginxAndIsPushedTo) {
   expect_converged(view(server.http(), path), "pull");
   expect_converged(view(server.ws(), path), "push");
   const auto root = test::temp_dir();
-  std::filesystem::copy_file(elephant_package(), root / "elephant.lods");
+  std::filesystem::copy_file(test::elephant_package(), root / "elephant.lods");
   test::Nginx nginx(root);
   expect_converged(view("http://127.0.0.1:" + std::to_string(nginx.port()) + "/elephant.lods", path), "pull");
 }
@@ -162,14 +151,14 @@ TEST(View, BadInputIsAOneLineError) {
       test::run_lodstream({"view", "/nonexistent.lods", "--headless", "--path", path.string(), "--out", out}),
       "nonexistent.lods");
   expect_error(
-      test::run_lodstream({"view", elephant_package().string(), "--path", path.string(), "--out", out}),
+      test::run_lodstream({"view", test::elephant_package().string(), "--path", path.string(), "--out", out}),
       "--headless");
-  expect_error(test::run_lodstream({"view", elephant_package().string(), "--headless", "--out", out}),
+  expect_error(test::run_lodstream({"view", test::elephant_package().string(), "--headless", "--out", out}),
                "--path");
   expect_error(test::run_lodstream({"view", "ws://127.0.0.1:1/elephant", "--headless", "--path",
                                     path.string(), "--out", out}),
                "127.0.0.1");
-  expect_error(test::run_lodstream({"view", elephant_package().string(), "--headless", "--path",
+  expect_error(test::run_lodstream({"view", test::elephant_package().string(), "--headless", "--path",
                                     path.string(), "--out", out, "--pixel-error", "0"}),
                "--pixel-error");
 }
