@@ -1,10 +1,12 @@
-// `lodstream render`: a shaded image of a model from an explicit camera (DESIGN.md, The command line), drawn
-// headless through EGL (llvmpipe without a GPU). With --frames N it draws N times and reports the median
-// time.
+// `lodstream render`: a shaded image of a model or a package from an explicit camera (DESIGN.md, The command
+// line), drawn headless through EGL (llvmpipe without a GPU). A package (.lods) is drawn at its cut for the
+// camera and --pixel-error, with every node available (the reference a streaming client is compared with).
+// With --frames N it draws N times and reports the median time.
 #include <time.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -17,6 +19,8 @@
 #include "render/context.hpp"
 #include "render/renderer.hpp"
 #include "render/scene_upload.hpp"
+#include "runtime/cut_geometry.hpp"
+#include "runtime/quality.hpp"
 
 namespace lodstream::cli {
 namespace {
@@ -24,6 +28,7 @@ namespace {
 struct RenderOptions {
   std::string model, eye, target, up, camera_file, size, output;
   std::optional<float> fov;
+  std::optional<double> pixel_error;
   int frames = 1;
   int msaa = 0;
   bool json = false;
@@ -61,13 +66,39 @@ double median(std::vector<double> values) {
   return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-void check_output(const std::filesystem::path& output) {
-  std::string ext = output.extension().string();
+std::string lower_extension(const std::filesystem::path& file) {
+  std::string ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  if (ext != ".png") throw Error(output.string() + ": the output must be a .png file");
+  return ext;
+}
+
+void check_output(const std::filesystem::path& output) {
+  if (lower_extension(output) != ".png") throw Error(output.string() + ": the output must be a .png file");
   const std::filesystem::path dir = output.parent_path().empty() ? "." : output.parent_path();
   if (!std::filesystem::is_directory(dir))
     throw Error(output.string() + ": folder " + dir.string() + " does not exist");
+}
+
+bool is_package(const std::filesystem::path& file) {
+  return lower_extension(file) == ".lods";
+}
+
+// A package's cut for `camera` at `tau` pixels, every node available.
+struct PackageCut {
+  Scene scene;
+  size_t nodes = 0;
+  double pixel_error_max = 0.0;
+};
+
+PackageCut package_cut(const std::string& file, const Camera& camera, double tau) {
+  package::PackageReader reader = package::PackageReader::open(file);
+  runtime::ReaderNodes nodes(reader);
+  const schedule::Cut cut = schedule::select_cut(reader.scene(), nodes, schedule::View::of(camera), {tau});
+  runtime::CutGeometry geometry(reader, std::filesystem::path(file).parent_path());
+  geometry.update(cut, runtime::pages_from_reader(reader));
+  const runtime::FrameQuality q =
+      runtime::frame_quality(reader.scene(), nodes, cut, schedule::View::of(camera), tau);
+  return {geometry.scene(), cut.drawn.size(), q.pixel_error_max};
 }
 
 int run_render(const RenderOptions& opt) {
@@ -77,7 +108,15 @@ int run_render(const RenderOptions& opt) {
   check_output(opt.output);
 
   const auto load_start = std::chrono::steady_clock::now();
-  const Scene scene = import_model(opt.model);
+  const bool package = is_package(opt.model);
+  if (opt.pixel_error && !package)
+    throw Error("--pixel-error applies to a package (.lods), not " + opt.model);
+  const double tau = opt.pixel_error.value_or(1.0);
+  if (!(tau > 0.0) || !std::isfinite(tau))
+    throw Error("--pixel-error must be a positive number of pixels, got " + std::to_string(tau));
+  PackageCut cut;
+  if (package) cut = package_cut(opt.model, camera, tau);
+  const Scene scene = package ? std::move(cut.scene) : import_model(opt.model);
   const double load_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
 
   auto context = render::create_headless_context();
@@ -100,19 +139,22 @@ int run_render(const RenderOptions& opt) {
   save_png(renderer.read_pixels(), opt.output);
 
   if (opt.json) {
-    print_json({{"triangles", upload.triangles},
-                {"width", camera.width},
-                {"height", camera.height},
-                {"frames", opt.frames},
-                {"draw_ms", median(draw_ms)},
-                {"draw_ms_min", *std::min_element(draw_ms.begin(), draw_ms.end())},
-                {"draw_cpu_ms", median(cpu_ms)},
-                {"load_s", load_s},
-                {"upload_s", upload_s},
-                {"renderer", context->renderer()},
-                {"platform", context->platform()},
-                {"msaa", opt.msaa},
-                {"output", opt.output}});
+    nlohmann::json out = {{"triangles", upload.triangles},
+                          {"width", camera.width},
+                          {"height", camera.height},
+                          {"frames", opt.frames},
+                          {"draw_ms", median(draw_ms)},
+                          {"draw_ms_min", *std::min_element(draw_ms.begin(), draw_ms.end())},
+                          {"draw_cpu_ms", median(cpu_ms)},
+                          {"load_s", load_s},
+                          {"upload_s", upload_s},
+                          {"renderer", context->renderer()},
+                          {"platform", context->platform()},
+                          {"msaa", opt.msaa},
+                          {"output", opt.output}};
+    if (package)
+      out.update({{"nodes", cut.nodes}, {"pixel_error", tau}, {"pixel_error_max", cut.pixel_error_max}});
+    print_json(out);
   } else {
     std::printf("%s: %zu triangles, %dx%d, draw %.1f ms (median of %d), load %.2f s, %s\n",
                 opt.output.c_str(), upload.triangles, camera.width, camera.height, median(draw_ms),
@@ -124,7 +166,10 @@ int run_render(const RenderOptions& opt) {
 const bool registered = register_command(
     {"render", "a shaded image of a model from an explicit camera (headless OpenGL)", [](CLI::App& sub) {
        auto opt = std::make_shared<RenderOptions>();
-       sub.add_option("MODEL", opt->model, "model file (OBJ, PLY, OFF, glTF, ...)")->required();
+       sub.add_option("MODEL", opt->model, "model file (OBJ, PLY, OFF, glTF, ...) or package (.lods)")
+           ->required();
+       sub.add_option("--pixel-error", opt->pixel_error,
+                      "a package's target screen-space error in pixels: the cut drawn (default 1)");
        auto* eye = sub.add_option("--eye", opt->eye, "camera position X,Y,Z");
        auto* target = sub.add_option("--target", opt->target, "point looked at X,Y,Z");
        auto* up = sub.add_option("--up", opt->up, "up direction X,Y,Z (default 0,1,0)");

@@ -1,0 +1,111 @@
+#include "runtime/cut_geometry.hpp"
+
+#include <algorithm>
+#include <map>
+
+#include "core/error.hpp"
+
+namespace lodstream::runtime {
+
+PageSource pages_from_reader(const package::PackageReader& reader) {
+  return [&reader](uint32_t page) { return reader.read_page(page); };
+}
+
+PageSource pages_from_cache(const package::PackageReader& reader, PageCache& cache, CachedPages form) {
+  return [&reader, &cache, form](uint32_t page) {
+    const std::vector<uint8_t>* bytes = cache.find(reader.header().content_hash, page);
+    if (!bytes)
+      throw Error(reader.source().name() + ": page " + std::to_string(page) + " is drawn but not cached");
+    return form == CachedPages::stored ? reader.unpack_page(page, *bytes) : *bytes;
+  };
+}
+
+std::vector<Material> package_materials(const package::PackageScene& scene,
+                                        const std::filesystem::path& package_dir) {
+  std::vector<Material> materials;
+  for (const package::PackageMaterial& m : scene.materials) {
+    Material out = m.material;
+    if (m.texture_blob != package::kNone) {
+      out.base_color_texture.clear();  // embedded textures: not loaded yet
+    } else if (!out.base_color_texture.empty()) {
+      const std::filesystem::path texture(out.base_color_texture);
+      if (texture.is_relative()) out.base_color_texture = (package_dir / texture).string();
+    }
+    materials.push_back(std::move(out));
+  }
+  if (materials.empty()) materials.emplace_back();
+  return materials;
+}
+
+CutGeometry::CutGeometry(package::PackageReader& reader, const std::filesystem::path& package_dir,
+                         uint64_t decoded_triangle_budget)
+    : reader_(&reader),
+      materials_(package_materials(reader.scene(), package_dir)),
+      budget_(decoded_triangle_budget) {}
+
+size_t CutGeometry::update(const schedule::Cut& cut, const PageSource& pages) {
+  ++frame_;
+  // New nodes grouped by page, so each page is unpacked once.
+  std::map<uint32_t, std::vector<uint32_t>> missing_by_page;
+  for (const schedule::DrawnNode& d : cut.drawn) {
+    auto it = decoded_.find(d.node);
+    if (it != decoded_.end())
+      it->second.last_drawn = frame_;
+    else
+      missing_by_page[reader_->node(d.node).page].push_back(d.node);
+  }
+  size_t decoded = 0;
+  for (auto& [page, ids] : missing_by_page) {
+    const std::vector<uint8_t> bytes = pages(page);
+    for (uint32_t id : ids) {
+      if (decoded_.count(id)) continue;  // an instanced node listed once per object
+      Mesh mesh = reader_->decode_node(id, bytes).mesh;
+      if (mesh.material >= materials_.size()) mesh.material = 0;
+      decoded_.emplace(id, Decoded{std::move(mesh), frame_});
+      ++decoded;
+    }
+  }
+  items_.clear();
+  triangles_ = 0;
+  const auto& objects = reader_->scene().objects;
+  for (const schedule::DrawnNode& d : cut.drawn) {
+    const Mesh& mesh = decoded_.at(d.node).mesh;
+    items_.push_back({d.object, d.node, objects[d.object].transform, &mesh});
+    triangles_ += mesh.triangle_count();
+  }
+  evict();
+  return decoded;
+}
+
+void CutGeometry::evict() {
+  std::vector<std::pair<uint64_t, uint32_t>> idle;  // (last drawn, node) of nodes not drawn now
+  uint64_t idle_triangles = 0;
+  for (const auto& [id, d] : decoded_) {
+    if (d.last_drawn == frame_) continue;
+    idle.push_back({d.last_drawn, id});
+    idle_triangles += d.mesh.triangle_count();
+  }
+  if (idle_triangles <= budget_) return;
+  std::sort(idle.begin(), idle.end());
+  for (const auto& [last, id] : idle) {
+    if (idle_triangles <= budget_) break;
+    auto it = decoded_.find(id);
+    idle_triangles -= it->second.mesh.triangle_count();
+    decoded_.erase(it);
+  }
+}
+
+Scene CutGeometry::scene() const {
+  Scene scene;
+  scene.materials = materials_;
+  std::unordered_map<uint32_t, uint32_t> mesh_of_node;
+  for (const CutItem& item : items_) {
+    auto [it, inserted] = mesh_of_node.emplace(item.node, uint32_t(scene.meshes.size()));
+    if (inserted) scene.meshes.push_back(*item.mesh);
+    scene.objects.push_back({"object" + std::to_string(item.object) + "/node" + std::to_string(item.node),
+                             item.transform, it->second});
+  }
+  return scene;
+}
+
+}  // namespace lodstream::runtime

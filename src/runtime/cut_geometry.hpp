@@ -1,0 +1,99 @@
+// Cut geometry: the meshes of a cut's drawn nodes, decoded from their data pages, placed by their objects'
+// transforms and given the package's materials, as what a renderer draws (a core::Scene, or a list of items
+// for a caller that keeps its own GPU copy per node). Decoded meshes are cached per node, so a frame decodes
+// only the nodes that are new to it: each new node's page is unpacked once per update, then the node decoded.
+// Pure computation (no GL, no clock); the pages come from a PageSource (a local file through the
+// PackageReader, or pages already in the client's PageCache).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <unordered_map>
+#include <vector>
+
+#include "core/scene.hpp"
+#include "package/reader.hpp"
+#include "runtime/cache.hpp"
+#include "schedule/cut.hpp"
+
+namespace lodstream::runtime {
+
+// The decompressed bytes of data page `page` (what PackageReader::decode_node reads nodes from).
+using PageSource = std::function<std::vector<uint8_t>(uint32_t page)>;
+
+// Pages read from the reader's byte source (a local file or an HTTP range per page).
+PageSource pages_from_reader(const package::PackageReader& reader);
+// What a PageCache holds per page: the stored bytes as transferred (zstd; checked and unpacked here by the
+// reader), or the page already unpacked (PackageReader::read_page's output).
+enum class CachedPages { stored, unpacked };
+// Pages from `cache` (package = the reader's content hash). A page that is not cached is a lodstream::Error:
+// a cut draws only available nodes, so that means the cache and the NodeSource disagree.
+PageSource pages_from_cache(const package::PackageReader& reader, PageCache& cache, CachedPages form);
+
+// The package's materials as core materials: a texture path relative to the package resolves against the
+// package's folder (`package_dir`); embedded textures (blobs) are not loaded yet (base colour only).
+std::vector<Material> package_materials(const package::PackageScene& scene,
+                                        const std::filesystem::path& package_dir);
+
+// NodeSource of a complete package read locally: every record (its index page read on first use) and every
+// node available. What `render` of a package and the benchmark's reference images select from.
+class ReaderNodes final : public schedule::NodeSource {
+ public:
+  explicit ReaderNodes(package::PackageReader& reader) : reader_(&reader) {}
+  const package::NodeRecord* record(uint32_t id) const override {
+    return id < reader_->node_count() ? &reader_->node(id) : nullptr;
+  }
+  bool available(uint32_t id) const override { return id < reader_->node_count(); }
+
+ private:
+  package::PackageReader* reader_;
+};
+
+// One drawn (object, node): the node's decoded mesh (object space) under the object's transform.
+struct CutItem {
+  uint32_t object = 0, node = 0;
+  glm::mat4 transform{1.0f};   // object to world
+  const Mesh* mesh = nullptr;  // valid until the next update(); mesh->material indexes materials()
+};
+
+class CutGeometry {
+ public:
+  // `reader` must outlive this object. `decoded_triangle_budget`: decoded meshes of nodes that the current
+  // cut does not draw are kept (for a cut that goes back to them) up to this many triangles, least recently
+  // drawn dropped first.
+  explicit CutGeometry(package::PackageReader& reader, const std::filesystem::path& package_dir = {},
+                       uint64_t decoded_triangle_budget = 2'000'000);
+
+  // Makes the drawn nodes of `cut` (from select_cut over this reader's scene) ready to draw: decodes those
+  // not cached, reading each of their pages once from `pages`. Returns the number of nodes decoded. Cost:
+  // O(drawn nodes) plus the pages' unpacking and the new nodes' decoding. Throws lodstream::Error (from the
+  // reader or the page source) on a corrupted page or node.
+  size_t update(const schedule::Cut& cut, const PageSource& pages);
+
+  // The current cut's items, in the cut's (object, node) order.
+  const std::vector<CutItem>& items() const { return items_; }
+  const std::vector<Material>& materials() const { return materials_; }
+  // A core::Scene of the current cut: one mesh per distinct drawn node (copied: O(triangles drawn)), one
+  // object per item, the package's materials. What render::upload_scene draws.
+  Scene scene() const;
+  // Triangles drawn by the current cut (instances counted each time).
+  uint64_t triangles() const { return triangles_; }
+  // Decoded meshes held (drawn or kept for later).
+  size_t cached_nodes() const { return decoded_.size(); }
+
+ private:
+  struct Decoded {
+    Mesh mesh;
+    uint64_t last_drawn = 0;  // update() count of the last cut that drew it
+  };
+  void evict();
+
+  package::PackageReader* reader_;
+  std::vector<Material> materials_;
+  uint64_t budget_, frame_ = 0, triangles_ = 0;
+  std::unordered_map<uint32_t, Decoded> decoded_;
+  std::vector<CutItem> items_;
+};
+
+}  // namespace lodstream::runtime

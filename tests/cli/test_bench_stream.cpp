@@ -1,0 +1,177 @@
+// `lodstream bench stream` end to end on a small real scene (CGAL's elephant, baked by the command itself):
+// simulated runs are reproducible byte for byte, every policy converges on a static path, `full` draws
+// nothing before all of its pages arrived, the outputs follow DESIGN.md's contract, and bad arguments are
+// one-line errors.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+#include "support/run.hpp"
+
+using namespace lodstream;
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::vector<std::string> kPolicies{"full", "sse-pull", "sse-pull-3", "push", "oracle"};
+const char* kHeader = "t,bytes,nodes,triangles,pixel_error_max,pixel_error_mean,benefit_ratio,frame_ms";
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+// The package, baked once by the first run (the model is given, so bench stream bakes it into --out).
+fs::path elephant_package() {
+  static const fs::path file = [] {
+    const fs::path out = test::temp_dir() / "bake";
+    auto r = test::run_lodstream({"bench", "stream", test::data_file("elephant.off").string(), "--path",
+                                  "gen:orbit", "--policy", "sse-pull", "--psnr-every", "0", "--settle", "0",
+                                  "--out", out.string()});
+    EXPECT_EQ(r.status, 0) << r.err;
+    return out / "elephant.lods";
+  }();
+  return file;
+}
+
+test::RunResult bench(const fs::path& out, const std::vector<std::string>& extra) {
+  std::vector<std::string> args{
+      "bench", "stream",    elephant_package().string(), "--link", "bandwidth=2mbit,rtt=150ms,jitter=5ms",
+      "--out", out.string()};
+  args.insert(args.end(), extra.begin(), extra.end());
+  return test::run_lodstream(args);
+}
+
+struct Row {
+  double t = 0, benefit = 0;
+  uint64_t bytes = 0, nodes = 0;
+};
+
+std::vector<Row> rows(const fs::path& csv) {
+  std::istringstream in(slurp(csv));
+  std::string line;
+  std::getline(in, line);
+  std::vector<Row> out;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream cells(line);
+    for (std::string c; std::getline(cells, c, ',');) f.push_back(c);
+    EXPECT_GE(f.size(), 8u) << line;
+    if (f.size() < 8) break;
+    out.push_back({std::stod(f[0]), std::stod(f[6]), std::stoull(f[1]), std::stoull(f[2])});
+  }
+  return out;
+}
+
+}  // namespace
+
+// Same input, same outputs: every CSV (image metrics included) and summary.json, byte for byte.
+TEST(BenchStream, SimulatedRunsAreReproducibleByteForByte) {
+  const fs::path a = test::temp_dir() / "a", b = test::temp_dir() / "b";
+  const std::vector<std::string> args{"--path", "gen:teleport", "--size", "320x180", "--psnr-every",
+                                      "3",      "--settle",     "2"};
+  auto ra = bench(a, args), rb = bench(b, args);
+  ASSERT_EQ(ra.status, 0) << ra.err;
+  ASSERT_EQ(rb.status, 0) << rb.err;
+  for (const std::string& p : kPolicies) {
+    const std::string csv = slurp(a / (p + ".csv"));
+    EXPECT_GT(csv.size(), 1000u) << p;
+    EXPECT_EQ(csv, slurp(b / (p + ".csv"))) << p;
+    EXPECT_NE(csv.find(",psnr,ssim\n"), std::string::npos);
+  }
+  EXPECT_EQ(slurp(a / "summary.json"), slurp(b / "summary.json"));
+  EXPECT_EQ(slurp(a / "summary.md"), slurp(b / "summary.md"));
+}
+
+// A static camera: each policy ends with the converged cut (benefit 1, the run stopping once converged), and
+// `full` draws nothing until every byte it fetches has arrived.
+TEST(BenchStream, EveryPolicyConvergesOnAStaticPathAndFullWaitsForEverything) {
+  const fs::path dir = test::temp_dir() / "static";
+  fs::create_directories(dir);
+  const fs::path path = dir / "path.json";
+  std::ofstream(path) << R"({"fov": 50, "size": [320, 180], "keyframes": [{"t": 0, "eye": [0.2, 0.3, 1.4],
+                           "target": [0, 0, 0]}]})";
+  auto r = bench(dir, {"--path", path.string(), "--psnr-every", "0", "--settle", "20", "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json summary = r.json();
+  for (const std::string& p : kPolicies) {
+    const auto& s = summary["policies"][p];
+    ASSERT_FALSE(s["converged_s"].is_null()) << p;
+    const std::vector<Row> f = rows(dir / (p + ".csv"));
+    ASSERT_FALSE(f.empty());
+    EXPECT_NEAR(f.back().t, s["converged_s"].get<double>(), 1e-3) << p;
+    EXPECT_LT(f.back().t, 20.0) << p;  // stopped once converged, before the settle time ran out
+    EXPECT_GT(f.back().benefit, 0.999) << p;
+    EXPECT_EQ(f.back().bytes, s["bytes"].get<uint64_t>()) << p;
+    EXPECT_FALSE(s["time_to_095_s"].is_null()) << p;
+  }
+  const std::vector<Row> full = rows(dir / "full.csv");
+  const uint64_t total = full.back().bytes;
+  size_t drawn = 0;
+  for (const Row& row : full) {
+    if (row.nodes > 0) ++drawn;
+    if (row.bytes < total) {
+      EXPECT_EQ(row.nodes, 0u) << "t=" << row.t;
+      EXPECT_EQ(row.benefit, 0.0) << "t=" << row.t;
+    }
+  }
+  EXPECT_GT(drawn, 0u);
+  EXPECT_EQ(full.front().nodes, 0u);
+  // the pull policies draw before everything they fetch has arrived
+  const std::vector<Row> pull = rows(dir / "sse-pull.csv");
+  EXPECT_TRUE(std::any_of(pull.begin(), pull.end(),
+                          [&](const Row& row) { return row.nodes > 0 && row.bytes < pull.back().bytes; }));
+}
+
+// DESIGN.md's CSV header and summary keys; --json prints summary.json's object; plots and frames are written.
+TEST(BenchStream, OutputsFollowTheContract) {
+  const fs::path dir = test::temp_dir() / "contract";
+  auto r = bench(
+      dir, {"--path", "gen:drive", "--size", "320x180", "--psnr-every", "2", "--settle", "1", "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json printed = r.json();
+  EXPECT_EQ(printed, nlohmann::json::parse(slurp(dir / "summary.json")));
+  ASSERT_EQ(printed["policies"].size(), kPolicies.size());
+  for (const std::string& p : kPolicies) {
+    const auto& s = printed["policies"][p];
+    for (const char* key : {"time_to_first_frame_s", "time_to_095_s", "benefit_auc", "bytes", "psnr_at_1s",
+                            "psnr_at_2s", "psnr_at_5s", "frame_ms_p50", "frame_ms_p99"})
+      EXPECT_TRUE(s.contains(key)) << p << " " << key;
+    EXPECT_GE(s["benefit_auc"].get<double>(), 0.0);
+    EXPECT_LE(s["benefit_auc"].get<double>(), 1.0);
+    EXPECT_EQ(slurp(dir / (p + ".csv")).rfind(kHeader, 0), 0u) << p;
+  }
+  const std::string md = slurp(dir / "summary.md");
+  for (const std::string& p : kPolicies) EXPECT_NE(md.find("| " + p + " |"), std::string::npos) << md;
+  for (const char* png : {"benefit.png", "psnr.png", "bytes.png"}) EXPECT_TRUE(fs::exists(dir / png)) << png;
+  EXPECT_TRUE(fs::exists(dir / "frames" / "reference_001.00s.png"));
+}
+
+TEST(BenchStream, BadArgumentsAreOneLineErrors) {
+  const fs::path out = test::temp_dir() / "bad";
+  const std::string pkg = elephant_package().string();
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
+      {{"--path", "gen:orbit", "--policy", "full,warp"}, "--policy"},
+      {{"--path", "gen:orbit", "--link", "bandwidth=10mbit"}, "--link"},
+      {{"--path", "gen:orbit", "--link", "bandwidth=fast,rtt=80ms"}, "--link bandwidth"},
+      {{"--path", "gen:spiral"}, "gen:spiral"},
+      {{"--path", (out / "none.json").string()}, "none.json"},
+      {{"--path", "gen:orbit", "--real"}, "--real"},
+      {{"--path", "gen:orbit", "--up", "0,0"}, "--up"},
+  };
+  for (const auto& [extra, what] : cases) {
+    std::vector<std::string> args{"bench", "stream", pkg, "--out", out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    auto r = test::run_lodstream(args);
+    EXPECT_EQ(r.status, 1) << what << ": " << r.err;
+    EXPECT_EQ(r.err.rfind("lodstream: error:", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  auto r = test::run_lodstream(
+      {"bench", "stream", (out / "missing.lods").string(), "--path", "gen:orbit", "--out", out.string()});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("missing.lods"), std::string::npos) << r.err;
+}

@@ -1,0 +1,184 @@
+#include <gtest/gtest.h>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <set>
+
+#include "core/error.hpp"
+#include "package/reader.hpp"
+#include "package/writer.hpp"
+#include "runtime/cut_geometry.hpp"
+#include "runtime/package_nodes.hpp"
+#include "support/run.hpp"
+#include "support/synthetic_dag.hpp"
+
+using namespace lodstream;
+using namespace lodstream::runtime;
+
+namespace {
+
+// A strip of `quads` quads covering [x0, x1] x [-0.25, 0.25] at z = 0.
+Mesh strip(double x0, double x1, int quads) {
+  Mesh m;
+  for (int i = 0; i <= quads; ++i) {
+    const float x = float(x0 + (x1 - x0) * i / quads);
+    m.positions.push_back({x, -0.25f, 0.0f});
+    m.positions.push_back({x, 0.25f, 0.0f});
+  }
+  for (uint32_t i = 0; i < uint32_t(quads); ++i) {
+    const uint32_t a = 2 * i, b = a + 1, c = a + 2, d = a + 3;
+    m.indices.insert(m.indices.end(), {a, c, b, b, c, d});
+  }
+  return m;
+}
+
+// The synthetic DAG with real geometry: node i is a strip over its interval with (i % 3) + 1 quads per unit,
+// in two objects (the second shifted 20 units along x), materials 0 and 1 on alternate nodes.
+struct GeometryPackage {
+  test::SyntheticDag dag = test::SyntheticDag::make();
+  std::filesystem::path file = test::temp_dir() / "strips.lods";
+  std::vector<glm::mat4> transforms{glm::mat4(1.0f),
+                                    glm::translate(glm::mat4(1.0f), glm::vec3(20.0f, 0.0f, 0.0f))};
+
+  GeometryPackage() {
+    package::PackageScene scene = dag.scene(transforms);
+    Material red, blue;
+    red.base_color = {1.0f, 0.0f, 0.0f, 1.0f};
+    blue.base_color = {0.0f, 0.0f, 1.0f, 1.0f};
+    blue.base_color_texture = "textures/blue.png";
+    scene.materials = {{red, package::kNone}, {blue, package::kNone}};
+    scene.representations[0].grid = package::PositionGrid::for_bounds(scene.representations[0].bounds);
+    package::WriterOptions options;
+    options.page_bytes = 1024;
+    options.nodes_per_index_page = 8;
+    package::PackageWriter writer(file, options);
+    for (uint32_t i = 0; i < dag.records.size(); ++i) {
+      const auto [x0, x1] = dag.intervals[i];
+      const Mesh mesh = strip(x0, x1, int(x1 - x0) * int(i % 3 + 1));
+      dag.records[i].triangles = uint32_t(mesh.triangle_count());
+      dag.records[i].vertices = uint32_t(mesh.vertex_count());
+      dag.records[i].material = i % 2;
+      package::NodeGeometry geometry;
+      geometry.mesh = &mesh;
+      writer.add_node(i, package::default_node_codec().encode(geometry, scene.representations[0].grid));
+      writer.end_group();
+    }
+    writer.finish(scene, dag.records, 4);
+  }
+};
+
+View view_of(glm::vec3 eye, glm::vec3 target) {
+  Camera c;
+  c.eye = eye;
+  c.target = target;
+  return View::of(c);
+}
+
+std::set<uint32_t> distinct_nodes(const Cut& cut) {
+  std::set<uint32_t> s;
+  for (const auto& d : cut.drawn) s.insert(d.node);
+  return s;
+}
+
+}  // namespace
+
+// The drawn nodes decode to their own geometry under their object's transform, each node once however many
+// objects draw it; a frame decodes only what is new to it.
+TEST(CutGeometry, DecodesTheDrawnNodesOnceAndPlacesThemByObject) {
+  GeometryPackage p;
+  package::PackageReader reader = package::PackageReader::open(p.file);
+  ReaderNodes all(reader);
+  CutGeometry geometry(reader, "/packages");
+
+  const View far = view_of({8.0f, 2.0f, 60.0f}, {18.0f, 0.0f, 0.0f});
+  const Cut coarse = select_cut(reader.scene(), all, far, {2.0});
+  ASSERT_EQ(coarse.objects.size(), 2u);
+  ASSERT_FALSE(coarse.drawn.empty());
+  EXPECT_EQ(geometry.update(coarse, pages_from_reader(reader)), distinct_nodes(coarse).size());
+  ASSERT_EQ(geometry.items().size(), coarse.drawn.size());
+  uint64_t triangles = 0;
+  for (size_t i = 0; i < coarse.drawn.size(); ++i) {
+    const CutItem& item = geometry.items()[i];
+    const uint32_t id = coarse.drawn[i].node;
+    EXPECT_EQ(item.node, id);
+    EXPECT_EQ(item.object, coarse.drawn[i].object);
+    EXPECT_EQ(item.transform, p.transforms[item.object]);
+    ASSERT_NE(item.mesh, nullptr);
+    EXPECT_EQ(item.mesh->triangle_count(), p.dag.records[id].triangles);
+    EXPECT_EQ(item.mesh->material, id % 2);
+    const Bounds b = item.mesh->bounds();
+    EXPECT_NEAR(b.min.x, p.dag.intervals[id].first, 1e-2);
+    EXPECT_NEAR(b.max.x, p.dag.intervals[id].second, 1e-2);
+    triangles += item.mesh->triangle_count();
+  }
+  EXPECT_EQ(geometry.triangles(), triangles);
+  EXPECT_EQ(geometry.update(coarse, pages_from_reader(reader)), 0u);  // nothing new
+
+  const View near = view_of({-1.0f, 0.5f, 1.0f}, {8.0f, 0.0f, 0.0f});
+  const Cut fine = select_cut(reader.scene(), all, near, {0.5});
+  size_t fresh = 0;
+  for (uint32_t id : distinct_nodes(fine)) fresh += !distinct_nodes(coarse).count(id);
+  ASSERT_GT(fresh, 0u);
+  EXPECT_EQ(geometry.update(fine, pages_from_reader(reader)), fresh);
+
+  // The scene: one mesh per distinct node, one object per item, materials resolved against the package's
+  // folder.
+  const Scene scene = geometry.scene();
+  EXPECT_EQ(scene.meshes.size(), distinct_nodes(fine).size());
+  EXPECT_EQ(scene.objects.size(), fine.drawn.size());
+  EXPECT_EQ(scene.triangle_count(), geometry.triangles());
+  ASSERT_EQ(scene.materials.size(), 2u);
+  EXPECT_EQ(scene.materials[1].base_color_texture, "/packages/textures/blue.png");
+  EXPECT_EQ(scene.materials[0].base_color, glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
+}
+
+// With no room for idle meshes, only the current cut's stay decoded.
+TEST(CutGeometry, DropsIdleMeshesBeyondTheBudget) {
+  GeometryPackage p;
+  package::PackageReader reader = package::PackageReader::open(p.file);
+  ReaderNodes all(reader);
+  CutGeometry geometry(reader, {}, 0);
+  const Cut fine = select_cut(reader.scene(), all, view_of({-1.0f, 0.5f, 1.0f}, {8.0f, 0.0f, 0.0f}), {0.5});
+  const Cut coarse =
+      select_cut(reader.scene(), all, view_of({8.0f, 2.0f, 60.0f}, {18.0f, 0.0f, 0.0f}), {2.0});
+  geometry.update(fine, pages_from_reader(reader));
+  EXPECT_EQ(geometry.cached_nodes(), distinct_nodes(fine).size());
+  geometry.update(coarse, pages_from_reader(reader));
+  EXPECT_EQ(geometry.cached_nodes(), distinct_nodes(coarse).size());
+}
+
+// Pages from the client's cache, as transferred (stored) or unpacked; a drawn page that is not cached is an
+// error naming it.
+TEST(CutGeometry, ReadsPagesFromTheCache) {
+  GeometryPackage p;
+  package::PackageReader reader = package::PackageReader::open(p.file);
+  for (uint32_t id = 0; id < reader.node_count(); ++id) reader.node(id);  // every index page
+  const package::ContentHash hash = reader.header().content_hash;
+  PageCache stored(1u << 20), unpacked(1u << 20);
+  for (uint32_t page = 0; page < reader.root().pages.size(); ++page) {
+    const package::Range& r = reader.root().pages[page];
+    std::vector<uint8_t> bytes(r.size);
+    reader.source().read(r.offset, bytes);
+    stored.insert(hash, page, std::move(bytes));
+    unpacked.insert(hash, page, reader.read_page(page));
+  }
+  PackageNodes nodes(reader, stored);
+  const Cut cut = select_cut(reader.scene(), nodes, view_of({-1.0f, 0.5f, 1.0f}, {8.0f, 0.0f, 0.0f}), {0.5});
+  ASSERT_TRUE(cut.converged());
+  CutGeometry a(reader), b(reader), c(reader);
+  a.update(cut, pages_from_cache(reader, stored, CachedPages::stored));
+  b.update(cut, pages_from_cache(reader, unpacked, CachedPages::unpacked));
+  c.update(cut, pages_from_reader(reader));
+  ASSERT_EQ(a.items().size(), c.items().size());
+  for (size_t i = 0; i < a.items().size(); ++i) {
+    EXPECT_EQ(a.items()[i].mesh->positions, c.items()[i].mesh->positions);
+    EXPECT_EQ(b.items()[i].mesh->indices, c.items()[i].mesh->indices);
+  }
+  PageCache empty(1u << 20);
+  CutGeometry d(reader);
+  try {
+    d.update(cut, pages_from_cache(reader, empty, CachedPages::stored));
+    FAIL() << "no error for a page that is not cached";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is drawn but not cached"), std::string::npos) << e.what();
+  }
+}
