@@ -17,12 +17,17 @@
 
 #include "command.hpp"
 #include "core/error.hpp"
+#include "core/image.hpp"
 #include "net/http_source.hpp"
 #include "net/page_inbox.hpp"
 #include "net/pull_fetcher.hpp"
 #include "net/push_client.hpp"
 #include "net/url.hpp"
+#include "render/context.hpp"
+#include "render/renderer.hpp"
+#include "render/scene_upload.hpp"
 #include "runtime/client_package.hpp"
+#include "runtime/cut_geometry.hpp"
 #include "schedule/camera_path.hpp"
 #include "schedule/motion.hpp"
 
@@ -41,6 +46,7 @@ struct ViewOptions {
   double cache_mb = 1024.0;
   uint64_t budget = 0;  // 0: none
   std::string order = "benefit";
+  int frames_every = 0;  // 0: no images
   bool json = false;
 };
 
@@ -100,6 +106,7 @@ int run_view(const ViewOptions& opt) {
   if (!(opt.cache_mb > 0.0) || !std::isfinite(opt.cache_mb))
     throw Error("--cache must be a positive MB count");
   if (opt.order != "benefit" && opt.order != "sse") throw Error("--order must be 'benefit' or 'sse'");
+  if (opt.frames_every < 0) throw Error("--frames-every must be >= 0 (0: no images)");
   const schedule::CameraPath path = schedule::load_camera_path(opt.path);
 
   // The package's root index, and the transport.
@@ -143,6 +150,28 @@ int run_view(const ViewOptions& opt) {
   schedule::CutOptions cut_options;
   cut_options.tau = opt.pixel_error;
   if (opt.budget) cut_options.triangle_budget = opt.budget;
+  const std::filesystem::path dir(opt.out);
+  std::filesystem::create_directories(dir);
+  // Images of the frames (--frames-every): the cut's geometry from the cache, drawn headless.
+  std::unique_ptr<render::Context> context;
+  std::unique_ptr<render::Renderer> renderer;
+  std::unique_ptr<runtime::CutGeometry> geometry;
+  const std::filesystem::path package_dir =
+      push || pull ? std::filesystem::path() : std::filesystem::path(opt.source).parent_path();
+  if (opt.frames_every > 0) {
+    context = render::create_headless_context();
+    renderer = std::make_unique<render::Renderer>(*context);
+    geometry = std::make_unique<runtime::CutGeometry>(client.reader(), package_dir);
+  }
+  auto draw = [&](uint64_t frame, const runtime::Frame& f, const Camera& camera) {
+    geometry->update(
+        f.cut, runtime::pages_from_cache(client.reader(), client.cache(), runtime::CachedPages::unpacked));
+    const render::SceneUpload upload = render::upload_scene(*renderer, geometry->scene());
+    renderer->draw(camera, upload.items);
+    char name[64];
+    std::snprintf(name, sizeof name, "frame_%05llu.png", (unsigned long long)frame);
+    save_png(renderer->read_pixels(), dir / name);
+  };
   std::string csv = "t,bytes,nodes,triangles,pixel_error_max,pixel_error_mean,benefit_ratio,frame_ms\n";
   std::vector<double> frame_ms;
   std::optional<double> first_frame_s, time_095_s;
@@ -179,6 +208,9 @@ int run_view(const ViewOptions& opt) {
       pusher->send_view(view_update(now));
     }
     last = client.frame(predicted[0].view, ahead, cut_options);
+    const bool final_pose = t >= path.end();
+    const bool done = final_pose && (last.cut.converged() || t >= path.end() + opt.settle_s);
+    if (geometry && (i % uint64_t(opt.frames_every) == 0 || done)) draw(i, last, path.pose_at(t));
     const double ms = 1e3 * std::chrono::duration<double>(Clock::now() - frame_start).count();
     frame_ms.push_back(ms);
     if (!first_frame_s && !last.cut.drawn.empty()) first_frame_s = t;
@@ -189,14 +221,10 @@ int run_view(const ViewOptions& opt) {
                   (unsigned long long)last.cut.triangles, last.quality.pixel_error_max,
                   last.quality.pixel_error_mean, last.quality.benefit_ratio, ms);
     csv += row;
-    if (t >= path.end()) {
-      converged = last.cut.converged();
-      if (converged || t >= path.end() + opt.settle_s) break;
-    }
+    if (final_pose) converged = last.cut.converged();
+    if (done) break;
   }
 
-  const std::filesystem::path dir(opt.out);
-  std::filesystem::create_directories(dir);
   const auto tmp = dir / "frames.csv.tmp";
   {
     std::ofstream f(tmp, std::ios::binary);
@@ -248,6 +276,8 @@ const bool registered = register_command(
        sub.add_option("--budget", opt->budget, "triangles drawn per frame at most (0: no limit)");
        sub.add_option("--order", opt->order, "pull order: benefit (benefit per byte, predicted) or sse")
            ->capture_default_str();
+       sub.add_option("--frames-every", opt->frames_every,
+                      "write DIR/frame_NNNNN.png every N frames and the final frame (0: none)");
        sub.add_flag("--json", opt->json, "print a JSON summary");
        sub.footer(
            "CSV columns: t,bytes,nodes,triangles,pixel_error_max,pixel_error_mean,benefit_ratio,frame_ms\n"

@@ -45,6 +45,8 @@ class ClientPackage {
   package::PackageReader& reader() { return reader_; }
   const package::PackageScene& scene() const { return reader_.scene(); }
   const PackageNodes& nodes() const { return nodes_; }
+  // The arrived data pages, decompressed (what CutGeometry draws from: pages_from_cache(..., unpacked)).
+  PageCache& cache() { return cache_; }
   const schedule::PageScheduler& scheduler() const { return scheduler_; }
   // The stored bytes installed so far (what the transport delivered).
   uint64_t bytes_received() const { return bytes_received_; }

@@ -36,17 +36,22 @@ std::filesystem::path camera_path(glm::vec3 from, glm::vec3 to, double seconds) 
 }
 
 struct ViewRun {
+  std::filesystem::path out;
   test::RunResult result;
   std::vector<std::vector<double>> rows;
   std::string header;
 };
 
-ViewRun view(const std::string& source, const std::filesystem::path& path, double settle = 20) {
+ViewRun view(const std::string& source, const std::filesystem::path& path,
+             std::vector<std::string> more = {}) {
   static int count = 0;
   const auto out = test::temp_dir() / ("view" + std::to_string(count++));
   ViewRun v;
-  v.result = test::run_lodstream({"view", source, "--headless", "--path", path.string(), "--out",
-                                  out.string(), "--settle", std::to_string(settle), "--json"});
+  std::vector<std::string> args{"view",  source,       "--headless", "--path", path.string(),
+                                "--out", out.string(), "--settle",   "20",     "--json"};
+  args.insert(args.end(), more.begin(), more.end());
+  v.result = test::run_lodstream(args);
+  v.out = out;
   std::ifstream csv(out / "frames.csv");
   std::getline(csv, v.header);
   for (std::string line; std::getline(csv, line);) {
@@ -102,6 +107,28 @@ TEST(View, PullsFromServeAndFromNginxAndIsPushedTo) {
   std::filesystem::copy_file(test::elephant_package(), root / "elephant.lods");
   test::Nginx nginx(root);
   expect_converged(view("http://127.0.0.1:" + std::to_string(nginx.port()) + "/elephant.lods", path), "pull");
+}
+
+TEST(View, TheFinalFrameOfAPushedViewIsTheRenderOfTheCut) {
+  // Issue 5's correctness: once converged, the client draws what `lodstream render --pixel-error 1` draws.
+  const auto path = camera_path({0.0f, 0.0f, 3.0f}, {0.8f, 0.2f, 0.8f}, 0.5);
+  Server server;
+  const auto v = view(server.ws(), path, {"--frames-every", "1000"});
+  expect_converged(v, "push");
+  const auto frames = v.rows.size() - 1;
+  char name[64];
+  std::snprintf(name, sizeof name, "frame_%05zu.png", frames);
+  ASSERT_TRUE(std::filesystem::exists(v.out / name)) << name;
+  const auto reference = test::temp_dir() / "reference.png";
+  auto r = test::run_lodstream({"render", test::elephant_package().string(), "--eye", "0.8,0.2,0.8",
+                                "--target", "0,0,0", "--fov", "60", "--size", "640x480", "--pixel-error", "1",
+                                "-o", reference.string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto m =
+      test::run_lodstream({"measure", "--images", (v.out / name).string(), reference.string(), "--json"});
+  ASSERT_EQ(m.status, 0) << m.err;
+  const auto j = m.json();
+  EXPECT_TRUE(j["psnr"].is_null() || j["psnr"].get<double>() >= 50.0) << j.dump();
 }
 
 TEST(View, SixteenClientsOnOneServerConvergeWhileAGarbageClientGetsBye) {
