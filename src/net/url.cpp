@@ -7,7 +7,8 @@
 namespace lodstream {
 
 UrlParts split_url(const std::string& url, const std::string& scheme) {
-  if (url.rfind(scheme, 0) != 0) throw Error(url + ": not a " + scheme + " URL");
+  if (url.rfind(scheme, 0) != 0)
+    throw Error(url + (scheme.rfind("http", 0) == 0 ? ": not an " : ": not a ") + scheme + " URL");
   UrlParts u;
   const size_t slash = url.find('/', scheme.size());
   const std::string authority =
