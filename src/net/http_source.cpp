@@ -1,5 +1,7 @@
 #include "net/http_source.hpp"
 
+#include "net/url.hpp"
+
 #include <utility>  // Boost 1.74 awaitable.hpp uses std::exchange without including it
 
 #include <boost/asio.hpp>
@@ -192,20 +194,10 @@ HttpSource::HttpSource(const std::string& url, Options options) : impl_(std::mak
   Impl& m = *impl_;
   m.url = url;
   m.options = options;
-  const std::string scheme = "http://";
-  if (url.rfind(scheme, 0) != 0) m.fail("not an http:// URL");
-  const size_t slash = url.find('/', scheme.size());
-  const std::string authority =
-      url.substr(scheme.size(), slash == std::string::npos ? slash : slash - scheme.size());
-  m.target = slash == std::string::npos ? "/" : url.substr(slash);
-  const size_t colon = authority.rfind(':');
-  m.host = authority.substr(0, colon);
-  m.port = colon == std::string::npos ? "80" : authority.substr(colon + 1);
-  unsigned port_number = 0;
-  auto [end, ec] = std::from_chars(m.port.data(), m.port.data() + m.port.size(), port_number);
-  if (m.host.empty() || ec != std::errc() || end != m.port.data() + m.port.size() || port_number == 0 ||
-      port_number > 65535)
-    m.fail("malformed URL (expected http://HOST[:PORT]/PATH)");
+  UrlParts parts = split_url(url, "http://");
+  m.host = std::move(parts.host);
+  m.port = std::move(parts.port);
+  m.target = std::move(parts.target);
   m.head();
 }
 

@@ -1,0 +1,46 @@
+// Where a client's transport (pull_fetcher.hpp, push_client.hpp) leaves what arrived, for the frame loop to
+// take at its next frame: so that streaming never blocks a frame (DESIGN.md, Client runtime). Thread-safe;
+// each call holds a mutex for O(1) (put) or O(arrived) (take).
+#pragma once
+
+#include <mutex>
+#include <utility>
+#include <string>
+#include <vector>
+
+#include "schedule/page_scheduler.hpp"
+
+namespace lodstream {
+
+struct ArrivedPage {
+  schedule::PageRef page;
+  std::vector<uint8_t> bytes;  // as stored in the package
+};
+
+class PageInbox {
+ public:
+  void put(ArrivedPage page) {
+    std::lock_guard lock(mutex_);
+    pages_.push_back(std::move(page));
+  }
+  // The transport failed (for good): the reason, once; later failures are dropped.
+  void fail(const std::string& reason) {
+    std::lock_guard lock(mutex_);
+    if (error_.empty()) error_ = reason;
+  }
+  std::vector<ArrivedPage> take() {
+    std::lock_guard lock(mutex_);
+    return std::exchange(pages_, {});
+  }
+  std::string error() const {
+    std::lock_guard lock(mutex_);
+    return error_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<ArrivedPage> pages_;
+  std::string error_;
+};
+
+}  // namespace lodstream

@@ -1,0 +1,41 @@
+// Push transport of a client (DESIGN.md, Serving and the wire): a WebSocket to ws://HOST:PORT/NAME on its own
+// thread and io_context. It sends the Hello, receives the Welcome and then pages (left in a PageInbox for the
+// frame loop), acknowledges every page as it arrives (cumulatively: the latest sequence, with the page's
+// server time echoed), and sends the latest view the frame loop gave it (send_view: the newest replaces one
+// not yet sent). A Bye from the server, a malformed message or a lost connection is reported through the
+// inbox.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "net/page_inbox.hpp"
+#include "net/wire.hpp"
+
+namespace lodstream {
+
+class PushClient {
+ public:
+  // `url`: ws://HOST:PORT/NAME. Returns at once; connecting happens on the client's thread (a failure is
+  // reported through `inbox`). Throws lodstream::Error when the URL is malformed. `inbox` must outlive this.
+  PushClient(const std::string& url, wire::Hello hello, PageInbox& inbox);
+  ~PushClient();  // closes the WebSocket (a normal close) and joins the thread
+  PushClient(const PushClient&) = delete;
+  PushClient& operator=(const PushClient&) = delete;
+
+  void send_view(const wire::ViewUpdate& view);
+  bool welcomed() const { return welcomed_; }
+  uint64_t pages_received() const { return pages_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::atomic<bool> welcomed_{false};
+  std::atomic<uint64_t> pages_{0};
+  std::thread thread_;
+};
+
+}  // namespace lodstream

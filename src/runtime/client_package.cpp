@@ -1,0 +1,66 @@
+#include "runtime/client_package.hpp"
+
+namespace lodstream::runtime {
+
+using schedule::PageKind;
+
+namespace {
+uint64_t key(PageKind kind, uint32_t id) {
+  return uint64_t(kind) << 32 | id;
+}
+}  // namespace
+
+ClientPackage::ClientPackage(package::PackageReader reader, uint64_t cache_bytes)
+    : reader_(std::move(reader)), cache_(cache_bytes), nodes_(reader_, cache_), scheduler_(reader_.root()) {}
+
+void ClientPackage::install(PageKind kind, uint32_t id, std::span<const uint8_t> stored) {
+  if (kind == PageKind::index)
+    reader_.add_index_page(id, stored);
+  else
+    cache_.insert(reader_.header().content_hash, id, reader_.unpack_page(id, stored));
+  scheduler_.set_held(kind, id);
+  in_flight_.erase(key(kind, id));
+  bytes_received_ += stored.size();
+}
+
+void ClientPackage::requested(const schedule::PageRef& page) {
+  scheduler_.set_held(page.kind, page.id);
+  in_flight_.insert(key(page.kind, page.id));
+}
+
+void ClientPackage::dropped(const schedule::PageRef& page) {
+  if (in_flight_.erase(key(page.kind, page.id))) scheduler_.set_held(page.kind, page.id, false);
+}
+
+Frame ClientPackage::frame(const View& view, std::span<const View> predicted, const schedule::CutOptions& options) {
+  Frame f;
+  f.cut = select_cut(reader_.scene(), nodes_, view, options);
+  f.quality = frame_quality(reader_.scene(), nodes_, f.cut, view, options.tau);
+  // Eviction order for the current and predicted views; what the cache let go may be scheduled again.
+  const auto hash = reader_.header().content_hash;
+  const std::vector<uint32_t> cached_pages = cache_.pages(hash);
+  std::vector<uint32_t> cached_nodes;
+  std::unordered_set<uint32_t> cached(cached_pages.begin(), cached_pages.end());
+  for (uint32_t id = 0; id < reader_.node_count(); ++id)
+    if (const package::NodeRecord* r = nodes_.record(id); r && cached.count(r->page))
+      cached_nodes.push_back(id);
+  std::vector<View> views{view};
+  views.insert(views.end(), predicted.begin(), predicted.end());
+  const PageUsefulness u = page_usefulness(reader_.scene(), nodes_, f.cut, views, cached_nodes);
+  cache_.set_usefulness(hash, u.pinned, u.usefulness);
+  if (cache_.evicted_pages() > 0)
+    for (uint32_t page : cached_pages)
+      if (!cache_.contains(hash, page)) scheduler_.set_held(PageKind::data, page, false);
+  return f;
+}
+
+std::vector<uint32_t> ClientPackage::held(PageKind kind) const {
+  std::vector<uint32_t> pages;
+  const size_t count =
+      kind == PageKind::data ? reader_.root().pages.size() : reader_.root().index_pages.size();
+  for (uint32_t id = 0; id < count; ++id)
+    if (scheduler_.held(kind, id) && !in_flight_.count(key(kind, id))) pages.push_back(id);
+  return pages;
+}
+
+}  // namespace lodstream::runtime
