@@ -124,9 +124,9 @@ int run_bake(const BakeArgs& args) {
       const size_t done_here = triangles - std::min(triangles, active);
       if (done_here > reported) report(done_here - reported), reported = done_here;
     };
-    dags[m] = hierarchy::build_cluster_dag(scene.meshes[m], options);
+    dags[m] = hierarchy::build_cluster_dag(std::move(scene.meshes[m]), options);  // the DAG holds it now
     report(triangles - reported);
-    scene.meshes[m] = Mesh{};  // the DAG holds the geometry now
+    scene.meshes[m] = Mesh{};
   });
   std::fprintf(stderr, "\n");
 

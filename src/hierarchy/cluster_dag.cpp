@@ -53,23 +53,23 @@ float round_up(double x) {
 }
 
 // Level 0: the input (without degenerate triangles) split into clusters; position ids by exact welding.
-void build_level0(Builder& b, const Mesh& input) {
-  Mesh mesh;
-  mesh.positions = input.positions, mesh.normals = input.normals, mesh.uvs = input.uvs;
-  mesh.colors = input.colors, mesh.material = input.material;
-  mesh.indices.reserve(input.indices.size());
-  for (size_t t = 0; t + 2 < input.indices.size(); t += 3) {
-    const uint32_t a = input.indices[t], c1 = input.indices[t + 1], c2 = input.indices[t + 2];
+void build_level0(Builder& b, Mesh mesh) {
+  size_t kept = 0;
+  for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const uint32_t a = mesh.indices[t], c1 = mesh.indices[t + 1], c2 = mesh.indices[t + 2];
     if (a == c1 || c1 == c2 || a == c2) continue;
-    mesh.indices.insert(mesh.indices.end(), {a, c1, c2});
+    mesh.indices[kept++] = a, mesh.indices[kept++] = c1, mesh.indices[kept++] = c2;
   }
+  mesh.indices.resize(kept);
   b.dag.input_triangles = mesh.triangle_count();
   if (mesh.indices.empty()) return;
 
-  PositionIndex index(mesh.positions.size());
   std::vector<uint32_t> vertex_id(mesh.positions.size());
-  for (size_t v = 0; v < mesh.positions.size(); ++v) vertex_id[v] = index.insert(mesh.positions[v]);
-  b.next_position_id = uint32_t(index.size());
+  {
+    PositionIndex index(mesh.positions.size());
+    for (size_t v = 0; v < mesh.positions.size(); ++v) vertex_id[v] = index.insert(mesh.positions[v]);
+    b.next_position_id = uint32_t(index.size());
+  }
 
   std::vector<ClusterPart> parts =
       clusterize(mesh, b.options.max_cluster_vertices, b.options.max_cluster_triangles);
@@ -212,9 +212,9 @@ GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
 
 }  // namespace
 
-ClusterDag build_cluster_dag(const Mesh& mesh, const DagOptions& options) {
+ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
   Builder b{options, {}, {}, {}, {}};
-  build_level0(b, mesh);
+  build_level0(b, std::move(mesh));
   ClusterDag& dag = b.dag;
   if (dag.clusters.empty()) return std::move(dag);
   dag.levels = 1;

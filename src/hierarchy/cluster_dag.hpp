@@ -96,7 +96,8 @@ struct ClusterDag {
 // Builds the DAG. Degenerate triangles (a repeated index) are dropped; an empty mesh gives an empty DAG.
 // Cost: about twice the cost of simplifying the whole mesh once (every level simplifies half the previous
 // one), groups of a level in parallel (TBB); memory about 60 bytes per input triangle for the clusters.
-// Never throws on odd input (non-manifold, many tiny components, degenerate).
-ClusterDag build_cluster_dag(const Mesh& mesh, const DagOptions& options = {});
+// Never throws on odd input (non-manifold, many tiny components, degenerate). The mesh is taken by value and
+// released once split into clusters: move it in to avoid a copy (18 bytes per triangle of peak memory).
+ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options = {});
 
 }  // namespace lodstream::hierarchy

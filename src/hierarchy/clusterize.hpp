@@ -15,7 +15,12 @@ struct ClusterPart {
   std::vector<uint32_t> indices;   // three cluster-vertex numbers per triangle
 };
 
-// Clusters of `mesh`'s triangles, every triangle in exactly one. Cost: O(T log T), one core.
+// Clusters per run of the spatial order that is built on its own (in parallel); a run's last cluster may be
+// partly filled and the cut between runs is ragged, so runs are long (1024 clusters).
+inline constexpr size_t kChunkClusters = 1024;
+
+// Clusters of `mesh`'s triangles, every triangle in exactly one. Cost: O(T log T); meshes of more than
+// kChunkClusters clusters use every core.
 std::vector<ClusterPart> clusterize(const Mesh& mesh, size_t max_vertices, size_t max_triangles);
 
 // The cluster's own mesh: positions and every attribute the mesh has, material copied.

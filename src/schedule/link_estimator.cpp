@@ -27,6 +27,17 @@ void LinkEstimator::on_ack(uint32_t sequence, double now_s) {
   auto it = in_flight_.find(sequence);
   if (it == in_flight_.end()) return;
   // Everything up to `sequence` is delivered (acknowledgements are cumulative).
+  // (Before the first acknowledgement the earlier sequences are unknown: scan what is in flight.)
+  if (!any_acked_) {
+    for (auto e = in_flight_.begin(); e != in_flight_.end();) {
+      if (e->first < sequence) {
+        delivered_bytes_ += e->second.bytes;
+        e = in_flight_.erase(e);
+      } else {
+        ++e;
+      }
+    }
+  }
   for (uint32_t s = any_acked_ ? last_acked_ + 1 : sequence; s < sequence; ++s) {
     auto earlier = in_flight_.find(s);
     if (earlier == in_flight_.end()) continue;

@@ -471,12 +471,13 @@ class Simplifier {
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 1024), [&](const auto& r) {
       thread_local std::vector<uint32_t> outs, ins;
       for (uint32_t i = r.begin(); i < r.end(); ++i) {
-        fan(i, outs, ins);
-        for (uint32_t s = offsets_[i], k = 0; s < offsets_[i + 1]; ++s, ++k) {
-          uint32_t j = outs[k];
-          if (!touched_[i] && !touched_[j]) continue;
+        bool have_fan = false;  // the fan only when an edge of i needs re-evaluation
+        for (uint32_t s = offsets_[i]; s < offsets_[i + 1]; ++s) {
           const uint32_t* t = &indices_[3 * size_t(faces_[s])];
-          size_t corner = 3 * size_t(faces_[s]) + (t[0] == i ? 0 : (t[1] == i ? 1 : 2));
+          const uint32_t k = t[0] == i ? 0 : (t[1] == i ? 1 : 2), j = t[(k + 1) % 3];
+          if (!touched_[i] && !touched_[j]) continue;
+          if (!have_fan) fan(i, outs, ins), have_fan = true;
+          size_t corner = 3 * size_t(faces_[s]) + k;
           bool twin = std::find(ins.begin(), ins.end(), j) != ins.end();
           slots_[corner] = (twin && i > j) ? Candidate{std::numeric_limits<float>::infinity(), kNone, kNone}
                                            : evaluate(i, j);
@@ -562,7 +563,14 @@ class Simplifier {
     bool moving[3];
     bool dies;
   };
-  std::vector<Corners> old_;  // neighbour marks (stamp_ = this collapse)
+  std::vector<Corners> old_;
+  struct Segment {  // a projected edge for vertical_bound: origin + t direction, heights and radii at its
+                    // ends
+    glm::dvec2 origin, direction;
+    double h0, h1, r0, r1;
+  };
+  std::vector<Segment> old_edges_, spokes_;  // spokes: direction from x, origin unused
+  // neighbour marks (stamp_ = this collapse)
   uint32_t stamp_ = 0;
 
   // Validity (link condition, boundary pinch, lost surface, normal change), bound, then the collapse.
@@ -776,26 +784,33 @@ class Simplifier {
       }
       if (!found) return kInf;
     }
-    // Old edges at a or b against new edges at x.
+    // Old edges at a or b against new edges at x: both lists once, then every pair (division-free rejection
+    // first: most pairs do not cross).
+    old_edges_.clear(), spokes_.clear();
     for (const Corners& c : old_)
       for (int i = 0; i < 3; ++i) {
         const int j = (i + 1) % 3;
-        if (!c.moving[i]) continue;  // each edge at a or b leaves a or b in exactly one of its faces
-        const glm::dvec2 o0 = c.y[i], od = c.y[j] - c.y[i];
-        for (const Corners& e : old_) {
-          if (e.dies) continue;
-          for (int k = 0; k < 3; ++k) {
-            if (!e.moving[(k + 2) % 3]) continue;  // the new edge x -> ring vertex k (once per spoke)
-            const glm::dvec2 nd = e.y[k] - yx;
-            double den = cross2(nd, od);
-            if (std::abs(den) < 1e-30) continue;
-            double s = cross2(o0 - yx, od) / den, t = cross2(o0 - yx, nd) / den;
-            if (!(s > 0 && s < 1 && t > 0 && t < 1)) continue;
-            double gap = std::abs((1 - s) * hx + s * e.h[k] - ((1 - t) * c.h[i] + t * c.h[j]));
-            if (!require(1 - s, s * e.r[k], gap + (1 - t) * c.r[i] + t * c.r[j])) return kInf;
-          }
-        }
+        if (c.moving[i])  // each edge at a or b leaves a or b in exactly one of its faces
+          old_edges_.push_back({c.y[i], c.y[j] - c.y[i], c.h[i], c.h[j], c.r[i], c.r[j]});
+        if (!c.dies && c.moving[(i + 2) % 3])  // the new edge x -> ring vertex i (once per spoke)
+          spokes_.push_back({{}, c.y[i] - yx, c.h[i], 0.0, c.r[i], 0.0});
       }
+    for (const Segment& o : old_edges_) {
+      const glm::dvec2 rel = o.origin - yx;
+      for (const Segment& e : spokes_) {
+        const double den = cross2(e.direction, o.direction);
+        if (std::abs(den) < 1e-30) continue;
+        // s = cross2(rel, od) / den, t = cross2(rel, nd) / den, both strictly inside (0, 1).
+        const double sn = cross2(rel, o.direction), tn = cross2(rel, e.direction);
+        if (den > 0 ? (sn <= 0 || sn >= den || tn <= 0 || tn >= den)
+                    : (sn >= 0 || sn <= den || tn >= 0 || tn <= den))
+          continue;
+        const double s = sn / den, t = tn / den;
+        if (!(s > 0 && s < 1 && t > 0 && t < 1)) continue;
+        const double gap = std::abs((1 - s) * hx + s * e.h0 - ((1 - t) * o.h0 + t * o.h1));
+        if (!require(1 - s, s * e.r0, gap + (1 - t) * o.r0 + t * o.r1)) return kInf;
+      }
+    }
     return need;
   }
 

@@ -87,3 +87,15 @@ TEST(LinkEstimator, IdleGapsAndAppLimitedSamplesDoNotLowerTheEstimate) {
   EXPECT_EQ(estimator.bytes_in_flight(), 0u);
   EXPECT_DOUBLE_EQ(estimator.bandwidth_bps(), before);
 }
+
+TEST(LinkEstimator, TheFirstAcknowledgementIsCumulativeToo) {
+  LinkEstimator e;
+  e.on_send(1, 1000, 0.0);
+  e.on_send(2, 1000, 0.0);
+  e.on_send(3, 500, 0.0);
+  EXPECT_EQ(e.bytes_in_flight(), 2500u);
+  e.on_ack(2, 0.1);  // covers 1 and 2
+  EXPECT_EQ(e.bytes_in_flight(), 500u);
+  e.on_ack(3, 0.2);
+  EXPECT_EQ(e.bytes_in_flight(), 0u);
+}

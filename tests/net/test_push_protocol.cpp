@@ -1,0 +1,154 @@
+#include <gtest/gtest.h>
+
+#include "net/push_protocol.hpp"
+#include "support/dag_package.hpp"
+
+using namespace lodstream;
+using schedule::PageKind;
+
+namespace {
+
+struct Fixture {
+  test::DagPackage dag;
+  std::shared_ptr<const PushPackage> package =
+      std::make_shared<const PushPackage>("dag", std::make_shared<const package::PackageReader>(dag.reader));
+  size_t total_pages = dag.reader.root().pages.size() + dag.reader.root().index_pages.size();
+};
+
+wire::Hello hello() {
+  wire::Hello h;
+  h.package = "dag";
+  h.cache_budget_bytes = 64u << 20;
+  h.viewport_width = 1280;
+  h.viewport_height = 720;
+  return h;
+}
+
+wire::ViewUpdate view(glm::vec3 eye, glm::vec3 forward) {
+  wire::ViewUpdate v;
+  v.eye = eye;
+  v.forward = glm::normalize(forward);
+  v.up = {0, 1, 0};
+  v.viewport_width = 1280;
+  v.viewport_height = 720;
+  return v;
+}
+
+schedule::View view_of(const wire::ViewUpdate& v) {
+  schedule::ViewSample s;
+  s.eye = v.eye;
+  s.forward = v.forward;
+  s.up = v.up;
+  s.fov_y_radians = v.fov_y_radians;
+  return schedule::view_of(s);
+}
+
+}  // namespace
+
+TEST(PushProtocol, AHelloForThisPackageComesFirst) {
+  Fixture f;
+  {
+    PushProtocol p(f.package);
+    EXPECT_THROW(p.on_message(wire::Ack{1, 0, 0, 0}, 0.0), wire::WireError);
+  }
+  {
+    PushProtocol p(f.package);
+    wire::Hello h = hello();
+    h.package = "other";
+    EXPECT_THROW(p.on_message(h, 0.0), wire::WireError);
+  }
+  PushProtocol p(f.package);
+  EXPECT_FALSE(p.next_page(0.0));  // nothing before the hello
+  auto welcome = p.on_message(hello(), 0.0);
+  ASSERT_TRUE(welcome && std::holds_alternative<wire::Welcome>(*welcome));
+  EXPECT_EQ(std::get<wire::Welcome>(*welcome).package_hash, f.dag.reader.header().content_hash);
+  EXPECT_THROW(p.on_message(hello(), 0.1), wire::WireError);                // a second hello
+  EXPECT_THROW(p.on_message(wire::Welcome{}, 0.1), wire::WireError);        // a server's message
+  EXPECT_THROW(p.on_message(wire::Ack{5, 0, 0, 0}, 0.1), wire::WireError);  // never sent
+}
+
+// On a virtual clock with a 50 ms round trip: the view's pages come first (records before the pages that need
+// them, within the window, never a held page), the view's cut completes before the rest of the package is
+// sent, and with the idle fill the rest follows until everything is sent once.
+TEST(PushProtocol, PushesTheViewsCutFirstThenFillsWithinTheWindow) {
+  Fixture f;
+  PushProtocolOptions options;
+  options.min_window_bytes = 4000;
+  PushProtocol p(f.package, options);
+  wire::Hello h = hello();
+  h.cached_hash = f.dag.reader.header().content_hash;
+  const uint32_t held_page = f.dag.page_of(f.dag.dag.roots[0]);
+  h.held = {{held_page, 1}};
+  p.on_message(h, 0.0);
+  const wire::ViewUpdate v = view({2, 0, 3}, {0, 0, -1});
+  p.on_message(v, 0.0);
+  test::Held client(f.dag.all, p.scheduler());
+  std::set<std::pair<int, uint32_t>> sent;
+  double t = 0.0, converged_at_pages = -1;
+  for (int round = 0; round < 200 && !p.everything_sent(); ++round) {
+    uint32_t last = 0;
+    while (auto page = p.next_page(t)) {
+      EXPECT_TRUE(sent.insert({int(page->page.kind), page->page.id}).second) << "page sent twice";
+      EXPECT_FALSE(page->page.kind == PageKind::data && page->page.id == held_page);
+      EXPECT_LE(p.link().bytes_in_flight(), p.window_bytes() + 1000);
+      if (page->page.kind == PageKind::data) {
+        for (uint32_t n = 0; n < f.dag.all.size(); ++n) {
+          if (f.dag.page_of(n) == page->page.id) {
+            EXPECT_TRUE(p.scheduler().record_held(n)) << "node " << n;
+          }
+        }
+      }
+      last = page->sequence;
+      if (converged_at_pages < 0 &&
+          schedule::select_cut(f.dag.scene(), client, view_of(v), {1.0}).converged())
+        converged_at_pages = double(sent.size());
+    }
+    t += 0.05;
+    if (last) p.on_message(wire::Ack{last, 0, t, 0}, t);
+  }
+  EXPECT_TRUE(p.everything_sent());
+  EXPECT_EQ(sent.size(), f.total_pages - 1);
+  ASSERT_GT(converged_at_pages, 0);
+  EXPECT_LT(converged_at_pages, double(f.total_pages - 1));
+  EXPECT_DOUBLE_EQ(p.ack_deadline(), INFINITY);
+}
+
+TEST(PushProtocol, WithoutTheIdleFillANewViewRestartsSending) {
+  Fixture f;
+  PushProtocolOptions options;
+  options.fill_when_idle = false;
+  PushProtocol p(f.package, options);
+  p.on_message(hello(), 0.0);
+  EXPECT_FALSE(p.next_page(0.0));  // no view: nothing to send
+  p.on_message(view({2, 0, 3}, {0, 0, -1}), 0.0);
+  double t = 0.0;
+  auto drain = [&] {
+    size_t n = 0;
+    for (int round = 0; round < 100; ++round) {
+      uint32_t last = 0;
+      while (auto page = p.next_page(t)) last = page->sequence, ++n;
+      t += 0.05;
+      if (!last) break;
+      p.on_message(wire::Ack{last, 0, t, 0}, t);
+    }
+    return n;
+  };
+  const size_t first = drain();
+  EXPECT_GT(first, 0u);
+  EXPECT_FALSE(p.everything_sent());
+  EXPECT_FALSE(p.next_page(t));
+  p.on_message(view({14, 0, 3}, {0, 0, -1}), t);  // the other end of the DAG
+  EXPECT_GT(drain(), 0u);
+}
+
+TEST(PushProtocol, AClientThatAcknowledgesNothingTimesOut) {
+  Fixture f;
+  PushProtocolOptions options;
+  options.ack_timeout_s = 5.0;
+  PushProtocol p(f.package, options);
+  p.on_message(hello(), 0.0);
+  ASSERT_TRUE(p.next_page(1.0));  // the idle fill
+  EXPECT_DOUBLE_EQ(p.ack_deadline(), 6.0);
+  EXPECT_NO_THROW(p.check_timeout(5.9));
+  EXPECT_THROW(p.check_timeout(6.1), wire::WireError);
+}
