@@ -419,8 +419,10 @@ int run_bench_stream(const StreamArgs& args) {
   const std::string md =
       std::string(head) + summary_table(policies, summaries) +
       "\nBenefit AUC: mean benefit ratio over the window (path + settle). PSNR against the "
-      "package's finest cut from the same camera (simulated mode; frame times from the cost "
-      "model).\n";
+      "package's finest cut from the same camera (99.0: identical; '-': nothing sampled yet); a "
+      "policy's PSNR at t is its last sampled frame at or before t. Simulated mode; frame times from the "
+      "cost "
+      "model.\n";
   write_text(out / "summary.md", md);
   plot(out, policies, window_s);
   if (args.json)
