@@ -52,8 +52,8 @@ void write_exact(int fd, const void* p, size_t n) {
   }
 }
 
-// One connection: the first byte says what it is. 'P': echo each byte until end of stream. 'B': read until end
-// of stream, then answer with the receiver's throughput (bits per second between first and last byte).
+// One connection: the first byte says what it is. 'P': echo each byte until end of stream. 'B': read until
+// end of stream, then answer with the receiver's throughput (bits per second between first and last byte).
 void session(int fd) {
   char mode = 0;
   if (!read_exact(fd, &mode, 1)) return close(fd), void();
@@ -121,8 +121,8 @@ int main(int argc, char** argv) {
     double bps = 0;
     if (!read_exact(fd, &bps, sizeof bps)) fail("bulk");
     close(fd);
-    std::printf("{\"rtt_ms\": %.2f, \"throughput_mbit\": %.3f, \"bytes\": %zu}\n", rtts[rtts.size() / 2], bps / 1e6,
-                bytes);
+    std::printf("{\"rtt_ms\": %.2f, \"throughput_mbit\": %.3f, \"bytes\": %zu}\n", rtts[rtts.size() / 2],
+                bps / 1e6, bytes);
     return 0;
   }
   std::fprintf(stderr, "usage: bench_link_probe serve ADDR PORT | measure ADDR PORT BYTES\n");

@@ -9,7 +9,8 @@
 
 int main(int argc, char** argv) {
   using namespace lodstream;
-  CLI::App app{"lodstream: stream large 3D scenes to clients that render them at a bounded frame time.", "lodstream"};
+  CLI::App app{"lodstream: stream large 3D scenes to clients that render them at a bounded frame time.",
+               "lodstream"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "lodstream 0.1.0");
   std::function<int()> run;

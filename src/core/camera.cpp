@@ -9,7 +9,9 @@
 
 namespace lodstream {
 
-glm::mat4 Camera::view() const { return glm::lookAt(eye, target, up); }
+glm::mat4 Camera::view() const {
+  return glm::lookAt(eye, target, up);
+}
 
 glm::mat4 Camera::projection(float near_plane, float far_plane) const {
   return glm::perspective(glm::radians(fov_y_degrees), aspect(), near_plane, far_plane);
@@ -17,7 +19,8 @@ glm::mat4 Camera::projection(float near_plane, float far_plane) const {
 
 void validate_camera(const Camera& c, const std::string& where) {
   auto finite = [](glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
-  if (!finite(c.eye) || !finite(c.target) || !finite(c.up)) throw Error(where + ": camera has a non-finite coordinate");
+  if (!finite(c.eye) || !finite(c.target) || !finite(c.up))
+    throw Error(where + ": camera has a non-finite coordinate");
   glm::vec3 dir = c.target - c.eye;
   if (glm::length(dir) <= 0.0f) throw Error(where + ": camera eye and target are the same point");
   if (glm::length(glm::cross(glm::normalize(dir), c.up)) < 1e-6f)

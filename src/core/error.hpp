@@ -1,5 +1,5 @@
-// Errors: every failure lodstream reports to a user is an lodstream::Error whose message is one line that names
-// what is wrong and where (a file, a byte offset, an argument). The command line prints it as
+// Errors: every failure lodstream reports to a user is an lodstream::Error whose message is one line that
+// names what is wrong and where (a file, a byte offset, an argument). The command line prints it as
 // "lodstream: error: <message>" and exits 1.
 #pragma once
 

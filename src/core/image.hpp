@@ -18,11 +18,13 @@ struct Image {
   const uint8_t* pixel(int x, int y) const { return &rgba[(size_t(y) * size_t(width) + size_t(x)) * 4]; }
 };
 
-// Reads a PNG (or any format stb_image reads) as RGBA. Throws lodstream::Error naming the file and stb's reason.
+// Reads a PNG (or any format stb_image reads) as RGBA. Throws lodstream::Error naming the file and stb's
+// reason.
 Image load_image(const std::filesystem::path& file);
 
-// Writes a PNG: to a temporary file in the same folder, then renamed over `file`, so an interrupted write never
-// leaves a broken image. Deterministic: the same pixels give the same bytes. Throws lodstream::Error on failure.
+// Writes a PNG: to a temporary file in the same folder, then renamed over `file`, so an interrupted write
+// never leaves a broken image. Deterministic: the same pixels give the same bytes. Throws lodstream::Error on
+// failure.
 void save_png(const Image& image, const std::filesystem::path& file);
 
 // Writes `bytes` to `file` through a temporary file in the same folder and a rename (atomic replace).

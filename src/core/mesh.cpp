@@ -7,7 +7,8 @@ void compute_smooth_normals(Mesh& mesh) {
   for (size_t t = 0; t < mesh.triangle_count(); ++t) {
     const uint32_t* v = &mesh.indices[3 * t];
     // The unnormalized cross product weights each face by its area.
-    glm::vec3 n = glm::cross(mesh.positions[v[1]] - mesh.positions[v[0]], mesh.positions[v[2]] - mesh.positions[v[0]]);
+    glm::vec3 n =
+        glm::cross(mesh.positions[v[1]] - mesh.positions[v[0]], mesh.positions[v[2]] - mesh.positions[v[0]]);
     for (int k = 0; k < 3; ++k) mesh.normals[v[k]] += n;
   }
   for (auto& n : mesh.normals) {

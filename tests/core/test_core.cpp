@@ -4,8 +4,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/camera.hpp"
-#include "core/image.hpp"
 #include "core/error.hpp"
+#include "core/image.hpp"
 #include "core/scene.hpp"
 #include "support/run.hpp"
 #include "support/shapes.hpp"
@@ -75,11 +75,11 @@ TEST(Camera, LoadsFileWithDefaults) {
 }
 
 TEST(Camera, RejectsBadFilesWithOneLineErrors) {
-  for (const char* text : {"{", "[]", R"({"eye": [0,0,0]})", R"({"eye": [0,0,0], "target": [0,0,0]})",
-                           R"({"eye": [0,0,1], "target": [0,0,0], "up": [0,0,1]})",
-                           R"({"eye": [0,0,1], "target": [0,0,0], "fov": 200})",
-                           R"({"eye": [0,0,1], "target": [0,0,0], "size": [0, 10]})",
-                           R"({"eye": "x", "target": [0,0,0]})"}) {
+  for (const char* text :
+       {"{", "[]", R"({"eye": [0,0,0]})", R"({"eye": [0,0,0], "target": [0,0,0]})",
+        R"({"eye": [0,0,1], "target": [0,0,0], "up": [0,0,1]})",
+        R"({"eye": [0,0,1], "target": [0,0,0], "fov": 200})",
+        R"({"eye": [0,0,1], "target": [0,0,0], "size": [0, 10]})", R"({"eye": "x", "target": [0,0,0]})"}) {
     try {
       load_camera(write(text));
       ADD_FAILURE() << "accepted " << text;

@@ -27,7 +27,9 @@ Mesh sphere_impl(float r, int rings, int segments, bool with_uvs) {
   m.positions.push_back({0, -r, 0});
   m.normals.push_back({0, -1, 0});
   if (with_uvs) m.uvs.push_back({0.5f, 0.0f});
-  auto ring = [&](int i, int j) { return uint32_t(1 + (i - 1) * ring_verts + (with_uvs ? j : j % segments)); };
+  auto ring = [&](int i, int j) {
+    return uint32_t(1 + (i - 1) * ring_verts + (with_uvs ? j : j % segments));
+  };
   for (int j = 0; j < segments; ++j) {
     m.indices.insert(m.indices.end(), {0u, ring(1, j + 1), ring(1, j)});
     m.indices.insert(m.indices.end(), {south, ring(rings - 1, j), ring(rings - 1, j + 1)});
@@ -41,8 +43,12 @@ Mesh sphere_impl(float r, int rings, int segments, bool with_uvs) {
 }
 }  // namespace
 
-Mesh sphere(float r, int rings, int segments) { return sphere_impl(r, rings, segments, false); }
-Mesh uv_sphere(float r, int rings, int segments) { return sphere_impl(r, rings, segments, true); }
+Mesh sphere(float r, int rings, int segments) {
+  return sphere_impl(r, rings, segments, false);
+}
+Mesh uv_sphere(float r, int rings, int segments) {
+  return sphere_impl(r, rings, segments, true);
+}
 
 Mesh grid(int n, float z0) {
   Mesh m;
@@ -80,8 +86,8 @@ Mesh cube_with_seams(int s) {
       auto at = [&](int i, int j) { return base + uint32_t(j * (s + 1) + i); };
       for (int j = 0; j < s; ++j)
         for (int i = 0; i < s; ++i)
-          m.indices.insert(m.indices.end(),
-                           {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+          m.indices.insert(m.indices.end(), {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j),
+                                             at(i + 1, j + 1), at(i, j + 1)});
     }
   return m;
 }
@@ -89,7 +95,7 @@ Mesh cube_with_seams(int s) {
 Mesh non_manifold() {
   Mesh m;
   m.positions = {{0, 0, 0}, {1, 0, 0}, {0.5f, 1, 0}, {0.5f, -1, 0}, {0.5f, 0, 1},  // fan of 3 on edge 0-1
-                 {2, 0, 0}, {3, 1, 0}, {3, -1, 0}, {1, 1, 1}, {1, -1, 1}};         // bowtie at vertex 1
+                 {2, 0, 0}, {3, 1, 0}, {3, -1, 0},   {1, 1, 1},     {1, -1, 1}};   // bowtie at vertex 1
   m.indices = {0, 1, 2, 1, 0, 3, 0, 1, 4, 1, 5, 6, 1, 7, 5, 1, 8, 9};
   return m;
 }
