@@ -111,6 +111,15 @@ schedule::CameraPath camera_path(const StreamArgs& args, const package::PackageS
   return schedule::generate_path(args.path.substr(4), world_bounds(scene), options);
 }
 
+// DESIGN.md's camera path JSON of `path` (what load_camera_path reads back): the run's path, recorded.
+nlohmann::json path_json(const schedule::CameraPath& path) {
+  auto vec = [](glm::vec3 v) { return nlohmann::json::array({v.x, v.y, v.z}); };
+  nlohmann::json keyframes = nlohmann::json::array();
+  for (const schedule::Keyframe& k : path.keyframes())
+    keyframes.push_back({{"t", k.t}, {"eye", vec(k.eye)}, {"target", vec(k.target)}, {"up", vec(k.up)}});
+  return {{"fov", path.fov_y_degrees()}, {"size", {path.width(), path.height()}}, {"keyframes", keyframes}};
+}
+
 // Image metrics of the sampled frames: PSNR and SSIM of each policy's frame against the full-resolution
 // frame from the same camera.
 class FrameRenderer {
@@ -400,6 +409,7 @@ int run_bench_stream(const StreamArgs& args) {
       {"pixel_error", args.tau},
       {"mode", "simulated"}};
   write_text(out / "summary.json", summary.dump(2) + "\n");
+  write_text(out / "path.json", path_json(path).dump() + "\n");
   char head[512];
   std::snprintf(head, sizeof head,
                 "# bench stream: %s, path %s (%.1f s + %.1f s settle), link %.3g Mbit/s, RTT %.0f ms%s\n\n",
@@ -409,8 +419,10 @@ int run_bench_stream(const StreamArgs& args) {
   const std::string md =
       std::string(head) + summary_table(policies, summaries) +
       "\nBenefit AUC: mean benefit ratio over the window (path + settle). PSNR against the "
-      "package's finest cut from the same camera (simulated mode; frame times from the cost "
-      "model).\n";
+      "package's finest cut from the same camera (99.0: identical; '-': nothing sampled yet); a "
+      "policy's PSNR at t is its last sampled frame at or before t. Simulated mode; frame times from the "
+      "cost "
+      "model.\n";
   write_text(out / "summary.md", md);
   plot(out, policies, window_s);
   if (args.json)
@@ -418,7 +430,7 @@ int run_bench_stream(const StreamArgs& args) {
   else
     std::printf(
         "%s\nwritten to %s: summary.md, summary.json, POLICY.csv, benefit.png, psnr.png, bytes.png, "
-        "frames/\n",
+        "path.json, frames/\n",
         md.c_str(), out.c_str());
   return 0;
 }

@@ -25,15 +25,16 @@ using schedule::View;
 class ArrivedNodes final : public schedule::NodeSource {
  public:
   explicit ArrivedNodes(const PackageFacts& p)
-      : index_pages_(p.index_page_bytes.size(), 0), pages_(p.page_bytes.size(), 0), p_(&p) {}
+      : index_pages(p.index_page_bytes.size(), 0), pages(p.page_bytes.size(), 0), p_(&p) {}
 
   const package::NodeRecord* record(uint32_t id) const override {
-    if (id >= p_->nodes.size()) return nullptr;
-    return id < p_->root_nodes || index_pages_[p_->index_page_of[id]] ? &p_->nodes[id] : nullptr;
+    if (!root || id >= p_->nodes.size()) return nullptr;
+    return id < p_->root_nodes || index_pages[p_->index_page_of[id]] ? &p_->nodes[id] : nullptr;
   }
-  bool available(uint32_t id) const override { return record(id) && pages_[p_->nodes[id].page]; }
+  bool available(uint32_t id) const override { return record(id) && pages[p_->nodes[id].page]; }
 
-  std::vector<uint8_t> index_pages_, pages_;  // 1 once arrived
+  bool root = false;                        // the root index arrived
+  std::vector<uint8_t> index_pages, pages;  // 1 once arrived
 
  private:
   const PackageFacts* p_;
@@ -230,52 +231,48 @@ Cut finest_cut(const PackageFacts& package, const View& view) {
 namespace {
 
 // Each policy's transfer logic; the frame loop (simulate) is shared.
-class Policy_ {
+class Transfers {
  public:
-  virtual ~Policy_() = default;
+  virtual ~Transfers() = default;
   // Before the frame at `t`: server-side work due by t (pushes).
   virtual void serve(double /*t*/) {}
   // A transfer arrived (already applied to what the client holds).
   virtual void on_arrival(const Transfer& /*transfer*/, double /*t*/) {}
   // After the frame at `t` was selected: the client's requests or messages.
-  virtual void after_frame(double t, const Cut& cut) = 0;
+  virtual void after_frame(double t, const View& view, const Cut& cut) = 0;
 };
 
-// sse-pull and sse-pull-3: the current cut's missing nodes, in its order, give the pages to request.
-class SsePull final : public Policy_ {
+// sse-pull and sse-pull-3: the scheduler's sse-pull ranking (PageScheduler::next_sse: the pages of the nodes
+// the current view's ideal cut misses, in decreasing order of the projected error their arrival removes,
+// counting what is requested as held), up to `window` requests outstanding.
+class SsePull final : public Transfers {
  public:
-  SsePull(const PackageFacts& p, Link& link, size_t window)
-      : p_(&p),
-        link_(&link),
-        window_(window),
-        pages_(p.page_bytes.size(), 0),
-        index_(p.index_page_bytes.size(), 0) {}
-  void after_frame(double t, const Cut& cut) override {
-    for (const schedule::MissingNode& m : cut.missing) {
-      if (link_->outstanding() >= window_) break;
-      if (!m.record_known) {
-        const uint32_t ip = p_->index_page_of[m.node];
-        if (std::exchange(index_[ip], 1)) continue;
-        link_->request(t, Transfer::index_page, ip, p_->index_page_bytes[ip]);
-      } else {
-        const uint32_t page = p_->nodes[m.node].page;
-        if (std::exchange(pages_[page], 1)) continue;
-        link_->request(t, Transfer::page, page, p_->page_bytes[page]);
-      }
+  SsePull(const PackageFacts& p, Link& link, const ArrivedNodes& arrived, size_t window, double tau)
+      : p_(&p), link_(&link), arrived_(&arrived), window_(window), tau_(tau), scheduler_(p.reader->root()) {}
+  void after_frame(double t, const View& view, const Cut&) override {
+    if (!arrived_->root || link_->outstanding() >= window_) return;
+    const size_t room = window_ - link_->outstanding();
+    for (const schedule::PageRef& page :
+         scheduler_.next_sse(p_->scene, *arrived_, view, {tau_, UINT64_MAX, room})) {
+      scheduler_.set_held(page.kind, page.id);
+      link_->request(t, page.kind == schedule::PageKind::index ? Transfer::index_page : Transfer::page,
+                     page.id, page.bytes);
     }
   }
 
  private:
   const PackageFacts* p_;
   Link* link_;
+  const ArrivedNodes* arrived_;
   size_t window_;
-  std::vector<uint8_t> pages_, index_;  // requested
+  double tau_;
+  schedule::PageScheduler scheduler_;
 };
 
 // push: the client sends hello, a view update every frame and an ack for what arrived; the server is the
 // real sans-I/O protocol core (net/push_protocol.hpp), fed each message when it reaches the server and
 // asked for pages then.
-class Push final : public Policy_ {
+class Push final : public Transfers {
  public:
   Push(const PackageFacts& p, Link& link, const schedule::CameraPath& path, const SimOptions& options)
       : link_(&link), path_(&path), frame_s_(1.0 / options.fps) {
@@ -305,7 +302,7 @@ class Push final : public Policy_ {
     received_ += tr.bytes;
     if (tr.sequence) last_ = tr;
   }
-  void after_frame(double t, const Cut&) override {
+  void after_frame(double t, const View&, const Cut&) override {
     if (!open_) return;
     if (!hello_sent_) {
       wire::Hello h;
@@ -343,7 +340,7 @@ class Push final : public Policy_ {
 // the path instead of predicted ones, and the true link: at each frame it tops what is in flight up to
 // window_bdp bandwidth-delay products (as the push server's window, from the true bandwidth and RTT).
 // Nothing is sent once every view's ideal cut is sent (no idle fill: it would add bytes, not benefit).
-class Oracle final : public Policy_ {
+class Oracle final : public Transfers {
  public:
   Oracle(const PackageFacts& p, Link& link, const schedule::CameraPath& path, const SimOptions& options)
       : p_(&p), link_(&link), path_(&path), options_(options), scheduler_(p.reader->root()), records_(p) {}
@@ -369,7 +366,7 @@ class Oracle final : public Policy_ {
                            page.id, 0.0, pushed_page_bytes(page.bytes)});
     }
   }
-  void after_frame(double, const Cut&) override {}
+  void after_frame(double, const View&, const Cut&) override {}
 
  private:
   const PackageFacts* p_;
@@ -381,7 +378,7 @@ class Oracle final : public Policy_ {
 };
 
 // full: after the root index, one request for every finest-level page, answered as one stream.
-class Full final : public Policy_ {
+class Full final : public Transfers {
  public:
   Full(const PackageFacts& p, Link& link) : p_(&p), link_(&link) {}
   void on_arrival(const Transfer& tr, double t) override {
@@ -390,7 +387,7 @@ class Full final : public Policy_ {
     for (uint32_t page : finest_pages(*p_)) all += p_->page_bytes[page];
     link_->request(t, Transfer::all_finest, 0, all);
   }
-  void after_frame(double, const Cut&) override {}
+  void after_frame(double, const View&, const Cut&) override {}
 
  private:
   const PackageFacts* p_;
@@ -406,19 +403,19 @@ SimResult simulate(const PackageFacts& package, const schedule::CameraPath& path
   Link link(options.link);
   ArrivedNodes arrived(package);
   AllNodes all(package);
-  bool root_arrived = false, finest_arrived = false;
+  bool finest_arrived = false;
   uint64_t bytes = 0;
   link.request(0.0, Transfer::root, 0, package.root_fetch_bytes);
-  std::unique_ptr<Policy_> transfers;
+  std::unique_ptr<Transfers> transfers;
   switch (policy) {
     case Policy::full:
       transfers = std::make_unique<Full>(package, link);
       break;
     case Policy::sse_pull:
-      transfers = std::make_unique<SsePull>(package, link, 20);
+      transfers = std::make_unique<SsePull>(package, link, arrived, 20, options.tau);
       break;
     case Policy::sse_pull_3:
-      transfers = std::make_unique<SsePull>(package, link, 3);
+      transfers = std::make_unique<SsePull>(package, link, arrived, 3, options.tau);
       break;
     case Policy::push:
       transfers = std::make_unique<Push>(package, link, path, options);
@@ -449,9 +446,9 @@ SimResult simulate(const PackageFacts& package, const schedule::CameraPath& path
     Transfer tr;
     while (link.arrived(t, tr)) {
       bytes += tr.bytes;
-      if (tr.kind == Transfer::root) root_arrived = true;
-      if (tr.kind == Transfer::index_page) arrived.index_pages_[tr.id] = 1;
-      if (tr.kind == Transfer::page) arrived.pages_[tr.id] = 1;
+      if (tr.kind == Transfer::root) arrived.root = true;
+      if (tr.kind == Transfer::index_page) arrived.index_pages[tr.id] = 1;
+      if (tr.kind == Transfer::page) arrived.pages[tr.id] = 1;
       if (tr.kind == Transfer::all_finest) finest_arrived = true;
       transfers->on_arrival(tr, t);
     }
@@ -461,7 +458,7 @@ SimResult simulate(const PackageFacts& package, const schedule::CameraPath& path
     row.t = t;
     row.bytes = bytes;
     Cut cut;
-    if (root_arrived) {
+    if (arrived.root) {
       if (policy == Policy::full) {
         if (finest_arrived) {
           cut = finest_cut(package, view);
@@ -483,7 +480,7 @@ SimResult simulate(const PackageFacts& package, const schedule::CameraPath& path
       row.pixel_error_mean = q.pixel_error_mean;
       row.benefit_ratio = q.benefit_ratio;
     }
-    transfers->after_frame(t, cut);
+    transfers->after_frame(t, view, cut);
     row.frame_ms = options.cost.frame_ms(row.triangles);
     result.frames.push_back(row);
     const bool last = k == last_frame || (k >= path_frames && row.converged);

@@ -15,9 +15,10 @@
 //   with
 //               no children), in file order, answered as one stream; nothing is drawn until all have arrived,
 //               then the finest cut (every finest node of every object in the frustum);
-//   sse-pull    each frame, the current cut's missing nodes in its order (decreasing projected error of what
-//               their arrival replaces; an unknown record asks for its index page) give the pages to request,
-//               up to 20 requests outstanding (cesium-native's default);
+//   sse-pull    each frame, the scheduler's sse-pull ranking (schedule::PageScheduler::next_sse: the pages of
+//               the nodes the view's ideal cut misses, counting requested pages as held, in decreasing order
+//               of the projected error their arrival removes; an unknown record asks for its index page
+//               first) gives the pages to request, up to 20 requests outstanding (cesium-native's default);
 //   sse-pull-3  the same with 3 (Nexus's default);
 //   push        a WebSocket (its upgrade costs one request and answer, alongside the root index's request),
 //               then hello, a view update every frame (pose, and velocities measured over the last frame) and

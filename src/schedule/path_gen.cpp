@@ -40,8 +40,8 @@ void sample(std::vector<Keyframe>& out, double t0, double t1, glm::vec3 up,
             const std::function<std::pair<glm::vec3, glm::vec3>(float)>& pose) {
   const int steps = std::max(1, int(std::lround((t1 - t0) / kStep)));
   for (int i = out.empty() ? 0 : 1; i <= steps; ++i) {
-    const float s = float(i) / float(steps);
-    const auto [eye, target] = pose(s);
+    const double s = double(i) / double(steps);
+    const auto [eye, target] = pose(float(s));
     out.push_back({t0 + (t1 - t0) * s, eye, target, up});
   }
 }
