@@ -28,8 +28,8 @@ struct HttpServerTest : ::testing::Test {
     for (int i = 0; i < 300000; ++i) content.push_back(char('a' + (i * 7) % 26));
     auto path = test::temp_dir() / "scene.lods";
     std::ofstream(path, std::ios::binary) << content;
-    server =
-        std::make_unique<HttpServer>("127.0.0.1", 0, std::vector<ServedFile>{{"scene.lods", path, "abc123"}});
+    server = std::make_unique<HttpServer>("127.0.0.1", 0,
+                                          std::vector<ServedFile>{{"scene.lods", path, "abc123", nullptr}});
     stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), server->port()));
   }
 
@@ -125,6 +125,6 @@ TEST_F(HttpServerTest, GarbageOnOneConnectionDoesNotAffectAnother) {
 }
 
 TEST(HttpServer, MissingFileAndBadAddressAreErrors) {
-  EXPECT_THROW(HttpServer("127.0.0.1", 0, {{"x.lods", "/nonexistent/x.lods", "1"}}), Error);
+  EXPECT_THROW(HttpServer("127.0.0.1", 0, {{"x.lods", "/nonexistent/x.lods", "1", nullptr}}), Error);
   EXPECT_THROW(HttpServer("localhost", 0, {}), Error);
 }

@@ -38,7 +38,7 @@ TEST(HttpSource, PackageReaderOverHttpReadsWhatTheFileHolds) {
   auto written = test::write_raw_package(file, 40, 0);
   ASSERT_GT(written.pages, 3u);
   ASSERT_GT(written.index_pages, 1u);
-  HttpServer server("127.0.0.1", 0, {{"scene.lods", file, written.content_hash.hex()}});
+  HttpServer server("127.0.0.1", 0, {{"scene.lods", file, written.content_hash.hex(), nullptr}});
   const std::string url = "http://127.0.0.1:" + std::to_string(server.port()) + "/scene.lods";
   auto source = std::make_shared<HttpSource>(url);
   EXPECT_EQ(source->size(), written.bytes);
@@ -82,7 +82,7 @@ TEST(HttpSource, DetectsAPackageChangedOnTheServerAndReconnects) {
   auto w2 = test::write_raw_package(second, 20, 1);
   ASSERT_NE(w1.content_hash, w2.content_hash);
   auto server = std::make_unique<HttpServer>(
-      "127.0.0.1", 0, std::vector<ServedFile>{{"s.lods", first, w1.content_hash.hex()}});
+      "127.0.0.1", 0, std::vector<ServedFile>{{"s.lods", first, w1.content_hash.hex(), nullptr}});
   const uint16_t port = server->port();
   const std::string url = "http://127.0.0.1:" + std::to_string(port) + "/s.lods";
   HttpSource source(url);
@@ -90,16 +90,16 @@ TEST(HttpSource, DetectsAPackageChangedOnTheServerAndReconnects) {
   source.read(64, a);
   // The same content served again (a server restart): the source reconnects and goes on.
   server.reset();
-  server = std::make_unique<HttpServer>("127.0.0.1", port,
-                                        std::vector<ServedFile>{{"s.lods", first, w1.content_hash.hex()}});
+  server = std::make_unique<HttpServer>(
+      "127.0.0.1", port, std::vector<ServedFile>{{"s.lods", first, w1.content_hash.hex(), nullptr}});
   std::vector<uint8_t> b(100);
   source.read(64, b);
   EXPECT_EQ(a, b);
   EXPECT_EQ(source.connections(), 2u);
   // Other content under the same URL: If-Range no longer matches, the server answers 200, we refuse.
   server.reset();
-  server = std::make_unique<HttpServer>("127.0.0.1", port,
-                                        std::vector<ServedFile>{{"s.lods", second, w2.content_hash.hex()}});
+  server = std::make_unique<HttpServer>(
+      "127.0.0.1", port, std::vector<ServedFile>{{"s.lods", second, w2.content_hash.hex(), nullptr}});
   const std::string err = error_of([&] { source.read(64, b); });
   EXPECT_EQ(err.rfind(url + ": changed on the server", 0), 0u) << err;
 }
@@ -107,7 +107,7 @@ TEST(HttpSource, DetectsAPackageChangedOnTheServerAndReconnects) {
 TEST(HttpSource, ClearErrorsForBadUrlsAndMissingFiles) {
   auto file = test::temp_dir() / "x.lods";
   auto written = test::write_raw_package(file, 4, 0);
-  HttpServer server("127.0.0.1", 0, {{"x.lods", file, written.content_hash.hex()}});
+  HttpServer server("127.0.0.1", 0, {{"x.lods", file, written.content_hash.hex(), nullptr}});
   const std::string base = "http://127.0.0.1:" + std::to_string(server.port());
   EXPECT_EQ(error_of([] { HttpSource s("ftp://host/x.lods"); }), "ftp://host/x.lods: not an http:// URL");
   EXPECT_NE(error_of([] { HttpSource s("http://127.0.0.1:99999/x"); }).find("malformed URL"),
