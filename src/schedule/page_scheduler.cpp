@@ -98,6 +98,13 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
              const WeightedView& v, double tau, std::map<uint64_t, Exchange>& exchanges,
              std::map<uint32_t, double>& unknown) {
   const double total = view_area(scene, cut, v.view);
+  // W_i: the screen area of the nodes drawn now for object i (the weights of alpha_i's mean).
+  std::vector<double> drawn_area(scene.objects.size(), 0.0);
+  for (const DrawnNode& d : cut.drawn) {
+    const package::ObjectRecord& o = scene.objects[d.object];
+    drawn_area[d.object] +=
+        projected_area(to_world(records.record(d.node)->sphere, o.transform, max_scale(o.transform)), v.view);
+  }
   std::vector<uint64_t> seen;
   for (const MissingNode& m : cut.missing) {
     if (!m.record_known) {
@@ -122,21 +129,18 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
       std::sort(e.p.begin(), e.p.end());
       e.g = records.record(e.p[0])->children;
     }
-    double e_g = 0.0;
-    bool known = true;
-    for (uint32_t n : e.g) {
-      const package::NodeRecord* gr = records.record(n);
-      if (!gr) {
-        known = false;
-        break;
-      }
-      e_g = std::max(e_g, screen_error(double(gr->error) * scale,
-                                       to_world(gr->sphere, object.transform, scale), v.view));
+    if (!std::all_of(e.g.begin(), e.g.end(), [&](uint32_t n) { return records.record(n) != nullptr; }))
+      continue;  // its unknown records are in `unknown`
+    // The object's share that changes: all of A_i for its roots; for P, its nodes' weight in alpha_i's mean
+    // (|P| spheres of area a(P) out of W_i), at most all of it.
+    const double object_area = projected_area(object_sphere(scene, m.object), v.view);
+    double area = object_area;
+    if (!root) {
+      const double a_p =
+          double(e.p.size()) * projected_area(to_world(r.parent_sphere, object.transform, scale), v.view);
+      area = drawn_area[m.object] > 0.0 ? object_area * std::min(1.0, a_p / drawn_area[m.object]) : a_p;
     }
-    if (!known) continue;  // its unknown records are in `unknown`
-    const double area = root ? projected_area(object_sphere(scene, m.object), v.view)
-                             : projected_area(to_world(r.parent_sphere, object.transform, scale), v.view);
-    const double gain = accuracy(tau, e_g) - (root ? 0.0 : accuracy(tau, m.parent_error_px));
+    const double gain = 1.0 - (root ? 0.0 : accuracy(tau, m.parent_error_px));
     auto [it, inserted] = exchanges.try_emplace(key, std::move(e));
     it->second.benefit += v.weight * area * gain / total;
     it->second.secondary = std::max(it->second.secondary, v.weight * std::min(m.parent_error_px, 1e300));
@@ -194,23 +198,30 @@ std::vector<PageRef> PageScheduler::next(const package::PackageScene& scene, con
   std::sort(by_priority.begin(), by_priority.end());
   for (auto [priority, node] : by_priority) plan.add_record(node);
 
-  // Greedy by benefit per byte among the eligible exchanges.
+  // Greedy by benefit per byte among the eligible exchanges. Ratios are taken once, with the costs as of the
+  // call (pages chosen during the call make shared pages cheaper; that is not re-ranked), so each pick is a
+  // scan for the first eligible exchange in ratio order: O(E) cheap checks, not E cost evaluations.
+  struct Ranked {
+    double ratio, secondary;
+    Exchange* e;
+  };
+  std::vector<Ranked> ranked;
+  for (auto& [key, e] : exchanges)
+    if (const uint64_t cost = plan.cost(e); cost > 0)
+      ranked.push_back({e.benefit / double(cost), e.secondary / double(cost), &e});
+  std::stable_sort(ranked.begin(), ranked.end(), [](const Ranked& a, const Ranked& b) {
+    return std::tie(a.ratio, a.secondary) > std::tie(b.ratio, b.secondary);
+  });
   while (!plan.full()) {
     Exchange* best = nullptr;
-    double best_ratio = 0.0, best_secondary = 0.0;
-    for (auto& [key, e] : exchanges) {
-      if (e.done || !plan.eligible(e)) continue;
-      const uint64_t cost = plan.cost(e);
-      if (cost == 0) {
-        e.done = true;
+    for (const Ranked& r : ranked) {
+      if (r.e->done || !plan.eligible(*r.e)) continue;
+      if (plan.cost(*r.e) == 0) {
+        r.e->done = true;
         continue;
       }
-      const double ratio = e.benefit / double(cost), secondary = e.secondary / double(cost);
-      if (!best || std::tie(ratio, secondary) > std::tie(best_ratio, best_secondary)) {
-        best = &e;
-        best_ratio = ratio;
-        best_secondary = secondary;
-      }
+      best = r.e;
+      break;
     }
     if (!best) break;
     for (const auto* ids : {&best->p, &best->g})

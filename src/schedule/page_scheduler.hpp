@@ -5,20 +5,26 @@
 //
 // Unit of benefit: a group exchange (schedule/cut.hpp) of a view's ideal cut whose G is not all held. Its
 // benefit is what drawing G instead of P adds to the view's benefit ratio (DESIGN.md, Measuring quality),
-// summed over the weighted views:
-//   benefit = sum_v w_v * A(P) * (min(1, tau / e_G) - min(1, tau / e_P)) / sum_i A_i,
-// A(P) the clipped screen area of P's bounding sphere (for an object's roots: their own spheres; P is then
-// "nothing drawn", whose accuracy is 0), e_P the projected error of P, e_G the largest projected error of G's
-// members, sum_i A_i the screen area of the objects in view v's frustum. Its cost is the stored bytes of the
-// pages it still needs: the data pages of G's members and the index pages of the records of P and G that are
-// not held. Greedy (seed 003, E11): the exchange with the largest benefit / cost goes first; its pages are
-// then counted as held, which may make further exchanges eligible (an exchange is eligible once all of P is
-// held or scheduled: it refines what will be drawn) or cheaper (pages shared). Exchanges of no benefit (no
-// screen area: outside the viewport) still come, after all others, by e_P per byte, so that a view's ideal
-// cut is always reached. Where the records the scheduler sees are unknown (a pulling client that has not
-// fetched an index page yet), the index page comes first, by the projected error its arrival may remove.
+// summed over the weighted views, counted as what the exchange makes reachable (its G and the exchanges below
+// it can take P's share of the object up to accuracy 1):
+//   benefit = sum_v w_v * A_i * min(1, |P| a(P) / W_i) * (1 - min(1, tau / e_P)) / sum_j A_j,
+// A_i the clipped screen area of the exchange's object, a(P) that of P's bounding sphere (shared by P's
+// nodes), W_i the screen area of the nodes drawn now for object i (so |P| a(P) / W_i is P's weight in
+// alpha_i's area-weighted mean), e_P the projected error of P, sum_j A_j the screen area of the objects in
+// view v's frustum. For an object's roots the share is 1 and P is "nothing drawn", whose accuracy is 0.
+// (The one-step gain min(1, tau / e_G) - min(1, tau / e_P) was measured first: it starves coarse exchanges,
+// whose own gain is tiny but which unlock everything below; on motorBike at 10 Mbit/s it reached a benefit
+// ratio of 0.25 at 1 s where sse-pull had 0.5.) Its cost is the stored bytes of the pages it still needs: the
+// data pages of G's members and the index pages of the records of P and G that are not held. Greedy (seed
+// 003, E11): exchanges are ranked once by benefit / cost (costs as of the call); the first eligible one in
+// that order goes next (eligible: all of P held or chosen, so it refines what will be drawn), its pages
+// counted as held, which may make later ones eligible. Exchanges of no benefit (no screen area: outside the
+// viewport) come after all others, by e_P per byte, so that a view's ideal cut is always reached. Where the
+// records the scheduler sees are unknown (a pulling client that has not fetched an index page yet), the index
+// page comes first, by the projected error its arrival may remove.
 //
-// Cost: one select_cut per view, then O(E log E + E * picks) over the E exchanges of the views' ideal cuts.
+// Cost: one select_cut per view, then O(E log E) to rank and O(E) cheap checks per exchange picked, over the
+// E exchanges of the views' ideal cuts.
 #pragma once
 
 #include <cstdint>
