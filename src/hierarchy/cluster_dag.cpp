@@ -3,9 +3,9 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 
+#include "core/error.hpp"
 #include "hierarchy/bounding_sphere.hpp"
 #include "hierarchy/clusterize.hpp"
 #include "hierarchy/group_partition.hpp"
@@ -21,8 +21,13 @@ struct Builder {
   ClusterDag dag;
   std::vector<std::vector<uint32_t>> position_ids;  // by cluster
   std::vector<uint8_t> open_boundary;               // by position id (ids of the input mesh)
-  std::atomic<uint32_t> next_position_id{0};
+  uint32_t next_position_id = 0;
 };
+
+// Positions a group simplification creates get ids kNewId | k while groups run in parallel; the ids are made
+// final (next_position_id onwards, in group order) once the level's groups are done, so that ids, and with
+// them the edge order METIS sees, do not depend on thread timing: the same input bakes the same package.
+constexpr uint32_t kNewId = 0x80000000u;
 
 uint64_t edge_key(uint32_t a, uint32_t b) {
   if (a > b) std::swap(a, b);
@@ -111,6 +116,7 @@ struct GroupResult {
   bool accepted = false;
   DagGroup group;
   std::vector<NewCluster> clusters;
+  uint32_t new_ids = 0;  // ids kNewId | [0, new_ids) in `clusters`
 };
 
 // Merges, simplifies with the border locked and re-splits one group (formula of error_g in the header).
@@ -174,7 +180,7 @@ GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
     // A new position (seam vertices share one) gets one new id.
     const uint32_t l = local.insert(result.positions[v]);
     if (l == local_to_id.size()) {
-      local_to_id.push_back(b.next_position_id.fetch_add(1));
+      local_to_id.push_back(kNewId | out.new_ids++);
       local_locked.push_back(0);
     }
     result_ids[v] = local_to_id[l];
@@ -282,6 +288,12 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
         continue;
       }
       any = true;
+      const uint32_t first_new_id = b.next_position_id;
+      if (uint64_t(first_new_id) + r.new_ids >= kNewId) throw Error("cluster DAG: more than 2^31 positions");
+      b.next_position_id += r.new_ids;
+      for (NewCluster& nc : r.clusters)
+        for (uint32_t& id : nc.ids)
+          if (id & kNewId) id = first_new_id + (id & ~kNewId);
       const uint32_t gid = uint32_t(dag.groups.size());
       for (uint32_t c : r.group.children) {
         DagCluster& child = dag.clusters[c];

@@ -3,6 +3,7 @@
 #include <metis.h>
 
 #include <algorithm>
+#include <mutex>
 #include <numeric>
 
 #include "core/error.hpp"
@@ -27,6 +28,9 @@ uint32_t morton(const glm::vec3& p, const glm::vec3& lo, const glm::vec3& extent
   return code;
 }
 
+// Up to this many clusters are grouped along the Morton curve instead of by METIS.
+constexpr size_t kMortonGroupingMax = 32;
+
 }  // namespace
 
 std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> triangles,
@@ -39,6 +43,21 @@ std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> 
   if (n <= group_clusters) {
     groups.emplace_back(n);
     std::iota(groups[0].begin(), groups[0].end(), 0u);
+    return groups;
+  }
+  if (n <= kMortonGroupingMax) {
+    // Few clusters: balanced runs of the Morton order of their centroids. METIS must run one call at a time
+    // (below), and on a scene of many small meshes these calls were most of a bake.
+    glm::vec3 lo(INFINITY), hi(-INFINITY);
+    for (const glm::vec3& c : centroids) lo = glm::min(lo, c), hi = glm::max(hi, c);
+    std::vector<std::pair<uint32_t, uint32_t>> order(n);
+    for (uint32_t i = 0; i < n; ++i) order[i] = {morton(centroids[i], lo, hi - lo), i};
+    std::sort(order.begin(), order.end());
+    const size_t parts = (n + group_clusters - 1) / group_clusters;
+    for (size_t p = 0; p < parts; ++p) {
+      groups.emplace_back();
+      for (size_t k = p * n / parts; k < (p + 1) * n / parts; ++k) groups.back().push_back(order[k].second);
+    }
     return groups;
   }
 
@@ -96,6 +115,11 @@ std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> 
   options[METIS_OPTION_SEED] = 1;  // deterministic builds
   options[METIS_OPTION_NUMBERING] = 0;
   std::vector<idx_t> part(n, 0);
+  // METIS keeps its random generator in process-wide state (GKlib), so calls from meshes baked in parallel
+  // reseeded and drew from one another's sequence: the same input gave different groupings from run to run.
+  // One call at a time keeps every partition a function of its graph (METIS is ~8 % of a bake).
+  static std::mutex metis_mutex;
+  std::lock_guard lock(metis_mutex);
   const int status =
       METIS_PartGraphKway(&nvtxs, &ncon, xadj.data(), adjncy.data(), vwgt.data(), nullptr, adjwgt.data(),
                           &nparts, nullptr, nullptr, options, &objval, part.data());

@@ -3,7 +3,8 @@
 // by METIS's k-way partitioning into parts of about `group_clusters` clusters, so that a group is compact and
 // its outer border (what stays locked) short. Clusters that share no edge with any other (tiny components)
 // are linked to their neighbours along a Morton curve over cluster centroids, so that they are grouped with
-// what is near them.
+// what is near them. Up to 32 clusters are grouped as balanced runs of the Morton order of their centroids
+// instead (METIS holds process-wide random state, so its calls are serialised; small graphs are most calls).
 #pragma once
 
 #include <cstdint>
