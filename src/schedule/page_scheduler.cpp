@@ -27,10 +27,9 @@ class Planned final : public NodeSource {
   const std::vector<bool>& data_;
 };
 
-// min(1, tau / e): a node's accuracy in the benefit ratio (DESIGN.md, Measuring quality).
-double accuracy(double tau, double error_px) {
-  return error_px > 0.0 ? std::min(1.0, tau / error_px) : 1.0;
-}
+// An exchange's gain per unit of screen area (header, formula of the benefit): the error it removes on a log
+// scale, ln(max(e_P, tau) / max(e_G, tau)); an object's roots (nothing drawn yet) count kRootGain.
+constexpr double kRootGain = 10.0;
 
 // A group exchange of some view's ideal cut: P (empty for an object's roots) is replaced by G.
 struct Exchange {
@@ -140,7 +139,8 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
           double(e.p.size()) * projected_area(to_world(r.parent_sphere, object.transform, scale), v.view);
       area = drawn_area[m.object] > 0.0 ? object_area * std::min(1.0, a_p / drawn_area[m.object]) : a_p;
     }
-    const double gain = 1.0 - (root ? 0.0 : accuracy(tau, m.parent_error_px));
+    const double gain =
+        root ? kRootGain : std::log(std::max(m.parent_error_px, tau) / std::max(m.error_px, tau));
     auto [it, inserted] = exchanges.try_emplace(key, std::move(e));
     it->second.benefit += v.weight * area * gain / total;
     it->second.secondary = std::max(it->second.secondary, v.weight * std::min(m.parent_error_px, 1e300));
