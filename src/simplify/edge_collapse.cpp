@@ -109,6 +109,7 @@ class Simplifier {
   size_t alive_triangles_ = 0;
   std::vector<uint32_t> offsets_, faces_;  // vertex -> faces (CSR), rebuilt each pass
   std::vector<Candidate> slots_, order_, sorted_;
+  std::vector<float> bucket_;    // goal_cost's candidate costs in one histogram bucket
   std::vector<uint32_t> dirty_;  // vertices of the faces around touched vertices, this pass
   std::vector<uint8_t> vertex_mark_;
   uint32_t step_ = 0;
@@ -504,21 +505,20 @@ class Simplifier {
     // that would reach the target, so that the pass order stays close to the greedy order. Only candidates
     // under the limit are sorted. When none of them is valid, the pass is run again without the limit (else
     // it would stop short of the target with valid collapses left).
-    auto cheaper = [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; };
     size_t collapsed = 0;
     for (bool limited : {true, false}) {
+      const size_t goal = (alive_triangles_ - target + 1) / 2;
+      const float limit = limited ? 1.5f * goal_cost(goal) : std::numeric_limits<float>::infinity();
+      // The candidates under the limit, scattered from slot order by i -> i * P mod n (P prime > n, so a
+      // permutation): the radix sort keeps this order among equal costs, so that flat regions (all costs
+      // equal) collapse spread out rather than row by row in face order, the same way on every run.
       order_.clear();
       for (const Candidate& c : slots_)
-        if (c.a != kNone && std::isfinite(c.cost)) order_.push_back(c);
-      size_t goal = (alive_triangles_ - target + 1) / 2;
-      float limit = std::numeric_limits<float>::infinity();
-      if (limited && goal < order_.size()) {
-        std::nth_element(order_.begin(), order_.begin() + goal, order_.end(), cheaper);
-        limit = 1.5f * order_[goal].cost;
-        order_.erase(
-            std::partition(order_.begin(), order_.end(), [&](const Candidate& c) { return c.cost <= limit; }),
-            order_.end());
-      }
+        if (c.a != kNone && std::isfinite(c.cost) && c.cost <= limit) order_.push_back(c);
+      constexpr uint64_t kScatter = 2654435761u;  // prime, above any candidate count
+      sorted_.resize(order_.size());
+      for (size_t i = 0; i < order_.size(); ++i) sorted_[i * kScatter % order_.size()] = order_[i];
+      order_.swap(sorted_);
       radix_sort_by_cost();
       for (const Candidate& c : order_) {
         if (c.cost > limit || alive_triangles_ <= target) break;
@@ -531,6 +531,30 @@ class Simplifier {
       if (collapsed > 0 || std::isinf(limit)) break;
     }
     return collapsed;
+  }
+
+  // The cost of rank `goal` (0-based) among the valid candidates in slots_, or +inf when there are no more
+  // than `goal` of them: a radix select on the float bits (costs are >= 0, so their bits order like them),
+  // a 4096-bucket histogram of the top 12 bits, then nth_element within the one bucket that holds the rank.
+  // Two scans of slots_ and a sort of one bucket, instead of a selection over every candidate.
+  float goal_cost(size_t goal) {
+    auto bits = [](float cost) {
+      uint32_t u;
+      std::memcpy(&u, &cost, 4);
+      return u;
+    };
+    std::vector<uint32_t> count(4096, 0);
+    size_t valid = 0;
+    for (const Candidate& c : slots_)
+      if (c.a != kNone && std::isfinite(c.cost)) ++count[bits(c.cost) >> 20], ++valid;
+    if (goal >= valid) return std::numeric_limits<float>::infinity();
+    uint32_t bucket = 0;
+    while (goal >= count[bucket]) goal -= count[bucket++];
+    bucket_.clear();
+    for (const Candidate& c : slots_)
+      if (c.a != kNone && std::isfinite(c.cost) && bits(c.cost) >> 20 == bucket) bucket_.push_back(c.cost);
+    std::nth_element(bucket_.begin(), bucket_.begin() + goal, bucket_.end());
+    return bucket_[goal];
   }
 
   // Sorts order_ by cost: LSD radix sort on the float bits (costs are >= 0, so their bits order like them),
