@@ -525,7 +525,6 @@ class Simplifier {
         Plan p;
         if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
         if (p.a2 != kNone && (touched_[p.a2] || touched_[p.b2])) continue;
-        place(p);
         if (try_collapse(p)) ++collapsed;
       }
       if (collapsed > 0 || std::isinf(limit)) break;
@@ -612,13 +611,11 @@ class Simplifier {
   // neighbour marks (stamp_ = this collapse)
   uint32_t stamp_ = 0;
 
-  // Validity (link condition, boundary pinch, lost surface, normal change), bound, then the collapse.
-  bool try_collapse(const Plan& p) {
+  // Validity (link condition, boundary pinch, lost surface, normal change), bound, then the collapse. The
+  // topological checks come first: they do not need the placement, which `place` computes only for the
+  // collapses that pass them.
+  bool try_collapse(Plan& p) {
     const uint32_t pa = pid_[p.a], pb = pid_[p.b];
-    const glm::vec3 x(p.x);  // as stored: the bounds use the rounded position
-    const double da = glm::length(glm::dvec3(pos_[p.a]) - glm::dvec3(x));
-    const double db = glm::length(glm::dvec3(pos_[p.b]) - glm::dvec3(x));
-    const double r_natural = std::max(radius_[p.a] + da, radius_[p.b] + db);
 
     na_.clear(), nb_.clear(), apex_.clear(), removed_.clear();
     size_t kept_faces = 0;
@@ -659,6 +656,12 @@ class Simplifier {
       if (mark_a_[v] == stamp_ && std::find(apex_.begin(), apex_.end(), v) == apex_.end()) return false;
     for (uint32_t c : apex_)
       if (mark_a_[c] != stamp_ && mark_b_[c] != stamp_) return false;
+
+    place(p);
+    const glm::vec3 x(p.x);  // as stored: the bounds use the rounded position
+    const double da = glm::length(glm::dvec3(pos_[p.a]) - glm::dvec3(x));
+    const double db = glm::length(glm::dvec3(pos_[p.b]) - glm::dvec3(x));
+    const double r_natural = std::max(radius_[p.a] + da, radius_[p.b] + db);
 
     // Normal change of every face that stays and moves.
     const float cos_max = std::cos(glm::radians(opt_.max_normal_change_deg));
