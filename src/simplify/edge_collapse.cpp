@@ -109,6 +109,9 @@ class Simplifier {
   size_t alive_triangles_ = 0;
   std::vector<uint32_t> offsets_, faces_;  // vertex -> faces (CSR), rebuilt each pass
   std::vector<Candidate> slots_, order_, sorted_;
+  std::vector<float> bucket_;    // goal_cost's candidate costs in one histogram bucket
+  std::vector<uint32_t> dirty_;  // vertices of the faces around touched vertices, this pass
+  std::vector<uint8_t> vertex_mark_;
   uint32_t step_ = 0;
   std::vector<Collapse>* record_ = nullptr;
 
@@ -461,26 +464,39 @@ class Simplifier {
   // Candidates live per face corner (slots_[3f + k]: the edge from corner k to corner k + 1), so that a
   // pass re-evaluates only edges with an end touched by the previous pass: an edge whose ends kept their
   // quadrics, positions and faces keeps its cost and allowed direction (open edges and seam twins only
-  // change at touched vertices).
+  // change at touched vertices). Such an edge lies in a face of its touched end, so only the vertices of
+  // the faces around touched vertices are visited (O(touched) per pass instead of every corner), in parallel.
   size_t run_pass(size_t target) {
     const size_t m = source_.size();
-    if (slots_.size() != indices_.size()) {
-      slots_.assign(indices_.size(), Candidate{std::numeric_limits<float>::infinity(), kNone, kNone});
-      std::fill(touched_.begin(), touched_.end(), 1);
+    const bool all = slots_.size() != indices_.size();
+    if (all) slots_.assign(indices_.size(), Candidate{std::numeric_limits<float>::infinity(), kNone, kNone});
+    dirty_.clear();
+    if (all) {
+      dirty_.resize(m);
+      for (uint32_t v = 0; v < m; ++v) dirty_[v] = v;
+    } else {
+      vertex_mark_.assign(m, 0);
+      for (uint32_t v = 0; v < m; ++v)
+        if (touched_[v])
+          for (uint32_t s = offsets_[v]; s < offsets_[v + 1]; ++s)
+            for (uint32_t k = 0; k < 3; ++k)
+              if (uint32_t u = indices_[3 * size_t(faces_[s]) + k]; !vertex_mark_[u])
+                vertex_mark_[u] = 1, dirty_.push_back(u);
     }
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 1024), [&](const auto& r) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, dirty_.size(), 256), [&](const auto& r) {
       thread_local std::vector<uint32_t> outs, ins;
-      for (uint32_t i = r.begin(); i < r.end(); ++i) {
-        bool have_fan = false;  // the fan only when an edge of i needs re-evaluation
+      for (size_t n = r.begin(); n < r.end(); ++n) {
+        const uint32_t i = dirty_[n];
+        fan(i, outs, ins);  // outs[s - offsets_[i]]: the far end of i's edge in its s-th face (all alive)
         for (uint32_t s = offsets_[i]; s < offsets_[i + 1]; ++s) {
+          const uint32_t j = outs[s - offsets_[i]];
+          if (!all && !touched_[i] && !touched_[j]) continue;
           const uint32_t* t = &indices_[3 * size_t(faces_[s])];
-          const uint32_t k = t[0] == i ? 0 : (t[1] == i ? 1 : 2), j = t[(k + 1) % 3];
-          if (!touched_[i] && !touched_[j]) continue;
-          if (!have_fan) fan(i, outs, ins), have_fan = true;
-          size_t corner = 3 * size_t(faces_[s]) + k;
+          const uint32_t k = t[0] == i ? 0 : (t[1] == i ? 1 : 2);
           bool twin = std::find(ins.begin(), ins.end(), j) != ins.end();
-          slots_[corner] = (twin && i > j) ? Candidate{std::numeric_limits<float>::infinity(), kNone, kNone}
-                                           : evaluate(i, j);
+          slots_[3 * size_t(faces_[s]) + k] =
+              (twin && i > j) ? Candidate{std::numeric_limits<float>::infinity(), kNone, kNone}
+                              : evaluate(i, j);
         }
       }
     });
@@ -489,33 +505,55 @@ class Simplifier {
     // that would reach the target, so that the pass order stays close to the greedy order. Only candidates
     // under the limit are sorted. When none of them is valid, the pass is run again without the limit (else
     // it would stop short of the target with valid collapses left).
-    auto cheaper = [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; };
     size_t collapsed = 0;
     for (bool limited : {true, false}) {
+      const size_t goal = (alive_triangles_ - target + 1) / 2;
+      const float limit = limited ? 1.5f * goal_cost(goal) : std::numeric_limits<float>::infinity();
+      // The candidates under the limit, scattered from slot order by i -> i * P mod n (P prime > n, so a
+      // permutation): the radix sort keeps this order among equal costs, so that flat regions (all costs
+      // equal) collapse spread out rather than row by row in face order, the same way on every run.
       order_.clear();
       for (const Candidate& c : slots_)
-        if (c.a != kNone && std::isfinite(c.cost)) order_.push_back(c);
-      size_t goal = (alive_triangles_ - target + 1) / 2;
-      float limit = std::numeric_limits<float>::infinity();
-      if (limited && goal < order_.size()) {
-        std::nth_element(order_.begin(), order_.begin() + goal, order_.end(), cheaper);
-        limit = 1.5f * order_[goal].cost;
-        order_.erase(
-            std::partition(order_.begin(), order_.end(), [&](const Candidate& c) { return c.cost <= limit; }),
-            order_.end());
-      }
+        if (c.a != kNone && std::isfinite(c.cost) && c.cost <= limit) order_.push_back(c);
+      constexpr uint64_t kScatter = 2654435761u;  // prime, above any candidate count
+      sorted_.resize(order_.size());
+      for (size_t i = 0; i < order_.size(); ++i) sorted_[i * kScatter % order_.size()] = order_[i];
+      order_.swap(sorted_);
       radix_sort_by_cost();
       for (const Candidate& c : order_) {
         if (c.cost > limit || alive_triangles_ <= target) break;
         Plan p;
         if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
         if (p.a2 != kNone && (touched_[p.a2] || touched_[p.b2])) continue;
-        place(p);
         if (try_collapse(p)) ++collapsed;
       }
       if (collapsed > 0 || std::isinf(limit)) break;
     }
     return collapsed;
+  }
+
+  // The cost of rank `goal` (0-based) among the valid candidates in slots_, or +inf when there are no more
+  // than `goal` of them: a radix select on the float bits (costs are >= 0, so their bits order like them),
+  // a 4096-bucket histogram of the top 12 bits, then nth_element within the one bucket that holds the rank.
+  // Two scans of slots_ and a sort of one bucket, instead of a selection over every candidate.
+  float goal_cost(size_t goal) {
+    auto bits = [](float cost) {
+      uint32_t u;
+      std::memcpy(&u, &cost, 4);
+      return u;
+    };
+    std::vector<uint32_t> count(4096, 0);
+    size_t valid = 0;
+    for (const Candidate& c : slots_)
+      if (c.a != kNone && std::isfinite(c.cost)) ++count[bits(c.cost) >> 20], ++valid;
+    if (goal >= valid) return std::numeric_limits<float>::infinity();
+    uint32_t bucket = 0;
+    while (goal >= count[bucket]) goal -= count[bucket++];
+    bucket_.clear();
+    for (const Candidate& c : slots_)
+      if (c.a != kNone && std::isfinite(c.cost) && bits(c.cost) >> 20 == bucket) bucket_.push_back(c.cost);
+    std::nth_element(bucket_.begin(), bucket_.begin() + goal, bucket_.end());
+    return bucket_[goal];
   }
 
   // Sorts order_ by cost: LSD radix sort on the float bits (costs are >= 0, so their bits order like them),
@@ -573,13 +611,11 @@ class Simplifier {
   // neighbour marks (stamp_ = this collapse)
   uint32_t stamp_ = 0;
 
-  // Validity (link condition, boundary pinch, lost surface, normal change), bound, then the collapse.
-  bool try_collapse(const Plan& p) {
+  // Validity (link condition, boundary pinch, lost surface, normal change), bound, then the collapse. The
+  // topological checks come first: they do not need the placement, which `place` computes only for the
+  // collapses that pass them.
+  bool try_collapse(Plan& p) {
     const uint32_t pa = pid_[p.a], pb = pid_[p.b];
-    const glm::vec3 x(p.x);  // as stored: the bounds use the rounded position
-    const double da = glm::length(glm::dvec3(pos_[p.a]) - glm::dvec3(x));
-    const double db = glm::length(glm::dvec3(pos_[p.b]) - glm::dvec3(x));
-    const double r_natural = std::max(radius_[p.a] + da, radius_[p.b] + db);
 
     na_.clear(), nb_.clear(), apex_.clear(), removed_.clear();
     size_t kept_faces = 0;
@@ -620,6 +656,12 @@ class Simplifier {
       if (mark_a_[v] == stamp_ && std::find(apex_.begin(), apex_.end(), v) == apex_.end()) return false;
     for (uint32_t c : apex_)
       if (mark_a_[c] != stamp_ && mark_b_[c] != stamp_) return false;
+
+    place(p);
+    const glm::vec3 x(p.x);  // as stored: the bounds use the rounded position
+    const double da = glm::length(glm::dvec3(pos_[p.a]) - glm::dvec3(x));
+    const double db = glm::length(glm::dvec3(pos_[p.b]) - glm::dvec3(x));
+    const double r_natural = std::max(radius_[p.a] + da, radius_[p.b] + db);
 
     // Normal change of every face that stays and moves.
     const float cos_max = std::cos(glm::radians(opt_.max_normal_change_deg));
