@@ -4,8 +4,8 @@
 #pragma once
 
 #include <mutex>
-#include <utility>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "schedule/page_scheduler.hpp"

@@ -32,7 +32,8 @@ void ClientPackage::dropped(const schedule::PageRef& page) {
   if (in_flight_.erase(key(page.kind, page.id))) scheduler_.set_held(page.kind, page.id, false);
 }
 
-Frame ClientPackage::frame(const View& view, std::span<const View> predicted, const schedule::CutOptions& options) {
+Frame ClientPackage::frame(const View& view, std::span<const View> predicted,
+                           const schedule::CutOptions& options) {
   Frame f;
   f.cut = select_cut(reader_.scene(), nodes_, view, options);
   f.quality = frame_quality(reader_.scene(), nodes_, f.cut, view, options.tau);
