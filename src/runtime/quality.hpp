@@ -11,26 +11,9 @@
 #pragma once
 
 #include "package/index.hpp"
-#include "schedule/cut.hpp"
-#include "schedule/screen_area.hpp"
-#include "schedule/screen_error.hpp"
+#include "runtime/selection.hpp"
 
 namespace lodstream::runtime {
-
-// Selection lives in the schedule module (the server's scheduler runs it too); the client names it here.
-using schedule::Cut;
-using schedule::DrawnNode;
-using schedule::in_frustum;
-using schedule::max_scale;
-using schedule::NodeSource;
-using schedule::object_sphere;
-using schedule::ObjectState;
-using schedule::projected_area;
-using schedule::screen_error;
-using schedule::select_cut;
-using schedule::to_world;
-using schedule::View;
-using schedule::WorldSphere;
 
 struct FrameQuality {
   double pixel_error_max = 0.0;   // 0 when nothing is drawn
