@@ -23,6 +23,7 @@
 #include <memory>
 #include <mutex>
 
+#include "bake_textures.hpp"
 #include "command.hpp"
 #include "core/error.hpp"
 #include "hierarchy/cluster_dag.hpp"
@@ -133,7 +134,6 @@ int run_bake(const BakeArgs& args) {
   // Representations, and the node order: roots, then each group's input clusters, coarse levels first.
   PackageScene ps;
   ps.input_triangles = input_triangles;
-  for (const Material& m : scene.materials) ps.materials.push_back({m, kNone});
   struct Ref {
     uint32_t mesh, cluster;
   };
@@ -245,6 +245,8 @@ int run_bake(const BakeArgs& args) {
   nlohmann::json metadata = {
       {"baker", "lodstream bake"}, {"normal_bits", args.normal_bits}, {"grid_bits", 14}};
   ps.metadata = metadata.dump();
+  EmbeddedTextures textures = embed_textures(scene.materials, writer);
+  ps.materials = std::move(textures.materials);
   const WrittenPackage written = writer.finish(std::move(ps), std::move(records), root_nodes);
   const double time_s = elapsed();
   const uint64_t rss = peak_rss_bytes();
@@ -266,6 +268,7 @@ int run_bake(const BakeArgs& args) {
                 {"root_index_bytes", written.root_index_bytes},
                 {"index_bytes", written.index_bytes},
                 {"page_bytes", written.page_bytes},
+                {"texture_bytes", textures.bytes},
                 {"raw_share",
                  {{"header", breakdown.header / raw},
                   {"vertices", breakdown.vertices / raw},
@@ -289,6 +292,9 @@ int run_bake(const BakeArgs& args) {
         "MB\n",
         (unsigned long long)written.bytes, per_triangle, (unsigned long long)written.root_index_bytes, time_s,
         double(input_triangles) / time_s, double(rss) / 1e6);
+    if (textures.bytes)
+      std::printf("  embedded textures: %llu bytes (in the bytes above)\n",
+                  (unsigned long long)textures.bytes);
     std::printf("  fallbacks: %zu partial, %zu positions-only, %zu abandoned groups, %zu stalled meshes\n",
                 partial, positions_only, abandoned, stalled);
   }

@@ -4,7 +4,7 @@
 // own), containing spheres, every page and node decodes and matches its record, and crack-free cuts: for N
 // random eyes and thresholds per representation, the cut chosen by the cut rule, welded by decoded position,
 // has exactly the boundary edges of the full-resolution (level-0) surface. Exits 1 naming the first
-// violation.
+// violation. Every embedded texture (blob) must decode as an image.
 #include <tbb/parallel_for.h>
 
 #include <cmath>
@@ -15,6 +15,7 @@
 
 #include "command.hpp"
 #include "core/error.hpp"
+#include "core/image.hpp"
 #include "hierarchy/bounding_sphere.hpp"
 #include "hierarchy/cut.hpp"
 #include "package/reader.hpp"
@@ -81,6 +82,8 @@ int run_inspect(const InspectArgs& args) {
     l.min_error = std::min(l.min_error, n.error), l.max_error = std::max(l.max_error, n.error);
   }
   const uint64_t bytes = reader.header().file_size;
+  uint64_t texture_bytes = 0;
+  for (const Range& b : root.blobs) texture_bytes += b.size;
 
   std::string violation;
   if (args.verify) {
@@ -124,6 +127,14 @@ int run_inspect(const InspectArgs& args) {
             }
           welded[id] = welders[nodes[id].representation].weld(m);
         }
+    }
+    // Every embedded texture decodes as an image.
+    for (uint32_t b = 0; b < root.blobs.size() && violation.empty(); ++b) {
+      try {
+        decode_image(reader.read_blob(b), "blob " + std::to_string(b));
+      } catch (const Error& e) {
+        violation = e.what();
+      }
     }
     // Crack-free cuts per cluster DAG.
     std::mt19937 rng(12345);
@@ -184,6 +195,8 @@ int run_inspect(const InspectArgs& args) {
                           {"representations", root.scene.representations.size()},
                           {"root_nodes", root.root_nodes.size()},
                           {"index_pages", root.index_pages.size()},
+                          {"textures", root.blobs.size()},
+                          {"texture_bytes", texture_bytes},
                           {"per_level", level_json}};
     if (args.verify) {
       out["verified"] = violation.empty();
@@ -195,6 +208,9 @@ int run_inspect(const InspectArgs& args) {
         "%s: %zu nodes, %zu pages, %u levels, %llu bytes, %llu input triangles (%zu stored), %zu objects\n",
         args.package.c_str(), nodes.size(), root.pages.size(), levels, (unsigned long long)bytes,
         (unsigned long long)root.scene.input_triangles, stored_triangles, root.scene.objects.size());
+    if (!root.blobs.empty())
+      std::printf("  %zu embedded textures, %llu bytes\n", root.blobs.size(),
+                  (unsigned long long)texture_bytes);
     for (const auto& [l, s] : per_level)
       std::printf("  level %2u: %7zu nodes %10zu triangles  error %.4g .. %.4g\n", l, s.nodes, s.triangles,
                   s.min_error, s.max_error);

@@ -96,6 +96,8 @@ PackageCut package_cut(const std::string& file, const Camera& camera, double tau
   const schedule::Cut cut = schedule::select_cut(reader.scene(), nodes, schedule::View::of(camera), {tau});
   runtime::CutGeometry geometry(reader, std::filesystem::path(file).parent_path());
   geometry.update(cut, runtime::pages_from_reader(reader));
+  for (const std::string& warning : geometry.warnings())
+    std::fprintf(stderr, "lodstream: warning: %s\n", warning.c_str());
   const runtime::FrameQuality q =
       runtime::frame_quality(reader.scene(), nodes, cut, schedule::View::of(camera), tau);
   return {geometry.scene(), cut.drawn.size(), q.pixel_error_max};

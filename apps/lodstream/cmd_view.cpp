@@ -161,7 +161,8 @@ int run_view(const ViewOptions& opt) {
   if (opt.frames_every > 0) {
     context = render::create_headless_context();
     renderer = std::make_unique<render::Renderer>(*context);
-    geometry = std::make_unique<runtime::CutGeometry>(client.reader(), package_dir);
+    geometry = std::make_unique<runtime::CutGeometry>(client.reader(), package_dir, 2'000'000,
+                                                      runtime::TextureLoading::background);
   }
   auto draw = [&](uint64_t frame, const runtime::Frame& f, const Camera& camera) {
     geometry->update(

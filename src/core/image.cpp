@@ -12,14 +12,31 @@
 
 namespace lodstream {
 
-Image load_image(const std::filesystem::path& file) {
-  int w = 0, h = 0, channels = 0;
-  stbi_uc* data = stbi_load(file.c_str(), &w, &h, &channels, 4);
-  if (!data) throw Error(file.string() + ": cannot read image (" + stbi_failure_reason() + ")");
+namespace {
+
+// Moves stb's RGBA result into an Image, or throws naming `name` with stb's reason.
+Image take_stb_image(stbi_uc* data, int w, int h, const std::string& name) {
+  if (!data) throw Error(name + ": cannot read image (" + stbi_failure_reason() + ")");
   Image image(w, h);
   std::memcpy(image.rgba.data(), data, image.rgba.size());
   stbi_image_free(data);
   return image;
+}
+
+}  // namespace
+
+Image load_image(const std::filesystem::path& file) {
+  int w = 0, h = 0, channels = 0;
+  stbi_uc* data = stbi_load(file.c_str(), &w, &h, &channels, 4);
+  return take_stb_image(data, w, h, file.string());
+}
+
+Image decode_image(std::span<const uint8_t> bytes, const std::string& name) {
+  if (bytes.size() > size_t(INT32_MAX))
+    throw Error(name + ": image of " + std::to_string(bytes.size()) + " bytes is too large");
+  int w = 0, h = 0, channels = 0;
+  stbi_uc* data = stbi_load_from_memory(bytes.data(), int(bytes.size()), &w, &h, &channels, 4);
+  return take_stb_image(data, w, h, name);
 }
 
 void save_png(const Image& image, const std::filesystem::path& file) {

@@ -3,6 +3,8 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
+#include <string>
 #include <vector>
 
 namespace lodstream {
@@ -21,6 +23,9 @@ struct Image {
 // Reads a PNG (or any format stb_image reads) as RGBA. Throws lodstream::Error naming the file and stb's
 // reason.
 Image load_image(const std::filesystem::path& file);
+// Decodes an image file held in memory (PNG, JPEG, … as stb_image reads them) as RGBA. `name` names it in
+// the error (for example "package.lods: blob 3"). Throws lodstream::Error with stb's reason.
+Image decode_image(std::span<const uint8_t> bytes, const std::string& name);
 
 // Writes a PNG: to a temporary file in the same folder, then renamed over `file`, so an interrupted write
 // never leaves a broken image. Deterministic: the same pixels give the same bytes. Throws lodstream::Error on

@@ -4,10 +4,12 @@
 
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "core/bounds.hpp"
+#include "core/image.hpp"
 #include "core/mesh.hpp"
 
 namespace lodstream {
@@ -16,6 +18,8 @@ struct Material {
   std::string name;
   glm::vec4 base_color{0.8f, 0.8f, 0.8f, 1.0f};  // linear RGBA
   std::string base_color_texture;                // absolute path of an image file, or empty
+  // The texture already decoded (an image embedded in a package); when set, it is drawn instead of the file.
+  std::shared_ptr<const Image> base_color_image;
 };
 
 struct Object {

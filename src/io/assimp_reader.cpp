@@ -94,7 +94,7 @@ Scene read_with_assimp(const std::filesystem::path& path) {
     mat.base_color_texture = texture_of(m, dir, file);
     scene.materials.push_back(std::move(mat));
   }
-  if (scene.materials.empty()) scene.materials.push_back(Material{"default", glm::vec4(0.8f), ""});
+  if (scene.materials.empty()) scene.materials.emplace_back().name = "default";  // base colour 0.8 grey
 
   // assimp mesh i → scene mesh (or none when it has no triangles).
   std::vector<int64_t> mesh_of(ai->mNumMeshes, -1);

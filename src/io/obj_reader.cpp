@@ -130,7 +130,7 @@ Scene read_obj(const std::filesystem::path& path) {
       scene.meshes.push_back(std::move(mesh));
     }
   }
-  if (default_used) scene.materials.push_back(Material{"default", glm::vec4(0.8f, 0.8f, 0.8f, 1.0f), ""});
+  if (default_used) scene.materials.emplace_back().name = "default";  // base colour 0.8 grey
   return scene;
 }
 

@@ -13,10 +13,18 @@ SceneUpload upload_scene(Renderer& renderer, const Scene& scene) {
 
   std::vector<DrawMaterial> materials;
   std::map<std::string, TextureHandle> by_file;  // kNoTexture for files that could not be read
+  std::map<const Image*, TextureHandle> by_image;
   for (const Material& material : scene.materials) {
     DrawMaterial draw{material.base_color, kNoTexture};
     const std::string& file = material.base_color_texture;
-    if (!file.empty()) {
+    if (material.base_color_image) {
+      auto [it, inserted] = by_image.try_emplace(material.base_color_image.get(), kNoTexture);
+      if (inserted) {
+        it->second = renderer.upload_texture(*material.base_color_image);
+        upload.textures.push_back(it->second);
+      }
+      draw.texture = it->second;
+    } else if (!file.empty()) {
       auto [it, inserted] = by_file.try_emplace(file, kNoTexture);
       if (inserted) {
         try {

@@ -1,6 +1,7 @@
 #include "runtime/cut_geometry.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <map>
 
 #include "core/error.hpp"
@@ -26,7 +27,7 @@ std::vector<Material> package_materials(const package::PackageScene& scene,
   for (const package::PackageMaterial& m : scene.materials) {
     Material out = m.material;
     if (m.texture_blob != package::kNone) {
-      out.base_color_texture.clear();  // embedded textures: not loaded yet
+      out.base_color_texture.clear();  // read by CutGeometry
     } else if (!out.base_color_texture.empty()) {
       const std::filesystem::path texture(out.base_color_texture);
       if (texture.is_relative()) out.base_color_texture = (package_dir / texture).string();
@@ -37,14 +38,66 @@ std::vector<Material> package_materials(const package::PackageScene& scene,
   return materials;
 }
 
+namespace {
+
+// Reads and decodes embedded texture `blob` of `reader`'s package.
+std::shared_ptr<const Image> read_texture(const package::PackageReader* reader, uint32_t blob) {
+  const std::vector<uint8_t> bytes = reader->read_blob(blob);
+  return std::make_shared<const Image>(
+      decode_image(bytes, reader->source().name() + ": texture blob " + std::to_string(blob)));
+}
+
+}  // namespace
+
 CutGeometry::CutGeometry(package::PackageReader& reader, const std::filesystem::path& package_dir,
-                         uint64_t decoded_triangle_budget)
+                         uint64_t decoded_triangle_budget, TextureLoading textures)
     : reader_(&reader),
+      texture_loading_(textures),
       materials_(package_materials(reader.scene(), package_dir)),
-      budget_(decoded_triangle_budget) {}
+      budget_(decoded_triangle_budget) {
+  const auto& stored = reader.scene().materials;
+  texture_requested_.assign(materials_.size(), true);
+  for (size_t m = 0; m < stored.size(); ++m) {
+    if (stored[m].texture_blob == package::kNone) continue;
+    if (textures == TextureLoading::background) {
+      texture_requested_[m] = false;
+      continue;
+    }
+    install_texture(uint32_t(m), [&] { return read_texture(reader_, stored[m].texture_blob); });
+  }
+}
+
+void CutGeometry::install_texture(uint32_t material,
+                                  const std::function<std::shared_ptr<const Image>()>& read) {
+  try {
+    materials_[material].base_color_image = read();
+  } catch (const Error& e) {
+    warnings_.push_back("material '" + materials_[material].name + "': " + e.what() +
+                        "; drawn in its base colour");
+  }
+}
+
+void CutGeometry::load_textures(const schedule::Cut& cut) {
+  for (auto it = pending_.begin(); it != pending_.end();) {
+    if (it->second.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+      ++it;
+      continue;
+    }
+    install_texture(it->first, [&] { return it->second.get(); });
+    it = pending_.erase(it);
+  }
+  for (const schedule::DrawnNode& d : cut.drawn) {
+    const uint32_t m = reader_->node(d.node).material;
+    if (m >= texture_requested_.size() || texture_requested_[m]) continue;
+    texture_requested_[m] = true;
+    pending_.emplace(
+        m, std::async(std::launch::async, read_texture, reader_, reader_->scene().materials[m].texture_blob));
+  }
+}
 
 size_t CutGeometry::update(const schedule::Cut& cut, const PageSource& pages) {
   ++frame_;
+  load_textures(cut);
   // New nodes grouped by page, so each page is unpacked once.
   std::map<uint32_t, std::vector<uint32_t>> missing_by_page;
   for (const schedule::DrawnNode& d : cut.drawn) {

@@ -9,6 +9,10 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <future>
+#include <map>
+#include <memory>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -32,9 +36,16 @@ enum class CachedPages { stored, unpacked };
 PageSource pages_from_cache(const package::PackageReader& reader, PageCache& cache, CachedPages form);
 
 // The package's materials as core materials: a texture path relative to the package resolves against the
-// package's folder (`package_dir`); embedded textures (blobs) are not loaded yet (base colour only).
+// package's folder (`package_dir`); an embedded texture (a blob) is left to CutGeometry to read (the material
+// has neither path nor image until then).
 std::vector<Material> package_materials(const package::PackageScene& scene,
                                         const std::filesystem::path& package_dir);
+
+// When CutGeometry reads the embedded textures (blobs) of the package's materials: `now`, all of them in the
+// constructor (a local file, or a caller that may wait: `render` of a package); `background`, each on a
+// thread of its own from the first update() that draws a node of its material (a streaming client: a blob
+// over HTTP must not stall a frame), the material drawn in its base colour until the image has arrived.
+enum class TextureLoading { now, background };
 
 // NodeSource of a complete package read locally: every record (its index page read on first use) and every
 // node available. What `render` of a package and the benchmark's reference images select from.
@@ -62,8 +73,11 @@ class CutGeometry {
   // `reader` must outlive this object. `decoded_triangle_budget`: decoded meshes of nodes that the current
   // cut does not draw are kept (for a cut that goes back to them) up to this many triangles, least recently
   // drawn dropped first.
+  // Embedded textures are read from the reader's byte source as `textures` says; one that cannot be read or
+  // decoded is a warning (warnings()), its material drawn in its base colour.
   explicit CutGeometry(package::PackageReader& reader, const std::filesystem::path& package_dir = {},
-                       uint64_t decoded_triangle_budget = 2'000'000);
+                       uint64_t decoded_triangle_budget = 2'000'000,
+                       TextureLoading textures = TextureLoading::now);
 
   // Makes the drawn nodes of `cut` (from select_cut over this reader's scene) ready to draw: decodes those
   // not cached, reading each of their pages once from `pages`. Returns the number of nodes decoded. Cost:
@@ -74,6 +88,10 @@ class CutGeometry {
   // The current cut's items, in the cut's (object, node) order.
   const std::vector<CutItem>& items() const { return items_; }
   const std::vector<Material>& materials() const { return materials_; }
+  // Embedded textures that could not be read or decoded, one line each.
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  // Embedded textures still being read in the background.
+  size_t textures_pending() const { return pending_.size(); }
   // A core::Scene of the current cut: one mesh per distinct drawn node (copied: O(triangles drawn)), one
   // object per item, the package's materials. What render::upload_scene draws.
   Scene scene() const;
@@ -88,9 +106,17 @@ class CutGeometry {
     uint64_t last_drawn = 0;  // update() count of the last cut that drew it
   };
   void evict();
+  // Starts (background) or finishes the reading of the embedded textures that `cut` draws.
+  void load_textures(const schedule::Cut& cut);
+  // Installs the image `read` returns into material `material`, or records the warning it throws.
+  void install_texture(uint32_t material, const std::function<std::shared_ptr<const Image>()>& read);
 
   package::PackageReader* reader_;
+  TextureLoading texture_loading_;
   std::vector<Material> materials_;
+  std::vector<bool> texture_requested_;  // per material: embedded texture asked for (or none to ask for)
+  std::map<uint32_t, std::future<std::shared_ptr<const Image>>> pending_;  // by material
+  std::vector<std::string> warnings_;
   uint64_t budget_, frame_ = 0, triangles_ = 0;
   std::unordered_map<uint32_t, Decoded> decoded_;
   std::vector<CutItem> items_;

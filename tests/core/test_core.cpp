@@ -2,6 +2,7 @@
 
 #include <fstream>
 #include <glm/gtc/matrix_transform.hpp>
+#include <iterator>
 
 #include "core/camera.hpp"
 #include "core/error.hpp"
@@ -108,4 +109,21 @@ TEST(Image, PngRoundTripIsExactAndDeterministic) {
   EXPECT_EQ(std::filesystem::file_size(dir / "a.png"), std::filesystem::file_size(dir / "b.png"));
   EXPECT_THROW(load_image(dir / "missing.png"), Error);
   EXPECT_THROW(save_png(img, dir / "no-such-dir" / "c.png"), Error);
+}
+
+TEST(Image, DecodesAFileHeldInMemoryAndNamesGarbage) {
+  Image img(3, 2);
+  for (size_t i = 0; i < img.rgba.size(); ++i) img.rgba[i] = uint8_t(i * 11);
+  auto dir = test::temp_dir();
+  save_png(img, dir / "a.png");
+  std::ifstream in(dir / "a.png", std::ios::binary);
+  std::vector<uint8_t> bytes{std::istreambuf_iterator<char>(in), {}};
+  EXPECT_EQ(decode_image(bytes, "mem").rgba, img.rgba);
+  bytes.resize(bytes.size() / 2);  // truncated
+  try {
+    decode_image(bytes, "scene.lods: texture blob 0");
+    ADD_FAILURE() << "a truncated PNG decoded";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.lods: texture blob 0"), std::string::npos) << e.what();
+  }
 }

@@ -55,8 +55,10 @@ TestPackage write_test_package(const std::filesystem::path& file) {
 
   t.scene.input_triangles = sphere.triangle_count() + cube.triangle_count();
   t.scene.metadata = R"({"test": true})";
-  t.scene.materials.push_back({Material{"skin", {0.8f, 0.7f, 0.6f, 1.0f}, "textures/skin.png"}, kNone});
-  t.scene.materials.push_back({Material{"crate", {0.5f, 0.5f, 0.5f, 1.0f}, ""}, 0});  // texture blob 0
+  t.scene.materials.push_back(
+      {Material{"skin", {0.8f, 0.7f, 0.6f, 1.0f}, "textures/skin.png", nullptr}, kNone});
+  t.scene.materials.push_back(
+      {Material{"crate", {0.5f, 0.5f, 0.5f, 1.0f}, "", nullptr}, 0});  // texture blob 0
 
   WriterOptions options;
   options.page_bytes = 2048;

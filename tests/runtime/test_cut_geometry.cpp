@@ -1,9 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <glm/gtc/matrix_transform.hpp>
+#include <iterator>
 #include <set>
+#include <thread>
 
 #include "core/error.hpp"
+#include "core/image.hpp"
 #include "package/reader.hpp"
 #include "package/writer.hpp"
 #include "runtime/cut_geometry.hpp"
@@ -39,7 +43,8 @@ struct GeometryPackage {
   std::vector<glm::mat4> transforms{glm::mat4(1.0f),
                                     glm::translate(glm::mat4(1.0f), glm::vec3(20.0f, 0.0f, 0.0f))};
 
-  GeometryPackage() {
+  // `blue_texture`: the blue material's texture embedded (a 3 x 2 PNG, blob 0) instead of referenced by path.
+  explicit GeometryPackage(bool blue_texture = false) {
     package::PackageScene scene = dag.scene(transforms);
     Material red, blue;
     red.base_color = {1.0f, 0.0f, 0.0f, 1.0f};
@@ -51,6 +56,13 @@ struct GeometryPackage {
     options.page_bytes = 1024;
     options.nodes_per_index_page = 8;
     package::PackageWriter writer(file, options);
+    if (blue_texture) {
+      const auto png = test::temp_dir() / "blue.png";
+      save_png(Image(3, 2), png);
+      std::ifstream in(png, std::ios::binary);
+      scene.materials[1].texture_blob =
+          writer.add_blob(std::vector<uint8_t>(std::istreambuf_iterator<char>(in), {}));
+    }
     for (uint32_t i = 0; i < dag.records.size(); ++i) {
       const auto [x0, x1] = dag.intervals[i];
       const Mesh mesh = strip(x0, x1, int(x1 - x0) * int(i % 3 + 1));
@@ -181,4 +193,33 @@ TEST(CutGeometry, ReadsPagesFromTheCache) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("is drawn but not cached"), std::string::npos) << e.what();
   }
+}
+
+// An embedded texture is read in the constructor (`now`), or in the background from the first update that
+// draws its material, the material untextured until then (`background`).
+TEST(CutGeometry, ReadsEmbeddedTexturesNowOrInTheBackground) {
+  GeometryPackage p(true);
+  package::PackageReader reader = package::PackageReader::open(p.file);
+  ReaderNodes all(reader);
+  const Cut cut = select_cut(reader.scene(), all, view_of({-1.0f, 0.5f, 1.0f}, {8.0f, 0.0f, 0.0f}), {0.5});
+
+  CutGeometry now(reader);
+  ASSERT_NE(now.materials()[1].base_color_image, nullptr);
+  EXPECT_EQ(now.materials()[1].base_color_image->width, 3);
+  EXPECT_TRUE(now.materials()[1].base_color_texture.empty());
+  EXPECT_EQ(now.materials()[0].base_color_image, nullptr);
+
+  CutGeometry later(reader, {}, 2'000'000, TextureLoading::background);
+  EXPECT_EQ(later.materials()[1].base_color_image, nullptr);
+  EXPECT_EQ(later.textures_pending(), 0u);
+  later.update(cut, pages_from_reader(reader));
+  // The read runs on its own thread: poll (each update installs what has arrived).
+  for (int i = 0; i < 1000 && later.textures_pending() > 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    later.update(cut, pages_from_reader(reader));
+  }
+  EXPECT_EQ(later.textures_pending(), 0u);
+  ASSERT_NE(later.materials()[1].base_color_image, nullptr);
+  EXPECT_EQ(later.materials()[1].base_color_image->rgba, now.materials()[1].base_color_image->rgba);
+  EXPECT_TRUE(later.warnings().empty());
 }
