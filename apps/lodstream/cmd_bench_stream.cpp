@@ -26,6 +26,7 @@
 #include "render/renderer.hpp"
 #include "render/scene_upload.hpp"
 #include "runtime/cut_geometry.hpp"
+#include "scene_bounds.hpp"
 #include "schedule/path_gen.hpp"
 #include "stream_sim.hpp"
 
@@ -94,13 +95,6 @@ fs::path package_of(const StreamArgs& args) {
     bake(args.input, package);
   }
   return package;
-}
-
-Bounds world_bounds(const package::PackageScene& scene) {
-  Bounds b;
-  for (const package::ObjectRecord& o : scene.objects)
-    b.add(transform_bounds(scene.representations[o.representation].bounds, o.transform));
-  return b;
 }
 
 schedule::CameraPath camera_path(const StreamArgs& args, const package::PackageScene& scene) {

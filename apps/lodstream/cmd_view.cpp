@@ -1,11 +1,12 @@
-// `lodstream view URL_OR_FILE --headless --path PATH.json --out DIR`: the streaming client (DESIGN.md, Client
-// runtime; the command line's addresses). FILE.lods is read locally, http://HOST:PORT/…/NAME.lods is pulled
-// (PageScheduler order over the views predicted from the path's motion, request window from the measured
-// bandwidth-delay product, from lodstream serve or any static server), ws://HOST:PORT/NAME is pushed to
-// (hello, a view update every frame, acknowledgements). Headless: follows the camera path on the wall clock
-// at 30 frames per second, keeps the last pose until the cut has converged or --settle seconds have passed,
-// and writes DESIGN's per-frame CSV to DIR/frames.csv. Streaming never blocks a frame: the transport runs on
-// its own threads and the frame installs what has arrived.
+// `lodstream view URL_OR_FILE`: the streaming client (DESIGN.md, Client runtime; the command line's
+// addresses), over a ViewClient (view_client.hpp: FILE.lods read locally, http://HOST:PORT/…/NAME.lods
+// pulled, ws://HOST:PORT/NAME pushed to). In a window (GLFW) it flies with mouse and keyboard
+// (fly_camera.hpp), the scheduling following the interactive camera and its measured motion; the window's
+// title is the on-screen line (frame time, triangles, bytes received, pixel error). `--headless --path
+// PATH.json --out DIR` follows the camera path on the wall clock at 30 frames per second, keeps the last pose
+// until the cut has converged or --settle seconds have passed, and writes DESIGN's per-frame CSV to
+// DIR/frames.csv. Streaming never blocks a frame: the transport and the pull scheduler run on threads of
+// their own; the frame installs what has arrived, selects the cut and draws.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -18,24 +19,21 @@
 #include "command.hpp"
 #include "core/error.hpp"
 #include "core/image.hpp"
-#include "net/http_source.hpp"
-#include "net/page_inbox.hpp"
-#include "net/pull_fetcher.hpp"
-#include "net/push_client.hpp"
-#include "net/url.hpp"
+#include "cut_drawer.hpp"
+#include "fly_camera.hpp"
 #include "render/context.hpp"
 #include "render/renderer.hpp"
-#include "render/scene_upload.hpp"
-#include "runtime/client_package.hpp"
 #include "runtime/cut_geometry.hpp"
+#include "scene_bounds.hpp"
 #include "schedule/camera_path.hpp"
-#include "schedule/motion.hpp"
+#include "schedule/path_gen.hpp"
+#include "view_client.hpp"
+#include "view_motion.hpp"
 
 namespace lodstream::cli {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-using schedule::PageKind;
 
 struct ViewOptions {
   std::string source;
@@ -48,46 +46,16 @@ struct ViewOptions {
   std::string order = "benefit";
   int frames_every = 0;  // 0: no images
   bool json = false;
+  // Window mode.
+  uint64_t frames = 0;  // exit after this many frames (0: when the window closes)
+  std::string screenshot, up = "0,1,0", size = "1280x720";
 };
 
-constexpr double kFrameRate = 30.0;
+constexpr double kFrameRate = 30.0;   // headless: the path's frame timeline
+constexpr double kWindowRate = 60.0;  // window: frames per second at most
 
-// The path's pose at t with its motion (for the scheduler's prediction): the eye's velocity and the angular
-// velocity that turns the view direction from t to t + 1/30 s. Still after the path's end.
-schedule::ViewSample sample_at(const schedule::CameraPath& path, double t) {
-  const Camera c = path.pose_at(t);
-  const schedule::View v = schedule::View::of(c);
-  schedule::ViewSample s;
-  s.time_s = t;
-  s.eye = v.eye;
-  s.forward = v.forward;
-  s.up = v.up;
-  s.fov_y_radians = glm::radians(double(c.fov_y_degrees));
-  s.width = c.width;
-  s.height = c.height;
-  if (t < path.end()) {
-    s.velocity = glm::dvec3(path.velocity_at(t).eye);
-    const double dt = 1.0 / kFrameRate;
-    const glm::dvec3 next = schedule::View::of(path.pose_at(t + dt)).forward;
-    const glm::dvec3 axis = glm::cross(s.forward, next);
-    const double sine = glm::length(axis);
-    if (sine > 1e-12) s.angular_velocity = axis / sine * std::atan2(sine, glm::dot(s.forward, next)) / dt;
-  }
-  return s;
-}
-
-wire::ViewUpdate view_update(const schedule::ViewSample& s) {
-  wire::ViewUpdate u;
-  u.client_time_s = s.time_s;
-  u.eye = glm::vec3(s.eye);
-  u.forward = glm::vec3(s.forward);
-  u.up = glm::vec3(s.up);
-  u.velocity = glm::vec3(s.velocity);
-  u.angular_velocity = glm::vec3(s.angular_velocity);
-  u.fov_y_radians = float(s.fov_y_radians);
-  u.viewport_width = uint16_t(s.width);
-  u.viewport_height = uint16_t(s.height);
-  return u;
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
 double percentile(std::vector<double> v, double p) {
@@ -96,79 +64,69 @@ double percentile(std::vector<double> v, double p) {
   return v[std::min(v.size() - 1, size_t(p * double(v.size())))];
 }
 
-int run_view(const ViewOptions& opt) {
-  if (!opt.headless) throw Error("view: only --headless is available in this build (no window yet)");
+ViewClientOptions client_options(const ViewOptions& opt, int width, int height) {
+  ViewClientOptions o;
+  o.pixel_error = opt.pixel_error;
+  o.cache_mb = opt.cache_mb;
+  o.budget = opt.budget;
+  o.order = opt.order;
+  o.width = width;
+  o.height = height;
+  return o;
+}
+
+void write_file(const std::filesystem::path& file, const std::string& text) {
+  const auto tmp = file.string() + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary);
+    f << text;
+    if (!f) throw Error(file.string() + ": cannot write");
+  }
+  std::filesystem::rename(tmp, file);
+}
+
+// Summary of a run, printed as JSON (--json) or one line.
+void report(const ViewOptions& opt, const char* mode, nlohmann::json j, const std::vector<double>& frame_ms) {
+  j["mode"] = mode;
+  j["frames"] = frame_ms.size();
+  j["frame_ms_p50"] = percentile(frame_ms, 0.5);
+  j["frame_ms_p99"] = percentile(frame_ms, 0.99);
+  if (opt.json) {
+    print_json(j);
+    return;
+  }
+  std::printf("%s: %s, %zu frames in %.2f s, %llu bytes, benefit ratio %.4f, frame ms p50 %.1f%s\n",
+              opt.source.c_str(), mode, frame_ms.size(), j["duration_s"].get<double>(),
+              (unsigned long long)j["bytes"].get<uint64_t>(), j["benefit_ratio"].get<double>(),
+              j["frame_ms_p50"].get<double>(),
+              j.contains("converged") ? (j["converged"] == true ? ", converged" : ", not converged") : "");
+}
+
+int run_headless(const ViewOptions& opt) {
   if (opt.path.empty()) throw Error("view --headless needs --path PATH.json");
   if (opt.out.empty()) throw Error("view --headless needs --out DIR");
-  if (!(opt.pixel_error > 0.0) || !std::isfinite(opt.pixel_error))
-    throw Error("--pixel-error must be a positive number of pixels");
-  if (!(opt.settle_s >= 0.0) || !std::isfinite(opt.settle_s)) throw Error("--settle must be >= 0 seconds");
-  if (!(opt.cache_mb > 0.0) || !std::isfinite(opt.cache_mb))
-    throw Error("--cache must be a positive MB count");
-  if (opt.order != "benefit" && opt.order != "sse") throw Error("--order must be 'benefit' or 'sse'");
-  if (opt.frames_every < 0) throw Error("--frames-every must be >= 0 (0: no images)");
   const schedule::CameraPath path = schedule::load_camera_path(opt.path);
+  ViewClient client(opt.source, client_options(opt, path.width(), path.height()));
 
-  // The package's root index, and the transport.
-  const bool push = opt.source.rfind("ws://", 0) == 0, pull = opt.source.rfind("http://", 0) == 0;
-  std::string http_url = opt.source;
-  if (push) {
-    const UrlParts u = split_url(opt.source, "ws://");
-    http_url = "http://" + u.host + ":" + u.port + u.target + ".lods";  // the same server serves the file
-  }
-  std::shared_ptr<const package::ByteSource> root_source;
-  if (push || pull)
-    root_source = std::make_shared<HttpSource>(http_url);
-  else
-    root_source = std::make_shared<package::FileSource>(opt.source);
-  runtime::ClientPackage client(package::PackageReader(root_source), uint64_t(opt.cache_mb * 1024 * 1024));
-  const package::RootIndex& root = client.reader().root();
-
-  PageInbox inbox;
-  std::unique_ptr<PullFetcher> fetcher;
-  std::unique_ptr<PushClient> pusher;
-  if (push) {
-    wire::Hello hello;
-    hello.package = split_url(opt.source, "ws://").target.substr(1);
-    hello.cache_budget_bytes = uint64_t(opt.cache_mb * 1024 * 1024);
-    hello.triangles_per_frame =
-        uint32_t(std::min<uint64_t>(opt.budget ? opt.budget : UINT32_MAX, UINT32_MAX));
-    hello.viewport_width = uint16_t(path.width());
-    hello.viewport_height = uint16_t(path.height());
-    pusher = std::make_unique<PushClient>(opt.source, hello, inbox);
-  } else if (pull) {
-    fetcher =
-        std::make_unique<PullFetcher>([url = http_url] { return std::make_shared<HttpSource>(url); }, inbox);
-  } else {
-    PullOptions local;
-    local.connections = 1;
-    local.min_window_bytes = 8u << 20;
-    fetcher = std::make_unique<PullFetcher>(
-        [file = opt.source] { return std::make_shared<package::FileSource>(file); }, inbox, local);
-  }
-
-  schedule::CutOptions cut_options;
-  cut_options.tau = opt.pixel_error;
-  if (opt.budget) cut_options.triangle_budget = opt.budget;
   const std::filesystem::path dir(opt.out);
   std::filesystem::create_directories(dir);
   // Images of the frames (--frames-every): the cut's geometry from the cache, drawn headless.
   std::unique_ptr<render::Context> context;
   std::unique_ptr<render::Renderer> renderer;
   std::unique_ptr<runtime::CutGeometry> geometry;
-  const std::filesystem::path package_dir =
-      push || pull ? std::filesystem::path() : std::filesystem::path(opt.source).parent_path();
+  std::unique_ptr<CutDrawer> drawer;
   if (opt.frames_every > 0) {
     context = render::create_headless_context();
     renderer = std::make_unique<render::Renderer>(*context);
-    geometry = std::make_unique<runtime::CutGeometry>(client.reader(), package_dir, 2'000'000,
-                                                      runtime::TextureLoading::background);
+    geometry = std::make_unique<runtime::CutGeometry>(client.package().reader(), client.package_dir(),
+                                                      2'000'000, runtime::TextureLoading::background);
+    drawer = std::make_unique<CutDrawer>(*renderer, geometry->materials());
   }
+  runtime::ClientPackage& package = client.package();
   auto draw = [&](uint64_t frame, const runtime::Frame& f, const Camera& camera) {
     geometry->update(
-        f.cut, runtime::pages_from_cache(client.reader(), client.cache(), runtime::CachedPages::unpacked));
-    const render::SceneUpload upload = render::upload_scene(*renderer, geometry->scene());
-    renderer->draw(camera, upload.items);
+        f.cut, runtime::pages_from_cache(package.reader(), package.cache(), runtime::CachedPages::unpacked));
+    renderer->draw(camera, drawer->items(*geometry));
     char name[64];
     std::snprintf(name, sizeof name, "frame_%05llu.png", (unsigned long long)frame);
     save_png(renderer->read_pixels(), dir / name);
@@ -180,109 +138,203 @@ int run_view(const ViewOptions& opt) {
   bool converged = false;
   double t = 0.0;
   const Clock::time_point start = Clock::now();
+  const double dt = 1.0 / kFrameRate;
   for (uint64_t i = 0;; ++i) {
-    std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
-                                              std::chrono::duration<double>(double(i) / kFrameRate)));
+    std::this_thread::sleep_until(
+        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(double(i) * dt)));
     const Clock::time_point frame_start = Clock::now();
     t = std::chrono::duration<double>(frame_start - start).count();
-    if (std::string error = inbox.error(); !error.empty()) throw Error(error);
-    for (ArrivedPage& a : inbox.take()) client.install(a.page.kind, a.page.id, a.bytes);
-
-    const schedule::ViewSample now = sample_at(path, t);
-    const auto predicted = schedule::predicted_views(now, 0.0);
-    std::vector<schedule::View> ahead;
-    for (size_t k = 1; k < predicted.size(); ++k) ahead.push_back(predicted[k].view);
-    if (fetcher) {
-      const uint64_t in_flight = fetcher->in_flight_bytes(), window = fetcher->window_bytes();
-      if (in_flight < window) {
-        const schedule::ScheduleOptions s{opt.pixel_error, window - in_flight, SIZE_MAX};
-        const auto pages =
-            opt.order == "sse"
-                ? client.scheduler().next_sse(client.scene(), client.nodes(), predicted[0].view, s)
-                : client.scheduler().next(client.scene(), client.nodes(), predicted, s);
-        for (const schedule::PageRef& p : pages) {
-          client.requested(p);
-          fetcher->request(p, p.kind == PageKind::data ? root.pages[p.id] : root.index_pages[p.id].range);
-        }
-      }
-    } else {
-      pusher->send_view(view_update(now));
-    }
-    last = client.frame(predicted[0].view, ahead, cut_options);
+    const Camera pose = path.pose_at(t);
+    last = client.frame(view_sample(pose, t, pose, path.pose_at(t + dt), dt));
     const bool final_pose = t >= path.end();
     const bool done = final_pose && (last.cut.converged() || t >= path.end() + opt.settle_s);
-    if (geometry && (i % uint64_t(opt.frames_every) == 0 || done)) draw(i, last, path.pose_at(t));
-    const double ms = 1e3 * std::chrono::duration<double>(Clock::now() - frame_start).count();
+    if (geometry && (i % uint64_t(opt.frames_every) == 0 || done)) draw(i, last, pose);
+    const double ms = 1e3 * seconds_since(frame_start);
     frame_ms.push_back(ms);
     if (!first_frame_s && !last.cut.drawn.empty()) first_frame_s = t;
     if (!time_095_s && last.quality.benefit_ratio >= 0.95) time_095_s = t;
     char row[256];
     std::snprintf(row, sizeof row, "%.4f,%llu,%zu,%llu,%.6g,%.6g,%.6f,%.3f\n", t,
-                  (unsigned long long)client.bytes_received(), last.cut.drawn.size(),
+                  (unsigned long long)package.bytes_received(), last.cut.drawn.size(),
                   (unsigned long long)last.cut.triangles, last.quality.pixel_error_max,
                   last.quality.pixel_error_mean, last.quality.benefit_ratio, ms);
     csv += row;
     if (final_pose) converged = last.cut.converged();
     if (done) break;
   }
-
-  const auto tmp = dir / "frames.csv.tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    f << csv;
-    if (!f) throw Error((dir / "frames.csv").string() + ": cannot write");
-  }
-  std::filesystem::rename(tmp, dir / "frames.csv");
+  write_file(dir / "frames.csv", csv);
 
   nlohmann::json j;
-  j["mode"] = push ? "push" : pull ? "pull" : "file";
-  j["frames"] = frame_ms.size();
   j["duration_s"] = t;
   j["converged"] = converged;
-  j["bytes"] = client.bytes_received();
+  j["bytes"] = package.bytes_received();
   j["time_to_first_frame_s"] = first_frame_s ? nlohmann::json(*first_frame_s) : nlohmann::json(nullptr);
   j["time_to_095_s"] = time_095_s ? nlohmann::json(*time_095_s) : nlohmann::json(nullptr);
   j["benefit_ratio"] = last.quality.benefit_ratio;
   j["pixel_error_max"] = last.quality.pixel_error_max;
   j["nodes"] = last.cut.drawn.size();
   j["triangles"] = last.cut.triangles;
-  j["frame_ms_p50"] = percentile(frame_ms, 0.5);
-  j["frame_ms_p99"] = percentile(frame_ms, 0.99);
   j["csv"] = (dir / "frames.csv").string();
-  if (opt.json) {
-    print_json(j);
-  } else {
-    std::printf("%s: %s, %zu frames in %.2f s, %llu bytes, benefit ratio %.4f, %s\n", opt.source.c_str(),
-                j["mode"].get<std::string>().c_str(), frame_ms.size(), t,
-                (unsigned long long)client.bytes_received(), last.quality.benefit_ratio,
-                converged ? "converged" : "not converged");
-  }
+  report(opt, client.mode(), j, frame_ms);
   return 0;
 }
 
+// The window's on-screen line (its title).
+std::string status_line(double frame_ms, const runtime::Frame& f, uint64_t bytes, float speed) {
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "lodstream view | %.1f ms | %llu triangles | %.2f MB received | pixel error %.2f px (max) | "
+                "benefit %.3f | speed %.3g/s",
+                frame_ms, (unsigned long long)f.cut.triangles, double(bytes) / 1e6, f.quality.pixel_error_max,
+                f.quality.benefit_ratio, speed);
+  return line;
+}
+
+int run_window(const ViewOptions& opt) {
+  if (!opt.out.empty()) throw Error("--out is for --headless (a window writes no CSV; see --screenshot)");
+  const glm::vec3 up = parse_vec3(opt.up, "--up");
+  if (glm::length(up) == 0.0f) throw Error("--up must not be the zero vector");
+  auto [width, height] = parse_size(opt.size, "--size");
+  std::optional<schedule::CameraPath> path;
+  if (!opt.path.empty()) {
+    path = schedule::load_camera_path(opt.path);
+    width = path->width();
+    height = path->height();
+  }
+  ViewClient client(opt.source, client_options(opt, width, height));
+  runtime::ClientPackage& package = client.package();
+
+  // Start pose: the path's first key frame, else the generated fly-through's (3 r out, looking at the
+  // scene's centre); speed: the fly-through's, about 0.3 r per second.
+  const Bounds bounds = world_bounds(package.scene());
+  const float radius = std::max(0.5f * glm::length(bounds.extent()), 1e-6f);
+  Camera start;
+  if (path) {
+    start = path->pose_at(path->start());
+  } else {
+    schedule::PathGenOptions gen;
+    gen.up = up;
+    gen.width = width;
+    gen.height = height;
+    start = schedule::generate_path("fly", bounds, gen).pose_at(0.0);
+  }
+  FlyCamera fly(start, path ? path->keyframes().front().up : up, 0.3f * radius);
+
+  auto window = render::create_window_context(width, height, "lodstream view " + opt.source);
+  render::Renderer renderer(*window);
+  runtime::CutGeometry geometry(package.reader(), client.package_dir(), 2'000'000,
+                                runtime::TextureLoading::background);
+  CutDrawer drawer(renderer, geometry.materials());
+  for (const std::string& w : drawer.warnings()) std::fprintf(stderr, "lodstream: warning: %s\n", w.c_str());
+
+  std::vector<double> frame_ms;
+  runtime::Frame last;
+  const Clock::time_point start_time = Clock::now();
+  Camera previous = fly.camera(width, height);
+  double previous_t = 0.0, title_t = -1.0;
+  for (uint64_t i = 0; opt.frames == 0 || i < opt.frames; ++i) {
+    std::this_thread::sleep_until(start_time + std::chrono::duration_cast<Clock::duration>(
+                                                   std::chrono::duration<double>(double(i) / kWindowRate)));
+    const Clock::time_point frame_start = Clock::now();
+    const double t = seconds_since(start_time);
+    if (!window->poll_events() || window->input().quit) break;
+    fly.update(window->input(), t - previous_t);
+    const auto [fb_width, fb_height] = window->framebuffer_size();
+    if (fb_width <= 0 || fb_height <= 0) continue;  // minimised
+    const Camera camera = fly.camera(fb_width, fb_height);
+    // The view sample's motion: measured from the previous frame's pose.
+    const double dt = std::max(t - previous_t, 1e-3);
+    last = client.frame(view_sample(camera, t, i ? previous : camera, camera, dt));
+    previous = camera;
+    previous_t = t;
+    geometry.update(last.cut, runtime::pages_from_cache(package.reader(), package.cache(),
+                                                        runtime::CachedPages::unpacked));
+    renderer.draw(camera, drawer.items(geometry));
+    renderer.present(fb_width, fb_height);
+    window->swap_buffers();
+    frame_ms.push_back(1e3 * seconds_since(frame_start));
+    if (t - title_t >= 0.25) {
+      window->set_title(status_line(frame_ms.back(), last, package.bytes_received(), fly.speed()));
+      title_t = t;
+    }
+  }
+  if (!opt.screenshot.empty()) {
+    const Image image = renderer.read_pixels();
+    const auto tmp = opt.screenshot + ".tmp.png";
+    save_png(image, tmp);
+    std::filesystem::rename(tmp, opt.screenshot);
+  }
+  nlohmann::json j;
+  j["duration_s"] = seconds_since(start_time);
+  j["bytes"] = package.bytes_received();
+  j["benefit_ratio"] = last.quality.benefit_ratio;
+  j["pixel_error_max"] = last.quality.pixel_error_max;
+  j["nodes"] = last.cut.drawn.size();
+  j["triangles"] = last.cut.triangles;
+  j["renderer"] = window->renderer();
+  report(opt, client.mode(), j, frame_ms);
+  return 0;
+}
+
+int run_view(const ViewOptions& opt) {
+  if (!(opt.pixel_error > 0.0) || !std::isfinite(opt.pixel_error))
+    throw Error("--pixel-error must be a positive number of pixels");
+  if (!(opt.settle_s >= 0.0) || !std::isfinite(opt.settle_s)) throw Error("--settle must be >= 0 seconds");
+  if (!(opt.cache_mb > 0.0) || !std::isfinite(opt.cache_mb))
+    throw Error("--cache must be a positive MB count");
+  if (opt.order != "benefit" && opt.order != "sse") throw Error("--order must be 'benefit' or 'sse'");
+  if (opt.frames_every < 0) throw Error("--frames-every must be >= 0 (0: no images)");
+  return opt.headless ? run_headless(opt) : run_window(opt);
+}
+
 const bool registered = register_command(
-    {"view", "the streaming client: follow a camera path over a local, pulled or pushed package",
+    {"view",
+     "the streaming client: fly through a local, pulled or pushed package in a window, or follow a "
+     "camera path headless",
      [](CLI::App& sub) {
        auto opt = std::make_shared<ViewOptions>();
        sub.add_option("source", opt->source,
                       "FILE.lods, http://HOST:PORT/…/NAME.lods (pull) or ws://HOST:PORT/NAME (push)")
            ->required();
        sub.add_flag("--headless", opt->headless, "no window: follow --path and write --out/frames.csv");
-       sub.add_option("--path", opt->path, "camera path JSON (DESIGN.md)")->check(CLI::ExistingFile);
-       sub.add_option("--out", opt->out, "directory for frames.csv");
+       sub.add_option("--path", opt->path,
+                      "camera path JSON (DESIGN.md); in a window, only its first key frame (the start pose)")
+           ->check(CLI::ExistingFile);
+       sub.add_option("--out", opt->out, "directory for frames.csv (headless)");
        sub.add_option("--pixel-error", opt->pixel_error, "target pixel error tau")->capture_default_str();
-       sub.add_option("--settle", opt->settle_s, "seconds to keep the last pose until converged")
+       sub.add_option("--settle", opt->settle_s, "seconds to keep the last pose until converged (headless)")
            ->capture_default_str();
        sub.add_option("--cache", opt->cache_mb, "page cache budget, MB")->capture_default_str();
        sub.add_option("--budget", opt->budget, "triangles drawn per frame at most (0: no limit)");
        sub.add_option("--order", opt->order, "pull order: benefit (benefit per byte, predicted) or sse")
            ->capture_default_str();
        sub.add_option("--frames-every", opt->frames_every,
-                      "write DIR/frame_NNNNN.png every N frames and the final frame (0: none)");
+                      "headless: write DIR/frame_NNNNN.png every N frames and the final frame (0: none)");
        sub.add_flag("--json", opt->json, "print a JSON summary");
+       sub.add_option("--frames", opt->frames, "window: exit after N frames (0: when the window closes)");
+       sub.add_option("--screenshot", opt->screenshot, "window: write the last frame to this PNG on exit");
+       sub.add_option("--up", opt->up, "window: the world's up axis X,Y,Z (navigation, start pose)")
+           ->capture_default_str();
+       sub.add_option("--size", opt->size, "window: size WxH (a --path gives its own)")
+           ->capture_default_str();
        sub.footer(
-           "CSV columns: t,bytes,nodes,triangles,pixel_error_max,pixel_error_mean,benefit_ratio,frame_ms\n"
-           "(one row per frame at 30 frames/s; the last row is the final frame).");
+           "Window controls: drag with the left mouse button to look around; W/S (or Up/Down) fly forward "
+           "and\n"
+           "back, A/D (or Left/Right) sideways, E/Q up and down along --up; hold Shift to fly 4x faster; "
+           "the\n"
+           "mouse wheel changes the speed (x1.25 a step; it starts at 0.3 scene radii per second); Esc "
+           "quits.\n"
+           "The window's title shows the frame time, triangles drawn, bytes received, the pixel error and "
+           "the\n"
+           "benefit ratio. The window starts at --path's first key frame, else 3 scene radii out, looking "
+           "at\n"
+           "the scene's centre; scheduling follows the camera and its motion measured from frame to frame.\n"
+           "Headless CSV columns: t,bytes,nodes,triangles,pixel_error_max,pixel_error_mean,benefit_ratio,\n"
+           "frame_ms (one row per frame at 30 frames/s; the last row is the final frame).\n"
+           "Examples:\n"
+           "  lodstream view out/motorBike.lods --up 0,0,1\n"
+           "  lodstream view http://127.0.0.1:8080/motorBike.lods --up 0,0,1\n"
+           "  lodstream view ws://127.0.0.1:8080/motorBike --headless --path path.json --out out/view");
        return [opt] { return run_view(*opt); };
      }});
 

@@ -79,24 +79,27 @@ void PullFetcher::work(const SourceFactory& make_source) {
       inbox_.fail(e.what());
       return;
     }
-    inbox_.put(std::move(arrived));
-    std::lock_guard lock(mutex_);
-    const double t = now();
-    in_flight_ -= r.range.size;
-    const double took = t - r.sent_s;
-    if (min_rtt_s_ == 0.0 || took < min_rtt_s_) min_rtt_s_ = took;
-    // Delivery rate over the window (bytes completed in it / its span).
-    completed_.push_back({t, r.range.size});
-    while (completed_.size() > 1 && completed_.front().first < t - options_.bandwidth_window_s)
-      completed_.pop_front();
-    uint64_t bytes = 0;
-    for (auto& c : completed_) bytes += c.second;
-    const double span = std::max(t - completed_.front().first, took);
-    const double rate = span > 0.0 ? 8.0 * double(bytes) / span : 0.0;
-    if (rate > best_rate_bps_ || t - best_rate_time_ > options_.bandwidth_window_s) {
-      best_rate_bps_ = rate;
-      best_rate_time_ = t;
+    {
+      std::lock_guard lock(mutex_);
+      const double t = now();
+      in_flight_ -= r.range.size;
+      const double took = t - r.sent_s;
+      if (min_rtt_s_ == 0.0 || took < min_rtt_s_) min_rtt_s_ = took;
+      // Delivery rate over the window (bytes completed in it / its span).
+      completed_.push_back({t, r.range.size});
+      while (completed_.size() > 1 && completed_.front().first < t - options_.bandwidth_window_s)
+        completed_.pop_front();
+      uint64_t bytes = 0;
+      for (auto& c : completed_) bytes += c.second;
+      const double span = std::max(t - completed_.front().first, took);
+      const double rate = span > 0.0 ? 8.0 * double(bytes) / span : 0.0;
+      if (rate > best_rate_bps_ || t - best_rate_time_ > options_.bandwidth_window_s) {
+        best_rate_bps_ = rate;
+        best_rate_time_ = t;
+      }
     }
+    // After the bookkeeping: a consumer woken by the inbox sees the window this page freed.
+    inbox_.put(std::move(arrived));
   }
 }
 

@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace lodstream::render {
@@ -43,6 +44,17 @@ class Context {
 std::unique_ptr<Context> create_headless_context(const std::vector<EglPlatform>& order = {
                                                      EglPlatform::device, EglPlatform::surfaceless});
 
+// What a fly camera reads of the keyboard and mouse (window_input()): keys held now, and what accumulated
+// since the previous poll_events().
+struct WindowInput {
+  bool forward = false, back = false, left = false, right = false;  // W S A D (or the arrow keys)
+  bool down = false, up = false;                                    // Q E
+  bool fast = false;                                                // a Shift key
+  bool quit = false;                                                // Escape
+  double look_x = 0.0, look_y = 0.0;  // cursor motion while the left mouse button is held, pixels
+  double scroll = 0.0;                // wheel steps (positive: away from the user)
+};
+
 // A window of width x height pixels (hidden when `visible` is false) with an OpenGL 4.5 core context, through
 // GLFW (X11; needs DISPLAY). Throws lodstream::Error with GLFW's reason when no window can be made.
 class WindowContext : public Context {
@@ -51,6 +63,11 @@ class WindowContext : public Context {
   virtual void swap_buffers() = 0;
   // Processes pending window events; returns false once the user asked to close the window.
   virtual bool poll_events() = 0;
+  // The input as of the last poll_events() (motion and scroll since the one before).
+  virtual WindowInput input() const = 0;
+  // The default framebuffer's size in pixels (what to draw at; it follows the window's size).
+  virtual std::pair<int, int> framebuffer_size() const = 0;
+  virtual void set_title(const std::string& title) = 0;
 };
 
 std::unique_ptr<WindowContext> create_window_context(int width, int height, const std::string& title,

@@ -43,6 +43,10 @@ class GlfwContext final : public WindowContext {
                   " OpenGL 4.5 core window: " + reason);
     }
     ++glfw_windows;
+    glfwSetWindowUserPointer(window_, this);
+    glfwSetScrollCallback(window_, [](GLFWwindow* w, double, double dy) {
+      static_cast<GlfwContext*>(glfwGetWindowUserPointer(w))->scroll_ += dy;
+    });
     glfwMakeContextCurrent(window_);
   }
 
@@ -56,12 +60,47 @@ class GlfwContext final : public WindowContext {
   std::string platform() const override { return "glfw"; }
   void swap_buffers() override { glfwSwapBuffers(window_); }
   bool poll_events() override {
+    scroll_ = 0.0;
     glfwPollEvents();
+    auto held = [&](int a, int b = GLFW_KEY_UNKNOWN) {
+      return glfwGetKey(window_, a) == GLFW_PRESS ||
+             (b != GLFW_KEY_UNKNOWN && glfwGetKey(window_, b) == GLFW_PRESS);
+    };
+    input_ = WindowInput{};
+    input_.forward = held(GLFW_KEY_W, GLFW_KEY_UP);
+    input_.back = held(GLFW_KEY_S, GLFW_KEY_DOWN);
+    input_.left = held(GLFW_KEY_A, GLFW_KEY_LEFT);
+    input_.right = held(GLFW_KEY_D, GLFW_KEY_RIGHT);
+    input_.down = held(GLFW_KEY_Q);
+    input_.up = held(GLFW_KEY_E);
+    input_.fast = held(GLFW_KEY_LEFT_SHIFT, GLFW_KEY_RIGHT_SHIFT);
+    input_.quit = held(GLFW_KEY_ESCAPE);
+    input_.scroll = scroll_;
+    double x = 0.0, y = 0.0;
+    glfwGetCursorPos(window_, &x, &y);
+    if (glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS && dragging_) {
+      input_.look_x = x - cursor_x_;
+      input_.look_y = y - cursor_y_;
+    }
+    dragging_ = glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+    cursor_x_ = x;
+    cursor_y_ = y;
     return !glfwWindowShouldClose(window_);
   }
+  WindowInput input() const override { return input_; }
+  std::pair<int, int> framebuffer_size() const override {
+    int width = 0, height = 0;
+    glfwGetFramebufferSize(window_, &width, &height);
+    return {width, height};
+  }
+  void set_title(const std::string& title) override { glfwSetWindowTitle(window_, title.c_str()); }
 
  private:
   GLFWwindow* window_ = nullptr;
+  WindowInput input_;
+  double scroll_ = 0.0;  // wheel steps during the current poll_events()
+  double cursor_x_ = 0.0, cursor_y_ = 0.0;
+  bool dragging_ = false;
 };
 
 }  // namespace

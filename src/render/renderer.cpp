@@ -332,6 +332,15 @@ double Renderer::draw(const Camera& camera, std::span<const DrawItem> items) {
   return std::chrono::duration<double, std::milli>(end - start).count();
 }
 
+void Renderer::present(int width, int height) const {
+  if (!frame_.framebuffer) return;
+  const GLuint source = frame_.resolve_framebuffer ? frame_.resolve_framebuffer : frame_.framebuffer;
+  const GLenum filter = width == frame_.width && height == frame_.height ? GL_NEAREST : GL_LINEAR;
+  glBlitNamedFramebuffer(source, 0, 0, 0, frame_.width, frame_.height, 0, 0, width, height,
+                         GL_COLOR_BUFFER_BIT, filter);
+  check_gl("present");
+}
+
 Image Renderer::read_pixels() const {
   Image image(frame_.width, frame_.height);
   if (!frame_.framebuffer) return image;

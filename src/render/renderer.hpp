@@ -86,6 +86,10 @@ class Renderer {
   // The frame of the last draw(), rows top to bottom. Cost: one glReadPixels (0.5-5 ms at 1280x720).
   Image read_pixels() const;
 
+  // Copies the frame of the last draw() into the current context's default framebuffer (a window's back
+  // buffer; WindowContext::swap_buffers shows it), scaled to width x height. Cost: one framebuffer blit.
+  void present(int width, int height) const;
+
  private:
   struct GpuMesh {
     uint32_t vertex_array = 0, vertex_buffer = 0, index_buffer = 0;  // 0 once released

@@ -7,14 +7,12 @@
 
 namespace lodstream::render {
 
-SceneUpload upload_scene(Renderer& renderer, const Scene& scene) {
-  SceneUpload upload;
-  for (const Mesh& mesh : scene.meshes) upload.meshes.push_back(renderer.upload_mesh(mesh));
-
-  std::vector<DrawMaterial> materials;
+std::vector<DrawMaterial> upload_materials(Renderer& renderer, const std::vector<Material>& materials,
+                                           SceneUpload& upload) {
+  std::vector<DrawMaterial> draw_materials;
   std::map<std::string, TextureHandle> by_file;  // kNoTexture for files that could not be read
   std::map<const Image*, TextureHandle> by_image;
-  for (const Material& material : scene.materials) {
+  for (const Material& material : materials) {
     DrawMaterial draw{material.base_color, kNoTexture};
     const std::string& file = material.base_color_texture;
     if (material.base_color_image) {
@@ -37,8 +35,15 @@ SceneUpload upload_scene(Renderer& renderer, const Scene& scene) {
       }
       draw.texture = it->second;
     }
-    materials.push_back(draw);
+    draw_materials.push_back(draw);
   }
+  return draw_materials;
+}
+
+SceneUpload upload_scene(Renderer& renderer, const Scene& scene) {
+  SceneUpload upload;
+  for (const Mesh& mesh : scene.meshes) upload.meshes.push_back(renderer.upload_mesh(mesh));
+  const std::vector<DrawMaterial> materials = upload_materials(renderer, scene.materials, upload);
 
   for (const Object& object : scene.objects) {
     if (object.mesh >= scene.meshes.size())

@@ -23,6 +23,12 @@ struct SceneUpload {
 // a lodstream::Error (the Scene is malformed). Cost: the meshes' upload plus decoding each texture file once.
 SceneUpload upload_scene(Renderer& renderer, const Scene& scene);
 
+// Uploads the base-colour texture of each of `materials` (once per distinct file; handles appended to
+// `upload.textures`, unreadable files to `upload.warnings`, those materials falling back to their base
+// colour) and returns their draw materials, in order. What upload_scene() does for a scene's materials.
+std::vector<DrawMaterial> upload_materials(Renderer& renderer, const std::vector<Material>& materials,
+                                           SceneUpload& upload);
+
 // Releases what upload_scene() uploaded (its meshes and textures); its items must not be drawn again.
 void release_scene(Renderer& renderer, const SceneUpload& upload);
 

@@ -51,7 +51,10 @@ Frame ClientPackage::frame(const View& view, std::span<const View> predicted,
   cache_.set_usefulness(hash, u.pinned, u.usefulness);
   if (cache_.evicted_pages() > 0)
     for (uint32_t page : cached_pages)
-      if (!cache_.contains(hash, page)) scheduler_.set_held(PageKind::data, page, false);
+      if (!cache_.contains(hash, page)) {
+        scheduler_.set_held(PageKind::data, page, false);
+        evicted_.push_back(page);
+      }
   return f;
 }
 

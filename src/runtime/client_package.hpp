@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <span>
 #include <unordered_set>
+#include <utility>
 #include <vector>
 
 #include "package/reader.hpp"
@@ -51,6 +52,9 @@ class ClientPackage {
   // The stored bytes installed so far (what the transport delivered).
   uint64_t bytes_received() const { return bytes_received_; }
   size_t in_flight() const { return in_flight_.size(); }
+  // The data pages the cache evicted since the last call (in frame()), for a scheduler kept elsewhere (a pull
+  // scheduler on its own thread) to schedule again.
+  std::vector<uint32_t> take_evicted() { return std::exchange(evicted_, {}); }
   // Pages held, by kind, as runs (what a Hello tells a push server).
   std::vector<uint32_t> held(schedule::PageKind kind) const;
 
@@ -61,6 +65,7 @@ class ClientPackage {
   schedule::PageScheduler scheduler_;
   std::unordered_set<uint64_t> in_flight_;  // kind << 32 | id
   uint64_t bytes_received_ = 0;
+  std::vector<uint32_t> evicted_;  // since the last take_evicted()
 };
 
 }  // namespace lodstream::runtime

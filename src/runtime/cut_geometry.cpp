@@ -71,6 +71,7 @@ void CutGeometry::install_texture(uint32_t material,
                                   const std::function<std::shared_ptr<const Image>()>& read) {
   try {
     materials_[material].base_color_image = read();
+    ++materials_version_;
   } catch (const Error& e) {
     warnings_.push_back("material '" + materials_[material].name + "': " + e.what() +
                         "; drawn in its base colour");

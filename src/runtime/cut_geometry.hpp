@@ -92,6 +92,9 @@ class CutGeometry {
   const std::vector<std::string>& warnings() const { return warnings_; }
   // Embedded textures still being read in the background.
   size_t textures_pending() const { return pending_.size(); }
+  // Changes whenever a texture read in the background is installed into materials() (so a caller that
+  // uploaded the materials knows to upload them again).
+  uint64_t materials_version() const { return materials_version_; }
   // A core::Scene of the current cut: one mesh per distinct drawn node (copied: O(triangles drawn)), one
   // object per item, the package's materials. What render::upload_scene draws.
   Scene scene() const;
@@ -117,6 +120,7 @@ class CutGeometry {
   std::vector<bool> texture_requested_;  // per material: embedded texture asked for (or none to ask for)
   std::map<uint32_t, std::future<std::shared_ptr<const Image>>> pending_;  // by material
   std::vector<std::string> warnings_;
+  uint64_t materials_version_ = 0;
   uint64_t budget_, frame_ = 0, triangles_ = 0;
   std::unordered_map<uint32_t, Decoded> decoded_;
   std::vector<CutItem> items_;

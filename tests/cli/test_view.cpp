@@ -1,6 +1,6 @@
 // `lodstream view --headless` end to end: a baked package read locally, pulled from `lodstream serve` and
 // from a real nginx, and pushed to by `lodstream serve`, each reaching the converged cut (last CSV row:
-// benefit ratio 1) for a fixed camera; 16 clients on one server; bad input.
+// benefit ratio 1) for a fixed camera; 16 clients on one server; the window mode under Xvfb; bad input.
 #include <gtest/gtest.h>
 
 #include <utility>  // Boost 1.74 awaitable.hpp uses std::exchange without including it
@@ -13,9 +13,12 @@
 #include <thread>
 
 #include "baked.hpp"
+#include "core/image.hpp"
 #include "net/wire.hpp"
+#include "render/renderer.hpp"
 #include "support/nginx.hpp"
 #include "support/run.hpp"
+#include "support/xvfb.hpp"
 
 using namespace lodstream;
 
@@ -166,6 +169,42 @@ TEST(View, SixteenClientsOnOneServerConvergeWhileAGarbageClientGetsBye) {
   EXPECT_EQ(server.process.stop(), 0);
 }
 
+TEST(View, AWindowUnderXvfbDrawsWhatItPulledAndExitsAfterItsFrames) {
+  test::Xvfb x(800, 600);
+  ASSERT_FALSE(x.display().empty()) << "Xvfb did not start (scripts/setup installs xvfb)";
+  Server server;
+  const auto shot = test::temp_dir() / "window.png";
+  // The start pose is the path's first key frame: the elephant in the middle of a 640x480 window.
+  const auto path = camera_path({}, {0.0f, 0.2f, 1.5f}, 0);
+  setenv("DISPLAY", x.display().c_str(), 1);
+  const auto r = test::run_lodstream({"view", server.http(), "--path", path.string(), "--frames", "45",
+                                      "--screenshot", shot.string(), "--json"});
+  unsetenv("DISPLAY");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = r.json();
+  EXPECT_EQ(j["mode"], "pull");
+  EXPECT_EQ(j["frames"], 45);
+  EXPECT_GT(j["bytes"].get<uint64_t>(), 0u);
+  EXPECT_GT(j["triangles"].get<uint64_t>(), 0u);
+  // The last frame shows the scene: pixels other than the background, where the elephant is (the middle).
+  const Image image = load_image(shot);
+  ASSERT_EQ(image.width, 640);
+  ASSERT_EQ(image.height, 480);
+  size_t covered = 0, covered_middle = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const uint8_t* p = image.pixel(x, y);
+      if (std::equal(p, p + 3, render::kBackground.begin())) continue;
+      ++covered;
+      if (std::abs(x - image.width / 2) < image.width / 4 &&
+          std::abs(y - image.height / 2) < image.height / 4)
+        ++covered_middle;
+    }
+  EXPECT_GT(covered, size_t(image.width * image.height / 50)) << "the frame is (nearly) empty";
+  EXPECT_GT(covered_middle, covered / 2);
+  EXPECT_EQ(server.process.stop(), 0);
+}
+
 TEST(View, BadInputIsAOneLineError) {
   const auto path = camera_path({}, {0.0f, 0.0f, 2.0f}, 0);
   const auto out = (test::temp_dir() / "bad").string();
@@ -188,4 +227,10 @@ TEST(View, BadInputIsAOneLineError) {
   expect_error(test::run_lodstream({"view", test::elephant_package().string(), "--headless", "--path",
                                     path.string(), "--out", out, "--pixel-error", "0"}),
                "--pixel-error");
+  // A window without an X display: GLFW's reason, in one line.
+  const char* display = std::getenv("DISPLAY");
+  const std::string saved = display ? display : "";
+  unsetenv("DISPLAY");
+  expect_error(test::run_lodstream({"view", test::elephant_package().string(), "--frames", "1"}), "DISPLAY");
+  if (display) setenv("DISPLAY", saved.c_str(), 1);
 }

@@ -1,8 +1,4 @@
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cstdlib>
 #include <string>
@@ -12,8 +8,7 @@
 #include "render/renderer.hpp"
 #include "render_fixture.hpp"
 #include "support/shapes.hpp"
-
-extern char** environ;
+#include "support/xvfb.hpp"
 
 using namespace lodstream;
 using namespace lodstream::render;
@@ -46,34 +41,6 @@ void expect_same_image(const Image& a, const std::string& renderer_a, const Imag
     EXPECT_NEAR(double(test::covered_pixels(b)), covered, 0.02 * covered)
         << renderer_a << " vs " << renderer_b;
 }
-
-// An X server for the window test: Xvfb picks a free display and writes its number to a pipe (-displayfd).
-class Xvfb {
- public:
-  Xvfb() {
-    int fds[2];
-    if (pipe(fds) != 0) return;
-    std::string fd = std::to_string(fds[1]);
-    const char* argv[] = {"Xvfb",       "-displayfd", fd.c_str(), "-screen", "0",
-                          "320x240x24", "-nolisten",  "tcp",      nullptr};
-    if (posix_spawnp(&pid_, "Xvfb", nullptr, nullptr, const_cast<char**>(argv), environ) != 0) pid_ = -1;
-    close(fds[1]);
-    char c;
-    while (pid_ > 0 && read(fds[0], &c, 1) == 1 && c != '\n') display_ += c;
-    close(fds[0]);
-  }
-  ~Xvfb() {
-    if (pid_ > 0) {
-      kill(pid_, SIGTERM);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  std::string display() const { return display_.empty() ? "" : ":" + display_; }
-
- private:
-  pid_t pid_ = -1;
-  std::string display_;
-};
 
 }  // namespace
 
@@ -124,7 +91,7 @@ TEST(WindowContext, WithoutDisplayIsAClearError) {
 }
 
 TEST(WindowContext, UnderXvfbDrawsWhatHeadlessDraws) {
-  Xvfb server;
+  test::Xvfb server;
   ASSERT_FALSE(server.display().empty()) << "Xvfb did not start (scripts/setup installs xvfb)";
   setenv("DISPLAY", server.display().c_str(), 1);
   Image windowed;

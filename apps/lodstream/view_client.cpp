@@ -1,0 +1,96 @@
+#include "view_client.hpp"
+
+#include <algorithm>
+
+#include "core/error.hpp"
+#include "net/http_source.hpp"
+#include "net/push_client.hpp"
+#include "net/url.hpp"
+#include "pull_scheduler.hpp"
+#include "view_motion.hpp"
+
+namespace lodstream::cli {
+
+namespace {
+
+bool starts_with(const std::string& s, const char* prefix) {
+  return s.rfind(prefix, 0) == 0;
+}
+
+// The package file's URL: the source itself when pulled; for a push stream ws://HOST:PORT/NAME, the same
+// server's http://HOST:PORT/NAME.lods (DESIGN.md's addresses).
+std::string file_url(const std::string& source) {
+  if (!starts_with(source, "ws://")) return source;
+  const UrlParts u = split_url(source, "ws://");
+  return "http://" + u.host + ":" + u.port + u.target + ".lods";
+}
+
+std::shared_ptr<const package::ByteSource> open_source(const std::string& source, bool remote) {
+  if (remote) return std::make_shared<HttpSource>(file_url(source));
+  return std::make_shared<package::FileSource>(source);
+}
+
+uint64_t cache_bytes(const ViewClientOptions& o) {
+  return uint64_t(o.cache_mb * 1024 * 1024);
+}
+
+}  // namespace
+
+ViewClient::ViewClient(const std::string& source, const ViewClientOptions& options)
+    : mode_(starts_with(source, "ws://")     ? Mode::push
+            : starts_with(source, "http://") ? Mode::pull
+                                             : Mode::file),
+      package_dir_(mode_ == Mode::file ? std::filesystem::path(source).parent_path()
+                                       : std::filesystem::path()),
+      client_(package::PackageReader(open_source(source, mode_ != Mode::file)), cache_bytes(options)) {
+  cut_options_.tau = options.pixel_error;
+  if (options.budget) cut_options_.triangle_budget = options.budget;
+
+  if (mode_ == Mode::push) {
+    wire::Hello hello;
+    hello.package = split_url(source, "ws://").target.substr(1);
+    hello.cache_budget_bytes = cache_bytes(options);
+    hello.triangles_per_frame =
+        uint32_t(std::min<uint64_t>(options.budget ? options.budget : UINT32_MAX, UINT32_MAX));
+    hello.viewport_width = uint16_t(options.width);
+    hello.viewport_height = uint16_t(options.height);
+    pusher_ = std::make_unique<PushClient>(source, hello, arrived_);
+    return;
+  }
+  PullFetcher::SourceFactory make_source;
+  PullOptions fetch;
+  if (mode_ == Mode::pull) {
+    make_source = [url = source] { return std::make_shared<HttpSource>(url); };
+  } else {
+    make_source = [file = source] { return std::make_shared<package::FileSource>(file); };
+    fetch.connections = 1;
+    fetch.min_window_bytes = 8u << 20;
+  }
+  puller_ = std::make_unique<PullScheduler>(client_.reader(), std::move(make_source), fetch, arrived_,
+                                            options.order == "sse" ? PullOrder::sse : PullOrder::benefit,
+                                            options.pixel_error);
+}
+
+ViewClient::~ViewClient() = default;
+
+const char* ViewClient::mode() const {
+  return mode_ == Mode::push ? "push" : mode_ == Mode::pull ? "pull" : "file";
+}
+
+runtime::Frame ViewClient::frame(const schedule::ViewSample& now) {
+  if (std::string error = arrived_.error(); !error.empty()) throw Error(error);
+  for (ArrivedPage& a : arrived_.take()) client_.install(a.page.kind, a.page.id, a.bytes);
+  if (puller_)
+    puller_->publish(now);
+  else
+    pusher_->send_view(view_update(now));
+  const auto predicted = schedule::predicted_views(now, 0.0);
+  std::vector<schedule::View> ahead;
+  for (size_t k = 1; k < predicted.size(); ++k) ahead.push_back(predicted[k].view);
+  runtime::Frame f = client_.frame(predicted[0].view, ahead, cut_options_);
+  const std::vector<uint32_t> evicted = client_.take_evicted();
+  if (puller_) puller_->evicted(evicted);
+  return f;
+}
+
+}  // namespace lodstream::cli

@@ -1,0 +1,75 @@
+// The streaming client of `lodstream view` (DESIGN.md, Client runtime; the command line's addresses), apart
+// from its window or camera path: a source (FILE.lods read locally, http://HOST:PORT/…/NAME.lods pulled from
+// lodstream serve or any static server, ws://HOST:PORT/NAME pushed to by lodstream serve), its root index,
+// the transport, and per frame the installation of what arrived and the cut for the current view.
+//
+// Threads: construct, call and destroy a ViewClient on one thread (the frame thread); it owns the
+// ClientPackage (package() is for that thread only). The transport runs on threads of its own: a pull or a
+// local file has a PullScheduler (its scheduler thread plus the fetcher's readers), a push a PushClient;
+// they hand pages over through a PageInbox and take view samples through their own locked slot, so a frame
+// never waits on the network or on scheduling.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "net/page_inbox.hpp"
+#include "runtime/client_package.hpp"
+#include "schedule/cut.hpp"
+#include "schedule/motion.hpp"
+
+namespace lodstream {
+class PushClient;
+}
+
+namespace lodstream::cli {
+
+class PullScheduler;
+
+// Checked by the caller (cmd_view.cpp's option checks): positive finite pixel_error and cache_mb, a known
+// order.
+struct ViewClientOptions {
+  double pixel_error = 1.0;        // tau, pixels
+  double cache_mb = 1024.0;        // page cache budget
+  uint64_t budget = 0;             // triangles drawn per frame at most (0: no limit)
+  std::string order = "benefit";   // pull order: benefit or sse
+  int width = 1280, height = 720;  // the viewport a push server is told in the hello
+};
+
+class ViewClient {
+ public:
+  // Opens `source`: reads the root index (one read, blocking: a local read or one HTTP request) and starts
+  // the transport. Throws lodstream::Error (unreachable server, not a package, bad option) naming the source.
+  ViewClient(const std::string& source, const ViewClientOptions& options);
+  ~ViewClient();  // stops the transport
+  ViewClient(const ViewClient&) = delete;
+  ViewClient& operator=(const ViewClient&) = delete;
+
+  // "file", "pull" or "push".
+  const char* mode() const;
+
+  // One frame for the view sample `now` (pose and motion): installs the pages that arrived since the last
+  // frame (data pages checked and decompressed), hands `now` to the transport (the pull scheduler's slot or a
+  // view update to the push server), selects the cut for `now` from what has arrived and measures it; the
+  // views predicted from `now` set the cache's eviction order. Throws lodstream::Error when the transport
+  // failed. Cost: the pages' decompression + ClientPackage::frame.
+  runtime::Frame frame(const schedule::ViewSample& now);
+
+  runtime::ClientPackage& package() { return client_; }
+  // The local package's folder (textures resolve against it), empty for a remote source.
+  const std::filesystem::path& package_dir() const { return package_dir_; }
+
+ private:
+  enum class Mode { file, pull, push };
+  Mode mode_;
+  schedule::CutOptions cut_options_;
+  std::filesystem::path package_dir_;
+  runtime::ClientPackage client_;
+  PageInbox arrived_;  // what the transport delivered, for the next frame
+  std::unique_ptr<PullScheduler> puller_;
+  std::unique_ptr<PushClient> pusher_;
+};
+
+}  // namespace lodstream::cli
