@@ -28,6 +28,7 @@
 #include "render/scene_upload.hpp"
 #include "runtime/client_package.hpp"
 #include "runtime/cut_geometry.hpp"
+#include "runtime/disk_cache.hpp"
 #include "schedule/camera_path.hpp"
 #include "schedule/motion.hpp"
 
@@ -44,7 +45,8 @@ struct ViewOptions {
   double pixel_error = 1.0;
   double settle_s = 10.0;
   double cache_mb = 1024.0;
-  uint64_t budget = 0;  // 0: none
+  std::string cache_dir;  // empty: the cache lives in memory only
+  uint64_t budget = 0;    // 0: none
   std::string order = "benefit";
   int frames_every = 0;  // 0: no images
   bool json = false;
@@ -123,6 +125,13 @@ int run_view(const ViewOptions& opt) {
     root_source = std::make_shared<package::FileSource>(opt.source);
   runtime::ClientPackage client(package::PackageReader(root_source), uint64_t(opt.cache_mb * 1024 * 1024));
   const package::RootIndex& root = client.reader().root();
+  // Pages kept on disk by earlier sessions of this package (--cache-dir) are drawn from and never fetched.
+  std::optional<runtime::DiskCache> disk;
+  if (!opt.cache_dir.empty()) {
+    disk.emplace(opt.cache_dir, client.reader().header().content_hash);
+    for (const std::string& w : disk->restore(client, uint64_t(opt.cache_mb * 1024 * 1024)).warnings)
+      std::fprintf(stderr, "lodstream: warning: %s\n", w.c_str());
+  }
 
   PageInbox inbox;
   std::unique_ptr<PullFetcher> fetcher;
@@ -130,6 +139,9 @@ int run_view(const ViewOptions& opt) {
   if (push) {
     wire::Hello hello;
     hello.package = split_url(opt.source, "ws://").target.substr(1);
+    hello.cached_hash = client.reader().header().content_hash;
+    hello.held = wire::page_runs(client.held(PageKind::data));
+    hello.held_index = wire::page_runs(client.held(PageKind::index));
     hello.cache_budget_bytes = uint64_t(opt.cache_mb * 1024 * 1024);
     hello.triangles_per_frame =
         uint32_t(std::min<uint64_t>(opt.budget ? opt.budget : UINT32_MAX, UINT32_MAX));
@@ -185,7 +197,10 @@ int run_view(const ViewOptions& opt) {
     const Clock::time_point frame_start = Clock::now();
     t = std::chrono::duration<double>(frame_start - start).count();
     if (std::string error = inbox.error(); !error.empty()) throw Error(error);
-    for (ArrivedPage& a : inbox.take()) client.install(a.page.kind, a.page.id, a.bytes);
+    for (ArrivedPage& a : inbox.take()) {
+      client.install(a.page.kind, a.page.id, a.bytes);
+      if (disk) disk->store(a.page.kind, a.page.id, a.bytes);
+    }
 
     const schedule::ViewSample now = sample_at(path, t);
     const auto predicted = schedule::predicted_views(now, 0.0);
@@ -239,6 +254,8 @@ int run_view(const ViewOptions& opt) {
   j["duration_s"] = t;
   j["converged"] = converged;
   j["bytes"] = client.bytes_received();
+  j["bytes_restored"] = client.bytes_restored();
+  j["reconnects"] = pusher ? pusher->reconnects() : fetcher->reconnects();
   j["time_to_first_frame_s"] = first_frame_s ? nlohmann::json(*first_frame_s) : nlohmann::json(nullptr);
   j["time_to_095_s"] = time_095_s ? nlohmann::json(*time_095_s) : nlohmann::json(nullptr);
   j["benefit_ratio"] = last.quality.benefit_ratio;
@@ -273,6 +290,8 @@ const bool registered = register_command(
        sub.add_option("--settle", opt->settle_s, "seconds to keep the last pose until converged")
            ->capture_default_str();
        sub.add_option("--cache", opt->cache_mb, "page cache budget, MB")->capture_default_str();
+       sub.add_option("--cache-dir", opt->cache_dir,
+                      "keep received pages in DIR/<package hash>/ and start from them (no page sent twice)");
        sub.add_option("--budget", opt->budget, "triangles drawn per frame at most (0: no limit)");
        sub.add_option("--order", opt->order, "pull order: benefit (benefit per byte, predicted) or sse")
            ->capture_default_str();
