@@ -56,7 +56,7 @@ class PullFetcher {
   uint64_t window_bytes() const;
   double bandwidth_bps() const;
   double rtt_s() const;
-  // Sources made again after a failed read (reconnections), over all workers.
+  // Sources made again after a failed read (successful reconnections), over all workers.
   uint64_t reconnects() const;
 
  private:

@@ -130,6 +130,7 @@ struct PushClient::Impl {
             hello.held.clear(), hello.held_index.clear();
             arrived[0].clear(), arrived[1].clear();
           }
+          if (owner->welcomed_) ++owner->reconnects_;
           owner->welcomed_ = true;
           welcomed_now = true;
         } else if (auto* bye = std::get_if<wire::Bye>(&m)) {
@@ -168,7 +169,6 @@ struct PushClient::Impl {
       co_await backoff.async_wait(asio::redirect_error(use_awaitable, ec));
       if (closing) break;
       wait_s = std::min(2.0 * wait_s, reconnect.max_backoff_s);
-      ++owner->reconnects_;
     }
     done = true;
     wake.cancel();

@@ -37,7 +37,7 @@ class PushClient {
   void send_view(const wire::ViewUpdate& view);
   bool welcomed() const { return welcomed_; }
   uint64_t pages_received() const { return pages_; }
-  // Connections opened again after one was lost.
+  // Connections opened again (and welcomed) after one was lost.
   uint64_t reconnects() const { return reconnects_; }
 
  private:
