@@ -94,7 +94,8 @@ TEST(ViewReconnect, APulledViewStartedAgainRequestsNothingItHoldsAndRefetchesACo
 
 TEST(ViewReconnect, AServerRestartedMidPathIsReconnectedToAndNoPageArrivesTwice) {
   // The client reaches the server through a 2 Mbit/s link, so that the server is stopped with pages still to
-  // send; it starts again on the same port 0.4 s later while the client draws what it holds.
+  // send (once the first page is stored); it starts again on the same port 0.4 s later while the client draws
+  // what it holds.
   const auto path = camera_path({0.0f, 0.0f, 3.0f}, {0.8f, 0.2f, 0.8f}, 2.0);
   for (const std::string mode : {"push", "pull"}) {
     SCOPED_TRACE(mode);
@@ -110,7 +111,9 @@ TEST(ViewReconnect, AServerRestartedMidPathIsReconnectedToAndNoPageArrivesTwice)
     const auto dir = temp_dir() / "cache";
     ViewRun run;
     std::thread client([&] { run = view(source, path, {"--cache-dir", dir.string()}); });
-    std::this_thread::sleep_for(std::chrono::milliseconds(800));
+    // Stopped as soon as the first page is stored (within 20 s).
+    for (int i = 0; i < 1000 && stored_bytes(dir) == 0; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
     const uint64_t before = stored_bytes(dir);
     EXPECT_EQ(server->process.stop(), 0);
     server.reset();
@@ -124,4 +127,16 @@ TEST(ViewReconnect, AServerRestartedMidPathIsReconnectedToAndNoPageArrivesTwice)
     EXPECT_GE(j["reconnects"].get<uint64_t>(), 1u);
     EXPECT_EQ(stored_bytes(dir), j["bytes"].get<uint64_t>());  // every page arrived once over both sessions
   }
+}
+
+TEST(ViewReconnect, ACacheDirThatCannotBeCreatedIsAOneLineError) {
+  const auto file = temp_dir() / "a_file";
+  std::ofstream(file) << "not a directory";
+  const auto path = camera_path({}, {0.0f, 0.0f, 2.0f}, 0);
+  const auto r = run_lodstream({"view", elephant_package().string(), "--headless", "--path", path.string(),
+                                "--out", (temp_dir() / "out").string(), "--cache-dir", file.string()});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err.rfind("lodstream: error: " + file.string() + "/", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find("cannot create the cache directory"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
 }
