@@ -42,7 +42,8 @@ struct ViewOptions {
   double pixel_error = 1.0;
   double settle_s = 10.0;
   double cache_mb = 1024.0;
-  uint64_t budget = 0;  // 0: none
+  std::string cache_dir;  // empty: the cache lives in memory only
+  uint64_t budget = 0;    // 0: none
   std::string order = "benefit";
   int frames_every = 0;  // 0: no images
   bool json = false;
@@ -70,6 +71,7 @@ ViewClientOptions client_options(const ViewOptions& opt, int width, int height) 
   o.cache_mb = opt.cache_mb;
   o.budget = opt.budget;
   o.order = opt.order;
+  o.cache_dir = opt.cache_dir;
   o.width = width;
   o.height = height;
   return o;
@@ -168,6 +170,8 @@ int run_headless(const ViewOptions& opt) {
   j["duration_s"] = t;
   j["converged"] = converged;
   j["bytes"] = package.bytes_received();
+  j["bytes_restored"] = package.bytes_restored();
+  j["reconnects"] = client.reconnects();
   j["time_to_first_frame_s"] = first_frame_s ? nlohmann::json(*first_frame_s) : nlohmann::json(nullptr);
   j["time_to_095_s"] = time_095_s ? nlohmann::json(*time_095_s) : nlohmann::json(nullptr);
   j["benefit_ratio"] = last.quality.benefit_ratio;
@@ -305,6 +309,8 @@ const bool registered = register_command(
        sub.add_option("--settle", opt->settle_s, "seconds to keep the last pose until converged (headless)")
            ->capture_default_str();
        sub.add_option("--cache", opt->cache_mb, "page cache budget, MB")->capture_default_str();
+       sub.add_option("--cache-dir", opt->cache_dir,
+                      "keep received pages in DIR/<package hash>/ and start from them (no page sent twice)");
        sub.add_option("--budget", opt->budget, "triangles drawn per frame at most (0: no limit)");
        sub.add_option("--order", opt->order, "pull order: benefit (benefit per byte, predicted) or sse")
            ->capture_default_str();

@@ -1,7 +1,8 @@
 // The GPU side of a client's cut (what `view` draws each frame): each drawn node's decoded mesh uploaded to a
 // Renderer once, when a cut first draws it, and kept while cuts draw it (released after `keep_frames`
 // frames without), and the package's materials' textures uploaded once (again when CutGeometry installs an
-// embedded texture read in the background); so that a frame uploads only the nodes new to it. Needs the renderer's context current on the calling thread (one thread).
+// embedded texture read in the background); so that a frame uploads only the nodes new to it. Needs the
+// renderer's context current on the calling thread (one thread).
 #pragma once
 
 #include <cstdint>

@@ -7,7 +7,8 @@ namespace lodstream::cli {
 using schedule::PageKind;
 
 PullScheduler::PullScheduler(package::PackageReader reader, PullFetcher::SourceFactory make_source,
-                             PullOptions fetch, PageInbox& frames, PullOrder order, double tau)
+                             PullOptions fetch, PageInbox& frames, PullOrder order, double tau,
+                             std::span<const schedule::PageRef> held)
     : reader_(std::move(reader)),
       records_(reader_, no_pages_),
       scheduler_(reader_.root()),
@@ -15,6 +16,7 @@ PullScheduler::PullScheduler(package::PackageReader reader, PullFetcher::SourceF
       order_(order),
       tau_(tau),
       fetcher_(std::move(make_source), fetched_, fetch) {
+  for (const schedule::PageRef& p : held) scheduler_.set_held(p.kind, p.id);
   thread_ = std::thread([this] { run(); });
 }
 

@@ -43,9 +43,10 @@ class PullScheduler {
  public:
   // `reader`: a copy of the client's reader (its root index read; index pages added here). Starts the
   // fetcher (over `make_source`, with `fetch`) and this object's thread; arrived pages and the transport's
-  // failure go to `frames` (which must outlive this object). Nothing is fetched before the first publish().
+  // failure go to `frames` (which must outlive this object). Nothing is fetched before the first publish();
+  // `held` pages (restored from a disk cache) are never fetched.
   PullScheduler(package::PackageReader reader, PullFetcher::SourceFactory make_source, PullOptions fetch,
-                PageInbox& frames, PullOrder order, double tau);
+                PageInbox& frames, PullOrder order, double tau, std::span<const schedule::PageRef> held = {});
   // Stops this thread, then the fetcher (after the reads under way).
   ~PullScheduler();
   PullScheduler(const PullScheduler&) = delete;
@@ -58,6 +59,8 @@ class PullScheduler {
 
   // Plans made so far (each one scheduler call), for reports. Any thread.
   uint64_t plans() const;
+  // The fetcher's reconnections (PullFetcher::reconnects). Any thread.
+  uint64_t reconnects() const { return fetcher_.reconnects(); }
 
  private:
   void run();

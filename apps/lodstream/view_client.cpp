@@ -1,6 +1,7 @@
 #include "view_client.hpp"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "core/error.hpp"
 #include "net/http_source.hpp"
@@ -45,10 +46,18 @@ ViewClient::ViewClient(const std::string& source, const ViewClientOptions& optio
       client_(package::PackageReader(open_source(source, mode_ != Mode::file)), cache_bytes(options)) {
   cut_options_.tau = options.pixel_error;
   if (options.budget) cut_options_.triangle_budget = options.budget;
+  if (!options.cache_dir.empty()) {
+    disk_.emplace(options.cache_dir, client_.reader().header().content_hash);
+    for (const std::string& w : disk_->restore(client_, cache_bytes(options)).warnings)
+      std::fprintf(stderr, "lodstream: warning: %s\n", w.c_str());
+  }
 
   if (mode_ == Mode::push) {
     wire::Hello hello;
     hello.package = split_url(source, "ws://").target.substr(1);
+    hello.cached_hash = client_.reader().header().content_hash;
+    hello.held = wire::page_runs(client_.held(schedule::PageKind::data));
+    hello.held_index = wire::page_runs(client_.held(schedule::PageKind::index));
     hello.cache_budget_bytes = cache_bytes(options);
     hello.triangles_per_frame =
         uint32_t(std::min<uint64_t>(options.budget ? options.budget : UINT32_MAX, UINT32_MAX));
@@ -66,9 +75,12 @@ ViewClient::ViewClient(const std::string& source, const ViewClientOptions& optio
     fetch.connections = 1;
     fetch.min_window_bytes = 8u << 20;
   }
+  std::vector<schedule::PageRef> held;
+  for (schedule::PageKind kind : {schedule::PageKind::data, schedule::PageKind::index})
+    for (uint32_t id : client_.held(kind)) held.push_back({kind, id});
   puller_ = std::make_unique<PullScheduler>(client_.reader(), std::move(make_source), fetch, arrived_,
                                             options.order == "sse" ? PullOrder::sse : PullOrder::benefit,
-                                            options.pixel_error);
+                                            options.pixel_error, held);
 }
 
 ViewClient::~ViewClient() = default;
@@ -77,9 +89,16 @@ const char* ViewClient::mode() const {
   return mode_ == Mode::push ? "push" : mode_ == Mode::pull ? "pull" : "file";
 }
 
+uint64_t ViewClient::reconnects() const {
+  return puller_ ? puller_->reconnects() : pusher_->reconnects();
+}
+
 runtime::Frame ViewClient::frame(const schedule::ViewSample& now) {
   if (std::string error = arrived_.error(); !error.empty()) throw Error(error);
-  for (ArrivedPage& a : arrived_.take()) client_.install(a.page.kind, a.page.id, a.bytes);
+  for (ArrivedPage& a : arrived_.take()) {
+    client_.install(a.page.kind, a.page.id, a.bytes);
+    if (disk_) disk_->store(a.page.kind, a.page.id, a.bytes);
+  }
   if (puller_)
     puller_->publish(now);
   else

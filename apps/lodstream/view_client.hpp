@@ -13,10 +13,12 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "net/page_inbox.hpp"
 #include "runtime/client_package.hpp"
+#include "runtime/disk_cache.hpp"
 #include "schedule/cut.hpp"
 #include "schedule/motion.hpp"
 
@@ -36,12 +38,17 @@ struct ViewClientOptions {
   uint64_t budget = 0;             // triangles drawn per frame at most (0: no limit)
   std::string order = "benefit";   // pull order: benefit or sse
   int width = 1280, height = 720;  // the viewport a push server is told in the hello
+  // Pages received are kept under DIR/<package content hash>/ (runtime::DiskCache) and restored from it at
+  // start: never fetched again, and listed in the push hello. Empty: the cache lives in memory only.
+  std::filesystem::path cache_dir;
 };
 
 class ViewClient {
  public:
-  // Opens `source`: reads the root index (one read, blocking: a local read or one HTTP request) and starts
-  // the transport. Throws lodstream::Error (unreachable server, not a package, bad option) naming the source.
+  // Opens `source`: reads the root index (one read, blocking: a local read or one HTTP request), restores
+  // the pages kept on disk (options.cache_dir; files that fail their checks are dropped with a warning on
+  // standard error) and starts the transport. Throws lodstream::Error (unreachable server, not a package, a
+  // cache directory that cannot be created) naming what failed.
   ViewClient(const std::string& source, const ViewClientOptions& options);
   ~ViewClient();  // stops the transport
   ViewClient(const ViewClient&) = delete;
@@ -58,6 +65,9 @@ class ViewClient {
   runtime::Frame frame(const schedule::ViewSample& now);
 
   runtime::ClientPackage& package() { return client_; }
+  // Times the transport reconnected after losing its server (push: a new session with the held pages in its
+  // hello; pull: a new connection for a failed read).
+  uint64_t reconnects() const;
   // The local package's folder (textures resolve against it), empty for a remote source.
   const std::filesystem::path& package_dir() const { return package_dir_; }
 
@@ -67,6 +77,7 @@ class ViewClient {
   schedule::CutOptions cut_options_;
   std::filesystem::path package_dir_;
   runtime::ClientPackage client_;
+  std::optional<runtime::DiskCache> disk_;
   PageInbox arrived_;  // what the transport delivered, for the next frame
   std::unique_ptr<PullScheduler> puller_;
   std::unique_ptr<PushClient> pusher_;

@@ -31,7 +31,7 @@ void PullFetcher::request(const schedule::PageRef& page, const package::Range& r
     queue_.push_back({page, range, now()});
     in_flight_ += range.size;
   }
-  wake_.notify_one();
+  wake_.notify_all();  // a worker waiting out a back-off must not take the only notification
 }
 
 uint64_t PullFetcher::in_flight_bytes() const {
@@ -49,10 +49,43 @@ double PullFetcher::rtt_s() const {
   return min_rtt_s_;
 }
 
+uint64_t PullFetcher::reconnects() const {
+  std::lock_guard lock(mutex_);
+  return reconnects_;
+}
+
 uint64_t PullFetcher::window_bytes() const {
   std::lock_guard lock(mutex_);
   const double bdp = best_rate_bps_ / 8.0 * min_rtt_s_;
   return uint64_t(std::max(double(options_.min_window_bytes), options_.window_bdp * bdp));
+}
+
+bool PullFetcher::read_with_retry(const SourceFactory& make_source,
+                                  std::shared_ptr<const package::ByteSource>& source, const Request& r,
+                                  std::vector<uint8_t>& out) {
+  double wait_s = options_.first_backoff_s, failing_since = -1.0;
+  for (;;) {
+    try {
+      if (!source) {
+        source = make_source();
+        std::lock_guard lock(mutex_);
+        ++reconnects_;
+      }
+      source->read(r.range.offset, out);
+      return true;
+    } catch (const Error& e) {
+      source.reset();
+      const double t = now();
+      if (failing_since < 0.0) failing_since = t;
+      if (t - failing_since >= options_.retry_s) {
+        inbox_.fail(e.what());
+        return false;
+      }
+    }
+    std::unique_lock lock(mutex_);
+    if (wake_.wait_for(lock, std::chrono::duration<double>(wait_s), [&] { return stop_; })) return false;
+    wait_s = std::min(2.0 * wait_s, options_.max_backoff_s);
+  }
 }
 
 void PullFetcher::work(const SourceFactory& make_source) {
@@ -73,12 +106,7 @@ void PullFetcher::work(const SourceFactory& make_source) {
       queue_.pop_front();
     }
     ArrivedPage arrived{r.page, std::vector<uint8_t>(r.range.size)};
-    try {
-      source->read(r.range.offset, arrived.bytes);
-    } catch (const Error& e) {
-      inbox_.fail(e.what());
-      return;
-    }
+    if (!read_with_retry(make_source, source, r, arrived.bytes)) return;
     {
       std::lock_guard lock(mutex_);
       const double t = now();

@@ -8,8 +8,11 @@
 // Window = max(min_window_bytes, window_bdp * bandwidth * rtt): bandwidth = the largest rate of delivered
 // bytes over the last `bandwidth_window_s` (sampled per completed request: bytes completed in the window /
 // its span), rtt = the smallest time any request took (request to last byte: the round trip plus one page's
-// transfer, an upper bound of the path's RTT). A failed read is reported through the inbox (fail()) and ends
-// the fetcher's usefulness; the caller reports it.
+// transfer, an upper bound of the path's RTT). A failed read (the server went away or restarted) is tried
+// again on a new source (make_source) after a back-off that doubles from first_backoff_s to max_backoff_s,
+// the request kept, so that the client reconnects by itself while its frames draw what it holds (issue 5);
+// after `retry_s` of failures it is reported through the inbox (fail()) and ends that worker. A failure to
+// make the first source is reported at once.
 #pragma once
 
 #include <chrono>
@@ -33,6 +36,8 @@ struct PullOptions {
   size_t min_window_bytes = 256 * 1024;
   double window_bdp = 2.0;
   double bandwidth_window_s = 1.0;
+  double first_backoff_s = 0.1, max_backoff_s = 2.0;
+  double retry_s = 20.0;
 };
 
 class PullFetcher {
@@ -51,6 +56,8 @@ class PullFetcher {
   uint64_t window_bytes() const;
   double bandwidth_bps() const;
   double rtt_s() const;
+  // Sources made again after a failed read (successful reconnections), over all workers.
+  uint64_t reconnects() const;
 
  private:
   struct Request {
@@ -59,6 +66,10 @@ class PullFetcher {
     double sent_s;
   };
   void work(const SourceFactory& make_source);
+  // Reads `r` into `out` through `source`, making a new source after each failure (back-off, then retry);
+  // false when the fetcher stops or retry_s ran out (then reported).
+  bool read_with_retry(const SourceFactory& make_source, std::shared_ptr<const package::ByteSource>& source,
+                       const Request& r, std::vector<uint8_t>& out);
   double now() const;
 
   PageInbox& inbox_;
@@ -67,7 +78,7 @@ class PullFetcher {
   std::condition_variable wake_;
   std::deque<Request> queue_;
   bool stop_ = false;
-  uint64_t in_flight_ = 0;
+  uint64_t in_flight_ = 0, reconnects_ = 0;
   double min_rtt_s_ = 0.0;
   std::deque<std::pair<double, uint64_t>> completed_;  // (time, bytes) within the bandwidth window
   double best_rate_bps_ = 0.0, best_rate_time_ = -1e9;

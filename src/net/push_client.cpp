@@ -2,10 +2,12 @@
 
 #include <utility>  // Boost 1.74 awaitable.hpp uses std::exchange without including it
 
+#include <algorithm>
 #include <boost/asio.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/websocket.hpp>
 #include <chrono>
+#include <set>
 
 #include "net/url.hpp"
 
@@ -16,44 +18,66 @@ namespace beast = boost::beast;
 using asio::awaitable;
 using asio::use_awaitable;
 using tcp = asio::ip::tcp;
+using WebSocket = beast::websocket::stream<beast::tcp_stream>;
 
 struct PushClient::Impl {
   asio::io_context io;
-  beast::websocket::stream<beast::tcp_stream> ws{asio::make_strand(io)};
-  asio::steady_timer wake{ws.get_executor()};
-  asio::steady_timer stop_timer{ws.get_executor()};  // cuts off a close the server does not answer
+  asio::strand<asio::io_context::executor_type> strand = asio::make_strand(io);
+  asio::steady_timer wake{strand};
+  asio::steady_timer stop_timer{strand};  // cuts off a close the server does not answer
+  asio::steady_timer backoff{strand};     // the wait before a reconnection
   UrlParts url;
   wire::Hello hello;
   PageInbox* inbox = nullptr;
   PushClient* owner = nullptr;
+  PushReconnect reconnect;
   // Owned by the strand:
   std::optional<wire::ViewUpdate> view;
   std::optional<wire::Ack> ack;
   bool open = false, closing = false, done = false;
-  uint64_t received = 0;
+  bool welcomed_now = false;      // the current connection was welcomed
+  uint64_t connection = 0;        // the current connection's number; a writer of an older one stops
+  uint64_t received = 0;          // page bytes over the current connection
+  std::set<uint32_t> arrived[2];  // pages received over any connection, by kind
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
 
   double now() const {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
-  awaitable<void> send(const wire::Message& m) {
+  static awaitable<void> send(WebSocket& ws, const wire::Message& m) {
     const std::vector<uint8_t> frame = wire::encode(m);
     co_await ws.async_write(asio::buffer(frame), use_awaitable);
   }
 
-  awaitable<void> writer() {
+  // The Hello of a (re)connection: the pages held when the client started plus every page received since.
+  wire::Hello current_hello() const {
+    wire::Hello h = hello;
+    auto held = [&](const std::vector<wire::PageRun>& runs, const std::set<uint32_t>& more) {
+      std::set<uint32_t> pages = more;
+      for (const wire::PageRun& run : runs)
+        for (uint64_t p = run.first; p < uint64_t(run.first) + run.count; ++p) pages.insert(uint32_t(p));
+      const std::vector<uint32_t> sorted(pages.begin(), pages.end());
+      return wire::page_runs(sorted);
+    };
+    h.held = held(hello.held, arrived[size_t(schedule::PageKind::data)]);
+    h.held_index = held(hello.held_index, arrived[size_t(schedule::PageKind::index)]);
+    return h;
+  }
+
+  // Sends acknowledgements, views and the close of connection `number` over `ws` until it ends.
+  awaitable<void> writer(std::shared_ptr<WebSocket> ws, uint64_t number) {
     try {
-      while (open) {
+      while (open && connection == number) {
         if (ack) {
           const wire::Message m = *std::exchange(ack, std::nullopt);
-          co_await send(m);
+          co_await send(*ws, m);
         } else if (view) {
           const wire::Message m = *std::exchange(view, std::nullopt);
-          co_await send(m);
+          co_await send(*ws, m);
         } else if (closing) {
           open = false;
-          co_await ws.async_close(beast::websocket::close_code::normal, use_awaitable);
+          co_await ws->async_close(beast::websocket::close_code::normal, use_awaitable);
         } else {
           wake.expires_at(std::chrono::steady_clock::time_point::max());
           boost::system::error_code ec;
@@ -65,35 +89,50 @@ struct PushClient::Impl {
     }
   }
 
-  awaitable<void> session() {
+  // One connection: hello, then pages until it ends. Returns why it was lost ("" when it ended for good:
+  // closed by this client, or a failure already reported through the inbox).
+  awaitable<std::string> connect() {
+    auto ws = std::make_shared<WebSocket>(strand);
+    const uint64_t number = ++connection;
+    ack.reset();
+    received = 0;
+    welcomed_now = false;
+    std::string lost;
     try {
-      tcp::resolver resolver(ws.get_executor());
+      tcp::resolver resolver(strand);
       auto endpoints = co_await resolver.async_resolve(url.host, url.port, use_awaitable);
-      beast::get_lowest_layer(ws).expires_after(std::chrono::seconds(30));
-      co_await beast::get_lowest_layer(ws).async_connect(endpoints, use_awaitable);
-      beast::get_lowest_layer(ws).socket().set_option(tcp::no_delay(true));
-      beast::get_lowest_layer(ws).expires_never();
-      ws.set_option(beast::websocket::stream_base::timeout::suggested(beast::role_type::client));
-      ws.binary(true);
-      ws.read_message_max(wire::kMaxMessageBytes);
-      co_await ws.async_handshake(url.host + ":" + url.port, url.target, use_awaitable);
+      beast::get_lowest_layer(*ws).expires_after(std::chrono::seconds(30));
+      co_await beast::get_lowest_layer(*ws).async_connect(endpoints, use_awaitable);
+      beast::get_lowest_layer(*ws).socket().set_option(tcp::no_delay(true));
+      beast::get_lowest_layer(*ws).expires_never();
+      ws->set_option(beast::websocket::stream_base::timeout::suggested(beast::role_type::client));
+      ws->binary(true);
+      ws->read_message_max(wire::kMaxMessageBytes);
+      co_await ws->async_handshake(url.host + ":" + url.port, url.target, use_awaitable);
       open = true;
-      const wire::Message first = hello;
-      co_await send(first);
-      asio::co_spawn(ws.get_executor(), writer(), asio::detached);
+      co_await send(*ws, current_hello());
+      asio::co_spawn(strand, writer(ws, number), asio::detached);
       for (;;) {
         beast::flat_buffer buffer;
-        co_await ws.async_read(buffer, use_awaitable);
+        co_await ws->async_read(buffer, use_awaitable);
         const auto* data = static_cast<const uint8_t*>(buffer.data().data());
         wire::Message m = wire::decode(std::span<const uint8_t>(data, buffer.size()));
         if (auto* page = std::get_if<wire::Page>(&m)) {
           received += page->bytes.size();
           ack = wire::Ack{page->sequence, received, now(), page->server_time_s};
+          arrived[size_t(page->kind)].insert(page->page_id);
           inbox->put({{page->kind, page->page_id, uint32_t(page->bytes.size())}, std::move(page->bytes)});
           ++owner->pages_;
           wake.cancel();
-        } else if (std::holds_alternative<wire::Welcome>(m)) {
+        } else if (auto* welcome = std::get_if<wire::Welcome>(&m)) {
+          if (welcome->package_hash != hello.cached_hash) {  // what the client held is of another package
+            hello.cached_hash = welcome->package_hash;
+            hello.held.clear(), hello.held_index.clear();
+            arrived[0].clear(), arrived[1].clear();
+          }
+          if (owner->welcomed_) ++owner->reconnects_;
           owner->welcomed_ = true;
+          welcomed_now = true;
         } else if (auto* bye = std::get_if<wire::Bye>(&m)) {
           inbox->fail(url.host + ":" + url.port + url.target + ": the server said bye: " + bye->reason);
           break;
@@ -104,29 +143,55 @@ struct PushClient::Impl {
     } catch (const wire::WireError& e) {
       inbox->fail(e.what());
     } catch (const boost::system::system_error& e) {
-      if (!closing) inbox->fail("ws://" + url.host + ":" + url.port + url.target + ": " + e.code().message());
+      if (!closing) lost = "ws://" + url.host + ":" + url.port + url.target + ": " + e.code().message();
     }
     open = false;
+    wake.cancel();
+    co_return lost;
+  }
+
+  // Connections until the client closes: a lost one is opened again after a back-off that doubles from
+  // reconnect.first_backoff_s to reconnect.max_backoff_s (reset by each Welcome), as long as the first one
+  // was welcomed; a first connection that fails is an error.
+  awaitable<void> session() {
+    double wait_s = reconnect.first_backoff_s;
+    for (;;) {
+      const std::string lost = co_await connect();
+      if (lost.empty() || closing) break;
+      if (!owner->welcomed_ || !reconnect.enabled) {
+        inbox->fail(lost);
+        break;
+      }
+      if (welcomed_now) wait_s = reconnect.first_backoff_s;
+      backoff.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+          std::chrono::duration<double>(wait_s)));
+      boost::system::error_code ec;
+      co_await backoff.async_wait(asio::redirect_error(use_awaitable, ec));
+      if (closing) break;
+      wait_s = std::min(2.0 * wait_s, reconnect.max_backoff_s);
+    }
     done = true;
     wake.cancel();
     stop_timer.cancel();
   }
 };
 
-PushClient::PushClient(const std::string& url, wire::Hello hello, PageInbox& inbox)
+PushClient::PushClient(const std::string& url, wire::Hello hello, PageInbox& inbox, PushReconnect reconnect)
     : impl_(std::make_unique<Impl>()) {
   impl_->url = split_url(url, "ws://");
   impl_->hello = std::move(hello);
   impl_->inbox = &inbox;
   impl_->owner = this;
-  asio::co_spawn(impl_->ws.get_executor(), impl_->session(), asio::detached);
+  impl_->reconnect = reconnect;
+  asio::co_spawn(impl_->strand, impl_->session(), asio::detached);
   thread_ = std::thread([this] { impl_->io.run(); });
 }
 
 PushClient::~PushClient() {
-  asio::post(impl_->ws.get_executor(), [m = impl_.get()] {
+  asio::post(impl_->strand, [m = impl_.get()] {
     m->closing = true;
     m->wake.cancel();
+    m->backoff.cancel();
     if (m->done) return;
     // A normal close takes a round trip; a server that does not answer is cut off.
     m->stop_timer.expires_after(std::chrono::seconds(2));
@@ -138,7 +203,7 @@ PushClient::~PushClient() {
 }
 
 void PushClient::send_view(const wire::ViewUpdate& view) {
-  asio::post(impl_->ws.get_executor(), [m = impl_.get(), view] {
+  asio::post(impl_->strand, [m = impl_.get(), view] {
     m->view = view;
     m->wake.cancel();
   });

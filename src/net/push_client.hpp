@@ -2,8 +2,10 @@
 // thread and io_context. It sends the Hello, receives the Welcome and then pages (left in a PageInbox for the
 // frame loop), acknowledges every page as it arrives (cumulatively: the latest sequence, with the page's
 // server time echoed), and sends the latest view the frame loop gave it (send_view: the newest replaces one
-// not yet sent). A Bye from the server, a malformed message or a lost connection is reported through the
-// inbox.
+// not yet sent). A connection lost after a Welcome (the server restarted) is opened again with back-off,
+// its Hello listing the pages held at the start plus every page received since, so that the server sends
+// none of them again (issue 5); meanwhile the frame loop keeps drawing what it holds. A Bye from the server,
+// a malformed message, or a first connection that fails is reported through the inbox.
 #pragma once
 
 #include <atomic>
@@ -17,11 +19,17 @@
 
 namespace lodstream {
 
+struct PushReconnect {
+  bool enabled = true;
+  double first_backoff_s = 0.1;  // the wait before the first attempt; doubles per failed attempt
+  double max_backoff_s = 2.0;
+};
+
 class PushClient {
  public:
   // `url`: ws://HOST:PORT/NAME. Returns at once; connecting happens on the client's thread (a failure is
   // reported through `inbox`). Throws lodstream::Error when the URL is malformed. `inbox` must outlive this.
-  PushClient(const std::string& url, wire::Hello hello, PageInbox& inbox);
+  PushClient(const std::string& url, wire::Hello hello, PageInbox& inbox, PushReconnect reconnect = {});
   ~PushClient();  // closes the WebSocket (a normal close) and joins the thread
   PushClient(const PushClient&) = delete;
   PushClient& operator=(const PushClient&) = delete;
@@ -29,12 +37,14 @@ class PushClient {
   void send_view(const wire::ViewUpdate& view);
   bool welcomed() const { return welcomed_; }
   uint64_t pages_received() const { return pages_; }
+  // Connections opened again (and welcomed) after one was lost.
+  uint64_t reconnects() const { return reconnects_; }
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::atomic<bool> welcomed_{false};
-  std::atomic<uint64_t> pages_{0};
+  std::atomic<uint64_t> pages_{0}, reconnects_{0};
   std::thread thread_;
 };
 

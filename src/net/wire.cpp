@@ -143,6 +143,17 @@ void viewport(Reader& r, uint16_t& w, uint16_t& h) {
 
 }  // namespace
 
+std::vector<PageRun> page_runs(std::span<const uint32_t> sorted_pages) {
+  std::vector<PageRun> runs;
+  for (uint32_t page : sorted_pages) {
+    if (!runs.empty() && runs.back().first + runs.back().count == page)
+      ++runs.back().count;
+    else
+      runs.push_back({page, 1});
+  }
+  return runs;
+}
+
 const char* type_name(const Message& message) {
   static const char* names[] = {"hello", "view", "ack", "welcome", "page", "bye"};
   return names[message.index()];

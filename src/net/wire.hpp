@@ -39,6 +39,9 @@ struct PageRun {
   uint32_t count = 0;
 };
 
+// `sorted_pages` (ascending, no repeats) as runs. Cost: O(pages).
+std::vector<PageRun> page_runs(std::span<const uint32_t> sorted_pages);
+
 // Client → server, first message: which package, what the client holds, what it can do.
 struct Hello {
   std::string package;        // NAME, as in ws://HOST:PORT/NAME

@@ -14,13 +14,22 @@ ClientPackage::ClientPackage(package::PackageReader reader, uint64_t cache_bytes
     : reader_(std::move(reader)), cache_(cache_bytes), nodes_(reader_, cache_), scheduler_(reader_.root()) {}
 
 void ClientPackage::install(PageKind kind, uint32_t id, std::span<const uint8_t> stored) {
+  add(kind, id, stored);
+  bytes_received_ += stored.size();
+}
+
+void ClientPackage::restore(PageKind kind, uint32_t id, std::span<const uint8_t> stored) {
+  add(kind, id, stored);
+  bytes_restored_ += stored.size();
+}
+
+void ClientPackage::add(PageKind kind, uint32_t id, std::span<const uint8_t> stored) {
   if (kind == PageKind::index)
     reader_.add_index_page(id, stored);
   else
     cache_.insert(reader_.header().content_hash, id, reader_.unpack_page(id, stored));
   scheduler_.set_held(kind, id);
   in_flight_.erase(key(kind, id));
-  bytes_received_ += stored.size();
 }
 
 void ClientPackage::requested(const schedule::PageRef& page) {

@@ -33,6 +33,9 @@ class ClientPackage {
   // Installs an arrived page's stored bytes: an index page's records into the reader, a data page (checked
   // and decompressed) into the cache. Throws lodstream::Error when the bytes do not check out.
   void install(schedule::PageKind kind, uint32_t id, std::span<const uint8_t> stored);
+  // Installs a page's stored bytes kept from an earlier session (the DiskCache): checked like install, not
+  // counted as received (bytes_restored instead).
+  void restore(schedule::PageKind kind, uint32_t id, std::span<const uint8_t> stored);
   // A page was requested (held by the scheduler until it arrives or the request is dropped).
   void requested(const schedule::PageRef& page);
   // A requested page will not arrive (its request failed): it may be scheduled again.
@@ -51,11 +54,13 @@ class ClientPackage {
   const schedule::PageScheduler& scheduler() const { return scheduler_; }
   // The stored bytes installed so far (what the transport delivered).
   uint64_t bytes_received() const { return bytes_received_; }
+  // The stored bytes restored from an earlier session.
+  uint64_t bytes_restored() const { return bytes_restored_; }
   size_t in_flight() const { return in_flight_.size(); }
   // The data pages the cache evicted since the last call (in frame()), for a scheduler kept elsewhere (a pull
   // scheduler on its own thread) to schedule again.
   std::vector<uint32_t> take_evicted() { return std::exchange(evicted_, {}); }
-  // Pages held, by kind, as runs (what a Hello tells a push server).
+  // Pages held (arrived, not merely requested), by kind, sorted (what a Hello tells a push server).
   std::vector<uint32_t> held(schedule::PageKind kind) const;
 
  private:
@@ -64,7 +69,9 @@ class ClientPackage {
   PackageNodes nodes_;
   schedule::PageScheduler scheduler_;
   std::unordered_set<uint64_t> in_flight_;  // kind << 32 | id
-  uint64_t bytes_received_ = 0;
+  void add(schedule::PageKind kind, uint32_t id, std::span<const uint8_t> stored);
+
+  uint64_t bytes_received_ = 0, bytes_restored_ = 0;
   std::vector<uint32_t> evicted_;  // since the last take_evicted()
 };
 

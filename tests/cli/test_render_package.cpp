@@ -2,21 +2,12 @@
 // is close to the source model rendered from the same camera, and a larger target draws fewer triangles.
 #include <gtest/gtest.h>
 
+#include "baked.hpp"
 #include "support/run.hpp"
 
 using namespace lodstream;
 
 namespace {
-
-std::filesystem::path motorbike_package() {
-  static const std::filesystem::path file = [] {
-    const auto p = test::temp_dir() / "motorBike.lods";
-    auto r = test::run_lodstream({"bake", test::data_file("motorBike.obj").string(), "-o", p.string()});
-    EXPECT_EQ(r.status, 0) << r.err;
-    return p;
-  }();
-  return file;
-}
 
 nlohmann::json render(const std::vector<std::string>& args) {
   std::vector<std::string> all{"render"};
@@ -35,8 +26,10 @@ TEST(RenderPackage, CutAtOnePixelMatchesTheSourceAndCoarserTargetsDrawLess) {
   const std::string source = (dir / "source.png").string(), px1 = (dir / "px1.png").string(),
                     px8 = (dir / "px8.png").string();
   const auto s = render({test::data_file("motorBike.obj").string(), "--camera", camera, "-o", source});
-  const auto a = render({motorbike_package().string(), "--camera", camera, "--pixel-error", "1", "-o", px1});
-  const auto b = render({motorbike_package().string(), "--camera", camera, "--pixel-error", "8", "-o", px8});
+  const auto a =
+      render({test::motorbike_package().string(), "--camera", camera, "--pixel-error", "1", "-o", px1});
+  const auto b =
+      render({test::motorbike_package().string(), "--camera", camera, "--pixel-error", "8", "-o", px8});
   EXPECT_LE(a["pixel_error_max"].get<double>(), 1.0);
   EXPECT_LE(b["pixel_error_max"].get<double>(), 8.0);
   EXPECT_LT(b["triangles"].get<int64_t>(), a["triangles"].get<int64_t>());
@@ -54,7 +47,7 @@ TEST(RenderPackage, CutAtOnePixelMatchesTheSourceAndCoarserTargetsDrawLess) {
 TEST(RenderPackage, BadPixelErrorIsAnError) {
   const auto out = (test::temp_dir() / "x.png").string();
   for (const std::vector<std::string>& args :
-       {std::vector<std::string>{"render", motorbike_package().string(), "--eye", "2,1,2", "--target",
+       {std::vector<std::string>{"render", test::motorbike_package().string(), "--eye", "2,1,2", "--target",
                                  "0,0,0", "--pixel-error", "0", "-o", out},
         std::vector<std::string>{"render", test::data_file("motorBike.obj").string(), "--eye", "2,1,2",
                                  "--target", "0,0,0", "--pixel-error", "2", "-o", out}}) {

@@ -8,8 +8,6 @@
 #include <boost/asio.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/websocket.hpp>
-#include <fstream>
-#include <sstream>
 #include <thread>
 
 #include "baked.hpp"
@@ -19,82 +17,10 @@
 #include "support/nginx.hpp"
 #include "support/run.hpp"
 #include "support/xvfb.hpp"
+#include "view_run.hpp"
 
 using namespace lodstream;
-
-namespace {
-
-// A camera path: from `from` to `to` (looking at the origin) over `seconds` (0: a fixed camera at `to`).
-std::filesystem::path camera_path(glm::vec3 from, glm::vec3 to, double seconds) {
-  static int count = 0;
-  auto file = test::temp_dir() / ("path" + std::to_string(count++) + ".json");
-  auto key = [](double t, glm::vec3 e) {
-    return nlohmann::json{{"t", t}, {"eye", {e.x, e.y, e.z}}, {"target", {0, 0, 0}}};
-  };
-  nlohmann::json j{{"fov", 60}, {"size", {640, 480}}, {"keyframes", nlohmann::json::array()}};
-  if (seconds > 0) j["keyframes"].push_back(key(0.0, from));
-  j["keyframes"].push_back(key(seconds, to));
-  std::ofstream(file) << j.dump();
-  return file;
-}
-
-struct ViewRun {
-  std::filesystem::path out;
-  test::RunResult result;
-  std::vector<std::vector<double>> rows;
-  std::string header;
-};
-
-ViewRun view(const std::string& source, const std::filesystem::path& path,
-             std::vector<std::string> more = {}) {
-  static int count = 0;
-  const auto out = test::temp_dir() / ("view" + std::to_string(count++));
-  ViewRun v;
-  std::vector<std::string> args{"view",  source,       "--headless", "--path", path.string(),
-                                "--out", out.string(), "--settle",   "20",     "--json"};
-  args.insert(args.end(), more.begin(), more.end());
-  v.result = test::run_lodstream(args);
-  v.out = out;
-  std::ifstream csv(out / "frames.csv");
-  std::getline(csv, v.header);
-  for (std::string line; std::getline(csv, line);) {
-    std::vector<double> row;
-    std::stringstream s(line);
-    for (std::string cell; std::getline(s, cell, ',');) row.push_back(std::stod(cell));
-    v.rows.push_back(row);
-  }
-  return v;
-}
-
-// The run converged: exit 0, DESIGN's header, last row benefit ratio 1 and the JSON saying so.
-void expect_converged(const ViewRun& v, const std::string& mode) {
-  ASSERT_EQ(v.result.status, 0) << v.result.err;
-  EXPECT_EQ(v.header, "t,bytes,nodes,triangles,pixel_error_max,pixel_error_mean,benefit_ratio,frame_ms");
-  ASSERT_FALSE(v.rows.empty());
-  EXPECT_EQ(v.rows.back().at(6), 1.0);
-  EXPECT_LE(v.rows.back().at(4), 1.0);  // pixel error max within tau
-  EXPECT_GT(v.rows.back().at(1), 0.0);  // bytes arrived
-  const auto j = v.result.json();
-  EXPECT_EQ(j["mode"], mode);
-  EXPECT_EQ(j["converged"], true);
-  EXPECT_EQ(j["benefit_ratio"], 1.0);
-  // Bytes and triangles never decrease over the frames (nothing was evicted: the cache is large).
-  for (size_t i = 1; i < v.rows.size(); ++i) EXPECT_GE(v.rows[i][1], v.rows[i - 1][1]);
-}
-
-struct Server {
-  test::BackgroundProcess process{{"serve", test::elephant_package().string(), "--port", "0"}};
-  uint16_t port = 0;
-  Server() {
-    std::string line = process.read_line();
-    EXPECT_EQ(line.rfind("listening on http://127.0.0.1:", 0), 0u) << line;
-    port = uint16_t(std::stoi(line.substr(line.rfind(':') + 1)));
-  }
-  std::string http() const { return "http://127.0.0.1:" + std::to_string(port) + "/elephant.lods"; }
-  std::string ws() const { return "ws://127.0.0.1:" + std::to_string(port) + "/elephant"; }
-};
-
-}  // namespace
+using namespace lodstream::test;
 
 TEST(View, ALocalFileConvergesForAFixedCamera) {
   const auto v = view(test::elephant_package().string(), camera_path({}, {0.0f, 0.2f, 1.5f}, 0));
@@ -118,20 +44,7 @@ TEST(View, TheFinalFrameOfAPushedViewIsTheRenderOfTheCut) {
   Server server;
   const auto v = view(server.ws(), path, {"--frames-every", "1000"});
   expect_converged(v, "push");
-  const auto frames = v.rows.size() - 1;
-  char name[64];
-  std::snprintf(name, sizeof name, "frame_%05zu.png", frames);
-  ASSERT_TRUE(std::filesystem::exists(v.out / name)) << name;
-  const auto reference = test::temp_dir() / "reference.png";
-  auto r = test::run_lodstream({"render", test::elephant_package().string(), "--eye", "0.8,0.2,0.8",
-                                "--target", "0,0,0", "--fov", "60", "--size", "640x480", "--pixel-error", "1",
-                                "-o", reference.string()});
-  ASSERT_EQ(r.status, 0) << r.err;
-  auto m =
-      test::run_lodstream({"measure", "--images", (v.out / name).string(), reference.string(), "--json"});
-  ASSERT_EQ(m.status, 0) << m.err;
-  const auto j = m.json();
-  EXPECT_TRUE(j["psnr"].is_null() || j["psnr"].get<double>() >= 50.0) << j.dump();
+  expect_final_frame_is_render(v, elephant_package(), {0.8f, 0.2f, 0.8f});
 }
 
 TEST(View, SixteenClientsOnOneServerConvergeWhileAGarbageClientGetsBye) {

@@ -121,3 +121,20 @@ TEST(Wire, RandomBytesNeverCrash) {
     }
   }
 }
+
+TEST(Wire, HeldPagesBecomeRunsTheHelloAccepts) {
+  const std::vector<uint32_t> pages{0, 1, 2, 5, 7, 8, 100};
+  const auto runs = page_runs(pages);
+  ASSERT_EQ(runs.size(), 4u);
+  EXPECT_EQ(runs[0].first, 0u);
+  EXPECT_EQ(runs[0].count, 3u);
+  EXPECT_EQ(runs[1].first, 5u);
+  EXPECT_EQ(runs[1].count, 1u);
+  EXPECT_EQ(runs[2].first, 7u);
+  EXPECT_EQ(runs[2].count, 2u);
+  EXPECT_EQ(runs[3].first, 100u);
+  EXPECT_TRUE(page_runs({}).empty());
+  Hello h = hello();
+  h.held = runs;
+  EXPECT_EQ(std::get<Hello>(decode(encode(h))).held.back().first, 100u);  // sorted, non-overlapping: valid
+}

@@ -1,0 +1,54 @@
+// The client's page cache on disk (issue 5: the cache outlives the connection and the process): the stored
+// bytes of every page a client received, kept under DIR/<package content hash>/ as one file per page, named
+// `d<id>` (data page) or `i<id>` (index page). A file is written to a temporary name in the same directory
+// and renamed, so a reader sees a whole page or none. Because the directory is named by the content hash, a
+// changed package (another hash) never finds stale pages.
+//
+// Nothing read back is trusted: restore() checks each file's size against the page's Range in the root
+// index before reading it, then installs it through ClientPackage::restore, which checks the XXH3-64 checksum
+// of the Range and decompresses it; a file that fails is deleted and reported, never a crash. Names that are
+// not page files are reported and left alone. Pure file I/O (no sockets, no clock); one thread.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "runtime/client_package.hpp"
+
+namespace lodstream::runtime {
+
+struct RestoredPages {
+  uint64_t pages = 0;                 // pages installed from disk
+  uint64_t stored_bytes = 0;          // their stored (compressed) bytes
+  std::vector<std::string> warnings;  // one line per file dropped or ignored, naming it and why
+};
+
+class DiskCache {
+ public:
+  // The cache of the package with content hash `hash` under `root` (DIR/<hash hex>/, created if missing).
+  // Throws lodstream::Error naming the directory when it cannot be created.
+  DiskCache(const std::filesystem::path& root, const package::ContentHash& hash);
+
+  const std::filesystem::path& directory() const { return directory_; }
+
+  // Writes one received page's stored bytes (temporary file, then rename; an existing file is replaced).
+  // Throws lodstream::Error naming the file when the write fails. Cost: one file write of `stored`.
+  void store(schedule::PageKind kind, uint32_t id, std::span<const uint8_t> stored);
+
+  // Installs into `client` the pages held on disk: every valid index page, then data pages in page order
+  // while their decompressed size fits in `budget_bytes` (the memory cache's budget) beside what `client`'s
+  // cache already holds. Invalid files (wrong size, checksum or contents, an id the package does not have)
+  // are deleted and reported. Cost: one read, checksum and decompression per page loaded.
+  RestoredPages restore(ClientPackage& client, uint64_t budget_bytes) const;
+
+  // The file that holds a page (whether or not it exists).
+  std::filesystem::path file(schedule::PageKind kind, uint32_t id) const;
+
+ private:
+  std::filesystem::path directory_;
+};
+
+}  // namespace lodstream::runtime
