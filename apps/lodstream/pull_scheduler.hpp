@@ -1,19 +1,23 @@
 // The pulling client's scheduler on a thread of its own (issue 5: streaming never blocks a frame; the frame
 // thread does not pay for scheduling). The frame thread publishes its latest view sample; this thread decides
-// what to fetch (PageScheduler over the sample's predicted views, or the sse-pull order), keeps the
-// PullFetcher's request window full, and relays what arrives to the frame thread's inbox.
+// what to fetch (PageScheduler over the sample's predicted views, or the sse-pull order) and keeps the
+// PullFetcher's request window full.
 //
 // Ownership, so that nothing is shared without a lock: this object's thread alone owns a copy of the client's
-// PackageReader (the node records the scheduler sees: index pages are installed into it here as they arrive,
-// before they are relayed) and the PageScheduler with its held set (pages arrived or requested; pages the
-// frame thread's cache evicted are reported through evicted() and become schedulable again). The frame
-// thread owns the ClientPackage it installs relayed pages into. The two share only the mutex-protected slot
-// below (the latest view sample, the evicted pages, a wake-up flag) and the inboxes (thread-safe).
+// PackageReader (the node records the scheduler sees: index pages are installed into it here) and the
+// PageScheduler with its held set (pages arrived or requested; pages the frame thread's cache evicted are
+// reported through evicted() and become schedulable again). The frame thread owns the ClientPackage it
+// installs arrived pages into. Arrived pages are relayed on the fetcher's threads as soon as they are read
+// (the inbox's listener): into the frame thread's inbox, and for index pages a copy into this object's slot.
+// The threads share only that mutex-protected slot (latest view sample, evicted pages, index pages to
+// install, a wake-up flag) and the inboxes (thread-safe).
 //
-// When it plans (one PageScheduler::next or next_sse call, for as many bytes as the window has room): when
-// the window has room and something has changed since the last plan (a new view sample, an index page
-// arrived, a page evicted) or the last plan filled the room it had (there may be more to fetch). It sleeps
-// otherwise, woken by publish(), evicted() and every arrival (the fetcher's inbox listener): no polling.
+// When it plans (one PageScheduler::next or next_sse call, for as many bytes as the window has room): only
+// when the window has room, and then when an index page arrived (new records), a page was evicted, the view
+// moved and the last plan is at least kReplanInterval older in the samples' own time, or the last plan
+// filled the room it had and the window is at most half full again (there may be more to fetch). It sleeps
+// otherwise, woken by publish(), evicted() and every arrival: no polling. Plans cost one select_cut per
+// predicted view; bounding their rate keeps clients that share a few cores from spending them on plans.
 #pragma once
 
 #include <condition_variable>
@@ -41,6 +45,9 @@ enum class PullOrder { benefit, sse };
 
 class PullScheduler {
  public:
+  // Seconds of view-sample time between two plans made for a moved view alone.
+  static constexpr double kReplanInterval = 0.1;
+
   // `reader`: a copy of the client's reader (its root index read; index pages added here). Starts the
   // fetcher (over `make_source`, with `fetch`) and this object's thread; arrived pages and the transport's
   // failure go to `frames` (which must outlive this object). Nothing is fetched before the first publish().
@@ -56,15 +63,13 @@ class PullScheduler {
   void publish(const schedule::ViewSample& latest);
   void evicted(std::span<const uint32_t> pages);
 
-  // Plans made so far (each one scheduler call), for reports. Any thread.
+  // Plans made so far (each one scheduler call). Any thread.
   uint64_t plans() const;
 
  private:
   void run();
-  // Relays what arrived to `frames_`, installing index pages into `reader_` first; true if one was an index
-  // page. This thread.
-  bool relay();
-  void wake();
+  // The fetcher's threads: hands what arrived on (see above) and wakes this thread.
+  void relay();
 
   // This thread only.
   package::PackageReader reader_;
@@ -75,17 +80,18 @@ class PullScheduler {
   const PullOrder order_;
   const double tau_;
 
-  // The slot shared with the frame thread.
+  // The slot shared with the frame thread and the fetcher's threads.
   mutable std::mutex mutex_;
   std::condition_variable wake_;
   bool woken_ = false, stop_ = false;
   std::optional<schedule::ViewSample> latest_;
-  uint64_t view_generation_ = 0;
   std::vector<uint32_t> evicted_;
+  std::vector<ArrivedPage> index_pages_;  // arrived, for reader_
+  std::string error_;                     // the transport's failure, once
   uint64_t plans_ = 0;
 
-  PageInbox fetched_{[this] { wake(); }};  // the fetcher's, relayed by this thread
-  PullFetcher fetcher_;                    // after fetched_ and the slot: destroyed before them
+  PageInbox fetched_{[this] { relay(); }};  // the fetcher's
+  PullFetcher fetcher_;                     // after fetched_ and the slot: destroyed before them
   std::thread thread_;
 };
 

@@ -77,6 +77,10 @@ const char* ViewClient::mode() const {
   return mode_ == Mode::push ? "push" : mode_ == Mode::pull ? "pull" : "file";
 }
 
+uint64_t ViewClient::plans() const {
+  return puller_ ? puller_->plans() : 0;
+}
+
 runtime::Frame ViewClient::frame(const schedule::ViewSample& now) {
   if (std::string error = arrived_.error(); !error.empty()) throw Error(error);
   for (ArrivedPage& a : arrived_.take()) client_.install(a.page.kind, a.page.id, a.bytes);

@@ -57,6 +57,9 @@ class ViewClient {
   // failed. Cost: the pages' decompression + ClientPackage::frame.
   runtime::Frame frame(const schedule::ViewSample& now);
 
+  // The pull scheduler's plans so far (PullScheduler::plans; 0 for a push stream).
+  uint64_t plans() const;
+
   runtime::ClientPackage& package() { return client_; }
   // The local package's folder (textures resolve against it), empty for a remote source.
   const std::filesystem::path& package_dir() const { return package_dir_; }
