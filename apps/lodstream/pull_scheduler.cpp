@@ -1,5 +1,7 @@
 #include "pull_scheduler.hpp"
 
+#include <deque>
+
 #include "core/error.hpp"
 
 namespace lodstream::cli {
@@ -82,7 +84,8 @@ void PullScheduler::relay() {
 void PullScheduler::run() {
   const package::RootIndex& root = reader_.root();
   std::optional<schedule::ViewSample> planned;  // the sample of the last plan
-  bool room_left = false;  // the last plan filled the room it had: there may be more to fetch
+  bool room_left = false;               // the last plan reached its byte limit: there may be more to fetch
+  std::deque<schedule::PageRef> ahead;  // the last plan's pages not requested yet, in its order
   for (;;) {
     std::optional<schedule::ViewSample> sample;
     std::vector<uint32_t> evicted;
@@ -104,28 +107,36 @@ void PullScheduler::run() {
       return;
     }
     if (!sample) continue;
-    const uint64_t in_flight = fetcher_.in_flight_bytes(), window = fetcher_.window_bytes();
+    uint64_t in_flight = fetcher_.in_flight_bytes();
+    const uint64_t window = fetcher_.window_bytes();
     if (in_flight >= window) continue;
     const bool view_due =
         !planned || (moved(*sample, *planned) && sample->time_s - planned->time_s >= kReplanInterval);
-    const bool more = room_left && in_flight <= window / 2;
-    if (!(view_due || more || !index.empty() || !evicted.empty())) continue;
-    planned = sample;
-
-    const schedule::ScheduleOptions options{tau_, window - in_flight, SIZE_MAX};
-    const auto predicted = schedule::predicted_views(*sample, 0.0);
-    const std::vector<schedule::PageRef> pages =
-        order_ == PullOrder::sse ? scheduler_.next_sse(reader_.scene(), records_, predicted[0].view, options)
-                                 : scheduler_.next(reader_.scene(), records_, predicted, options);
-    uint64_t bytes = 0;
-    for (const schedule::PageRef& p : pages) {
+    const bool more = ahead.empty() && room_left;
+    if (view_due || more || !index.empty() || !evicted.empty()) {
+      // A plan for kPlanAhead windows: the window's room is requested now, the rest as it frees up.
+      planned = sample;
+      const schedule::ScheduleOptions options{tau_, kPlanAhead * window, SIZE_MAX};
+      const auto predicted = schedule::predicted_views(*sample, 0.0);
+      const std::vector<schedule::PageRef> pages =
+          order_ == PullOrder::sse
+              ? scheduler_.next_sse(reader_.scene(), records_, predicted[0].view, options)
+              : scheduler_.next(reader_.scene(), records_, predicted, options);
+      uint64_t bytes = 0;
+      for (const schedule::PageRef& p : pages) bytes += p.bytes;
+      room_left = !pages.empty() && bytes >= options.max_bytes;
+      ahead.assign(pages.begin(), pages.end());
+      std::lock_guard lock(mutex_);
+      ++plans_;
+    }
+    // Requests in plan order while the window has room (at least one page when it has any).
+    while (!ahead.empty() && in_flight < window) {
+      const schedule::PageRef p = ahead.front();
+      ahead.pop_front();
       scheduler_.set_held(p.kind, p.id);
       fetcher_.request(p, p.kind == PageKind::data ? root.pages[p.id] : root.index_pages[p.id].range);
-      bytes += p.bytes;
+      in_flight += p.bytes;
     }
-    room_left = !pages.empty() && bytes >= options.max_bytes;
-    std::lock_guard lock(mutex_);
-    ++plans_;
   }
 }
 

@@ -12,12 +12,13 @@
 // The threads share only that mutex-protected slot (latest view sample, evicted pages, index pages to
 // install, a wake-up flag) and the inboxes (thread-safe).
 //
-// When it plans (one PageScheduler::next or next_sse call, for as many bytes as the window has room): only
-// when the window has room, and then when an index page arrived (new records), a page was evicted, the view
-// moved and the last plan is at least kReplanInterval older in the samples' own time, or the last plan
-// filled the room it had and the window is at most half full again (there may be more to fetch). It sleeps
-// otherwise, woken by publish(), evicted() and every arrival: no polling. Plans cost one select_cut per
-// predicted view; bounding their rate keeps clients that share a few cores from spending them on plans.
+// Plans (one PageScheduler::next or next_sse call each) look kPlanAhead windows ahead: the window's room is
+// requested at once, the rest in the plan's order as arrivals free the window, without planning again. It
+// plans only when the window has room, and then when an index page arrived (new records), a page was
+// evicted, the view moved and the last plan is at least kReplanInterval older in the samples' own time, or
+// the last plan's pages are all requested and it had reached its byte limit (there may be more to fetch). It
+// sleeps otherwise, woken by publish(), evicted() and every arrival: no polling. A plan costs one select_cut
+// per predicted view; bounding their rate keeps clients that share a few cores from spending them on plans.
 #pragma once
 
 #include <condition_variable>
@@ -47,6 +48,8 @@ class PullScheduler {
  public:
   // Seconds of view-sample time between two plans made for a moved view alone.
   static constexpr double kReplanInterval = 0.1;
+  // How many request windows of pages a plan chooses.
+  static constexpr uint64_t kPlanAhead = 4;
 
   // `reader`: a copy of the client's reader (its root index read; index pages added here). Starts the
   // fetcher (over `make_source`, with `fetch`) and this object's thread; arrived pages and the transport's
