@@ -1,6 +1,6 @@
 #include "pull_scheduler.hpp"
 
-#include <deque>
+#include <utility>
 
 #include "core/error.hpp"
 
@@ -77,19 +77,31 @@ void PullScheduler::relay() {
     for (ArrivedPage& a : index) index_pages_.push_back(std::move(a));
     if (!error.empty()) error_ = error;
     woken_ = true;
+    issue();
   }
   wake_.notify_all();
 }
 
+void PullScheduler::issue() {
+  uint64_t in_flight = fetcher_.in_flight_bytes();
+  const uint64_t window = fetcher_.window_bytes();
+  const package::RootIndex& root = reader_.root();  // immutable: read from any thread
+  while (!ahead_.empty() && in_flight < window) {
+    const schedule::PageRef p = ahead_.front();
+    ahead_.pop_front();
+    fetcher_.request(p, p.kind == PageKind::data ? root.pages[p.id] : root.index_pages[p.id].range);
+    in_flight += p.bytes;
+  }
+}
+
 void PullScheduler::run() {
-  const package::RootIndex& root = reader_.root();
   std::optional<schedule::ViewSample> planned;  // the sample of the last plan
-  bool room_left = false;               // the last plan reached its byte limit: there may be more to fetch
-  std::deque<schedule::PageRef> ahead;  // the last plan's pages not requested yet, in its order
+  bool room_left = false;  // the last plan reached its byte limit: there may be more to fetch
   for (;;) {
     std::optional<schedule::ViewSample> sample;
     std::vector<uint32_t> evicted;
     std::vector<ArrivedPage> index;
+    bool ahead_empty = true;
     {
       std::unique_lock lock(mutex_);
       wake_.wait(lock, [&] { return stop_ || woken_; });
@@ -98,6 +110,7 @@ void PullScheduler::run() {
       sample = latest_;
       evicted.swap(evicted_);
       index.swap(index_pages_);
+      ahead_empty = ahead_.empty();
     }
     for (uint32_t page : evicted) scheduler_.set_held(PageKind::data, page, false);
     try {
@@ -107,36 +120,44 @@ void PullScheduler::run() {
       return;
     }
     if (!sample) continue;
-    uint64_t in_flight = fetcher_.in_flight_bytes();
     const uint64_t window = fetcher_.window_bytes();
-    if (in_flight >= window) continue;
+    if (fetcher_.in_flight_bytes() >= window && !ahead_empty) continue;
     const bool view_due =
         !planned || (moved(*sample, *planned) && sample->time_s - planned->time_s >= kReplanInterval);
-    const bool more = ahead.empty() && room_left;
-    if (view_due || more || !index.empty() || !evicted.empty()) {
-      // A plan for kPlanAhead windows: the window's room is requested now, the rest as it frees up.
-      planned = sample;
-      const schedule::ScheduleOptions options{tau_, kPlanAhead * window, SIZE_MAX};
-      const auto predicted = schedule::predicted_views(*sample, 0.0);
-      const std::vector<schedule::PageRef> pages =
-          order_ == PullOrder::sse
-              ? scheduler_.next_sse(reader_.scene(), records_, predicted[0].view, options)
-              : scheduler_.next(reader_.scene(), records_, predicted, options);
-      uint64_t bytes = 0;
-      for (const schedule::PageRef& p : pages) bytes += p.bytes;
-      room_left = !pages.empty() && bytes >= options.max_bytes;
-      ahead.assign(pages.begin(), pages.end());
-      std::lock_guard lock(mutex_);
-      ++plans_;
-    }
-    // Requests in plan order while the window has room (at least one page when it has any).
-    while (!ahead.empty() && in_flight < window) {
-      const schedule::PageRef p = ahead.front();
-      ahead.pop_front();
+    const bool more = ahead_empty && room_left;
+    if (!(view_due || more || !index.empty() || !evicted.empty())) continue;
+
+    // A plan for kPlanAhead windows, made while the fetcher's threads go on requesting the last plan's pages
+    // (held, so not chosen again). Its pages go first; what is left of the last plan follows, up to
+    // kPlanAhead windows in all, and the rest is not held any more (the next plan may choose it again).
+    planned = sample;
+    const schedule::ScheduleOptions options{tau_, kPlanAhead * window, SIZE_MAX};
+    const auto predicted = schedule::predicted_views(*sample, 0.0);
+    const std::vector<schedule::PageRef> pages =
+        order_ == PullOrder::sse ? scheduler_.next_sse(reader_.scene(), records_, predicted[0].view, options)
+                                 : scheduler_.next(reader_.scene(), records_, predicted, options);
+    uint64_t bytes = 0;
+    for (const schedule::PageRef& p : pages) {
       scheduler_.set_held(p.kind, p.id);
-      fetcher_.request(p, p.kind == PageKind::data ? root.pages[p.id] : root.index_pages[p.id].range);
-      in_flight += p.bytes;
+      bytes += p.bytes;
     }
+    room_left = !pages.empty() && bytes >= options.max_bytes;
+    std::vector<schedule::PageRef> dropped;
+    {
+      std::lock_guard lock(mutex_);
+      std::deque<schedule::PageRef> left = std::exchange(ahead_, {pages.begin(), pages.end()});
+      for (const schedule::PageRef& p : left) {
+        if (bytes + p.bytes <= options.max_bytes) {
+          ahead_.push_back(p);
+          bytes += p.bytes;
+        } else {
+          dropped.push_back(p);
+        }
+      }
+      ++plans_;
+      issue();
+    }
+    for (const schedule::PageRef& p : dropped) scheduler_.set_held(p.kind, p.id, false);
   }
 }
 

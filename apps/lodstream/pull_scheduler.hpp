@@ -5,24 +5,27 @@
 //
 // Ownership, so that nothing is shared without a lock: this object's thread alone owns a copy of the client's
 // PackageReader (the node records the scheduler sees: index pages are installed into it here) and the
-// PageScheduler with its held set (pages arrived or requested; pages the frame thread's cache evicted are
-// reported through evicted() and become schedulable again). The frame thread owns the ClientPackage it
-// installs arrived pages into. Arrived pages are relayed on the fetcher's threads as soon as they are read
-// (the inbox's listener): into the frame thread's inbox, and for index pages a copy into this object's slot.
-// The threads share only that mutex-protected slot (latest view sample, evicted pages, index pages to
-// install, a wake-up flag) and the inboxes (thread-safe).
+// PageScheduler with its held set (pages arrived, requested or planned; pages the frame thread's cache
+// evicted are reported through evicted() and become schedulable again). The frame thread owns the
+// ClientPackage it installs arrived pages into. The fetcher's threads relay arrived pages as soon as they are
+// read (the inbox's listener): into the frame thread's inbox, and for index pages a copy into this object's
+// slot; then they request the next planned pages while the window has room. The threads share only that
+// mutex-protected slot (latest view sample, evicted pages, index pages to install, the planned pages not
+// requested yet, a wake-up flag) and the inboxes (thread-safe).
 //
 // Plans (one PageScheduler::next or next_sse call each) look kPlanAhead windows ahead: the window's room is
-// requested at once, the rest in the plan's order as arrivals free the window, without planning again. It
-// plans only when the window has room, and then when an index page arrived (new records), a page was
-// evicted, the view moved and the last plan is at least kReplanInterval older in the samples' own time, or
-// the last plan's pages are all requested and it had reached its byte limit (there may be more to fetch). It
-// sleeps otherwise, woken by publish(), evicted() and every arrival: no polling. A plan costs one select_cut
-// per predicted view; bounding their rate keeps clients that share a few cores from spending them on plans.
+// requested at once, the rest in the plan's order as arrivals free the window, on the fetcher's threads, so
+// that the link stays busy while this thread plans. It plans only when the window has room or nothing is
+// left to request, and then when an index page arrived (new records), a page was evicted, the view moved and
+// the last plan is at least kReplanInterval older in the samples' own time, or the last plan's pages are all
+// requested and it had reached its byte limit (there may be more to fetch). It sleeps otherwise, woken by
+// publish(), evicted() and every arrival: no polling. A plan costs one select_cut per predicted view;
+// bounding their rate keeps clients that share a few cores from spending them on plans.
 #pragma once
 
 #include <condition_variable>
 #include <cstdint>
+#include <deque>
 #include <mutex>
 #include <optional>
 #include <span>
@@ -71,8 +74,10 @@ class PullScheduler {
 
  private:
   void run();
-  // The fetcher's threads: hands what arrived on (see above) and wakes this thread.
+  // The fetcher's threads: hands what arrived on (see above), requests planned pages, wakes this thread.
   void relay();
+  // Requests planned pages while the window has room. Any thread, with mutex_ held.
+  void issue();
 
   // This thread only.
   package::PackageReader reader_;
@@ -90,6 +95,7 @@ class PullScheduler {
   std::optional<schedule::ViewSample> latest_;
   std::vector<uint32_t> evicted_;
   std::vector<ArrivedPage> index_pages_;  // arrived, for reader_
+  std::deque<schedule::PageRef> ahead_;   // planned (held), not requested yet, in plan order
   std::string error_;                     // the transport's failure, once
   uint64_t plans_ = 0;
 
