@@ -178,6 +178,7 @@ int run_headless(const ViewOptions& opt) {
   j["pixel_error_max"] = last.quality.pixel_error_max;
   j["nodes"] = last.cut.drawn.size();
   j["triangles"] = last.cut.triangles;
+  j["plans"] = client.plans();
   j["csv"] = (dir / "frames.csv").string();
   report(opt, client.mode(), j, frame_ms);
   return 0;
@@ -275,6 +276,7 @@ int run_window(const ViewOptions& opt) {
   j["pixel_error_max"] = last.quality.pixel_error_max;
   j["nodes"] = last.cut.drawn.size();
   j["triangles"] = last.cut.triangles;
+  j["plans"] = client.plans();
   j["renderer"] = window->renderer();
   report(opt, client.mode(), j, frame_ms);
   return 0;

@@ -93,6 +93,10 @@ uint64_t ViewClient::reconnects() const {
   return puller_ ? puller_->reconnects() : pusher_->reconnects();
 }
 
+uint64_t ViewClient::plans() const {
+  return puller_ ? puller_->plans() : 0;
+}
+
 runtime::Frame ViewClient::frame(const schedule::ViewSample& now) {
   if (std::string error = arrived_.error(); !error.empty()) throw Error(error);
   for (ArrivedPage& a : arrived_.take()) {

@@ -64,6 +64,9 @@ class ViewClient {
   // failed. Cost: the pages' decompression + ClientPackage::frame.
   runtime::Frame frame(const schedule::ViewSample& now);
 
+  // The pull scheduler's plans so far (PullScheduler::plans; 0 for a push stream).
+  uint64_t plans() const;
+
   runtime::ClientPackage& package() { return client_; }
   // Times the transport reconnected after losing its server (push: a new session with the held pages in its
   // hello; pull: a new connection for a failed read).

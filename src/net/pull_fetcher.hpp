@@ -2,8 +2,9 @@
 // fetches page ranges itself, with a request window sized from the measured bandwidth-delay product; it works
 // against any static HTTP server"): `connections` worker threads, each with its own ByteSource (an
 // HttpSource: one keep-alive connection; or a local file), read the requested pages' byte ranges in request
-// order and leave them in a PageInbox. The caller (the frame loop) asks for pages while in_flight_bytes() <
-// window_bytes().
+// order and leave them in a PageInbox (after updating in_flight_bytes(), so that a consumer the inbox wakes
+// sees the room the page freed). The caller (one scheduling thread, e.g. the view's PullScheduler) asks for
+// pages while in_flight_bytes() < window_bytes(); every member function is thread-safe.
 //
 // Window = max(min_window_bytes, window_bdp * bandwidth * rtt): bandwidth = the largest rate of delivered
 // bytes over the last `bandwidth_window_s` (sampled per completed request: bytes completed in the window /

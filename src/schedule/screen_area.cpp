@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace lodstream::schedule {
 
@@ -14,6 +15,9 @@ double projected_area(const WorldSphere& sphere, const View& view) {
   const double f = view.focal_pixels();
   const double rho = f * r / std::sqrt(glm::dot(d, d) - r * r);
   const double cx = 0.5 * view.width + f * x / z, cy = 0.5 * view.height + f * y / z;
+  // A disc inside the viewport (most nodes of a view) needs no clipping: pi rho^2.
+  if (cx - rho >= 0.0 && cx + rho <= view.width && cy - rho >= 0.0 && cy + rho <= view.height)
+    return std::numbers::pi * rho * rho;
   // Chords of the disc over the strips of y inside the viewport, clipped to [0, width].
   const double y0 = std::max(cy - rho, 0.0), y1 = std::min(cy + rho, view.height);
   if (!(y1 > y0)) return 0.0;

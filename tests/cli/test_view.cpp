@@ -82,28 +82,11 @@ TEST(View, SixteenClientsOnOneServerConvergeWhileAGarbageClientGetsBye) {
   EXPECT_EQ(server.process.stop(), 0);
 }
 
-TEST(View, AWindowUnderXvfbDrawsWhatItPulledAndExitsAfterItsFrames) {
-  test::Xvfb x(800, 600);
-  ASSERT_FALSE(x.display().empty()) << "Xvfb did not start (scripts/setup installs xvfb)";
-  Server server;
-  const auto shot = test::temp_dir() / "window.png";
-  // The start pose is the path's first key frame: the elephant in the middle of a 640x480 window.
-  const auto path = camera_path({}, {0.0f, 0.2f, 1.5f}, 0);
-  setenv("DISPLAY", x.display().c_str(), 1);
-  const auto r = test::run_lodstream({"view", server.http(), "--path", path.string(), "--frames", "45",
-                                      "--screenshot", shot.string(), "--json"});
-  unsetenv("DISPLAY");
-  ASSERT_EQ(r.status, 0) << r.err;
-  const auto j = r.json();
-  EXPECT_EQ(j["mode"], "pull");
-  EXPECT_EQ(j["frames"], 45);
-  EXPECT_GT(j["bytes"].get<uint64_t>(), 0u);
-  EXPECT_GT(j["triangles"].get<uint64_t>(), 0u);
-  // The last frame shows the scene: pixels other than the background, where the elephant is (the middle).
-  const Image image = load_image(shot);
-  ASSERT_EQ(image.width, 640);
-  ASSERT_EQ(image.height, 480);
-  size_t covered = 0, covered_middle = 0;
+namespace {
+
+// Pixels of `image` other than the background: in all, and in its middle half (both axes).
+std::pair<size_t, size_t> covered_pixels(const Image& image) {
+  size_t covered = 0, middle = 0;
   for (int y = 0; y < image.height; ++y)
     for (int x = 0; x < image.width; ++x) {
       const uint8_t* p = image.pixel(x, y);
@@ -111,10 +94,58 @@ TEST(View, AWindowUnderXvfbDrawsWhatItPulledAndExitsAfterItsFrames) {
       ++covered;
       if (std::abs(x - image.width / 2) < image.width / 4 &&
           std::abs(y - image.height / 2) < image.height / 4)
-        ++covered_middle;
+        ++middle;
     }
-  EXPECT_GT(covered, size_t(image.width * image.height / 50)) << "the frame is (nearly) empty";
-  EXPECT_GT(covered_middle, covered / 2);
+  return {covered, middle};
+}
+
+}  // namespace
+
+TEST(View, AWindowUnderXvfbDrawsWhatItStreamedAndExitsAfterItsFrames) {
+  test::Xvfb x(800, 600);
+  ASSERT_FALSE(x.display().empty()) << "Xvfb did not start (scripts/setup installs xvfb)";
+  Server server;
+  // `frames` frames in a window; the last one as `shot`; returns the JSON summary.
+  auto window = [&](std::vector<std::string> args, const std::filesystem::path& shot) {
+    args.insert(args.end(), {"--frames", "45", "--screenshot", shot.string(), "--json"});
+    setenv("DISPLAY", x.display().c_str(), 1);
+    const auto r = test::run_lodstream(args);
+    unsetenv("DISPLAY");
+    EXPECT_EQ(r.status, 0) << r.err;
+    return r.status == 0 ? r.json() : nlohmann::json::object();
+  };
+  {
+    // Pulled, starting at the path's first key frame: the elephant in the middle of a 640x480 window.
+    SCOPED_TRACE("pull, --path");
+    const auto shot = test::temp_dir() / "window_pull.png";
+    const auto path = camera_path({}, {0.0f, 0.2f, 1.5f}, 0);
+    const auto j = window({"view", server.http(), "--path", path.string()}, shot);
+    EXPECT_EQ(j["mode"], "pull");
+    EXPECT_EQ(j["frames"], 45);
+    EXPECT_GT(j["bytes"].get<uint64_t>(), 0u);
+    EXPECT_GT(j["triangles"].get<uint64_t>(), 0u);
+    const Image image = load_image(shot);
+    ASSERT_EQ(image.width, 640);
+    ASSERT_EQ(image.height, 480);
+    const auto [covered, middle] = covered_pixels(image);
+    EXPECT_GT(covered, size_t(image.width * image.height / 50)) << "the frame is (nearly) empty";
+    EXPECT_GT(middle, covered / 2);
+  }
+  {
+    // Pushed, with no path: the start pose is fitted to the scene's bounds (3 radii out, at its centre).
+    SCOPED_TRACE("push, fitted start");
+    const auto shot = test::temp_dir() / "window_push.png";
+    const auto j = window({"view", server.ws(), "--size", "320x240"}, shot);
+    EXPECT_EQ(j["mode"], "push");
+    EXPECT_EQ(j["frames"], 45);
+    EXPECT_GT(j["bytes"].get<uint64_t>(), 0u);
+    EXPECT_GT(j["triangles"].get<uint64_t>(), 0u);
+    const Image image = load_image(shot);
+    ASSERT_EQ(image.width, 320);
+    const auto [covered, middle] = covered_pixels(image);
+    EXPECT_GT(covered, size_t(image.width * image.height / 200)) << "the frame is (nearly) empty";
+    EXPECT_GT(middle, covered / 2);
+  }
   EXPECT_EQ(server.process.stop(), 0);
 }
 
