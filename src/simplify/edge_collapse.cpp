@@ -4,8 +4,10 @@
 // neither seams nor a bound).
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 
@@ -25,13 +27,51 @@ struct Candidate {
   uint32_t b;  // kept
 };
 
+// A candidate in a pass's collapse order: its cost and its slot (Simplifier::slots_).
+struct Ranked {
+  float cost;
+  uint32_t slot;
+};
+
 // One planned collapse: a -> b and, on a seam, its twin a2 -> b2; x is where b (and b2) end up.
 struct Plan {
   uint32_t a = kNone, b = kNone, a2 = kNone, b2 = kNone;
+  uint32_t slot = kNone;  // the candidate's slot
   bool move = false;
   glm::dvec3 x{0.0};
   double cost = 0.0;
 };
+
+// One changed face for vertical_bound.
+struct Corners {
+  glm::dvec3 p[3];
+  glm::dvec2 y[3];
+  double h[3], r[3];
+  bool moving[3];
+  bool dies;
+};
+// A projected edge for vertical_bound: origin + t direction, heights and radii at its ends.
+struct Segment {
+  glm::dvec2 origin, direction;
+  double h0, h1, r0, r1;
+};
+
+constexpr uint8_t kAnyRegion = 2;
+
+// What one thread of the collapse loop needs of its own: the collapse's neighbourhood, vertical_bound's
+// faces and edges, and what its collapses changed (merged into the mesh's totals after the loop).
+struct Scratch {
+  uint8_t region = kAnyRegion;  // collapses must keep every face they read inside this region
+  std::vector<uint32_t> na, nb, apex, removed;
+  std::vector<Corners> old;
+  std::vector<Segment> old_edges, spokes;  // spokes: direction from x, origin unused
+  size_t removed_triangles = 0;
+  double bound = 0.0;  // the largest radius its collapses gave (the mesh's bound when run serially)
+  bool error_limited = false;
+  bool rejected = false;  // a candidate's slot was set to +inf by a failed collapse
+};
+
+enum class Outcome { kCollapsed, kRejected, kOutsideRegion };
 
 uint32_t hash_bits(const float* v, size_t n) {
   uint32_t h = 2166136261u;
@@ -57,9 +97,10 @@ class Simplifier {
     build_adjacency();
     classify();
     build_quadrics();
+    choose_split();
     const size_t target = opt_.target_triangles;
     const size_t start_tris = alive_triangles_;
-    bool stalled = false;
+    bool stalled = false, retried = false;
     uint32_t pass = 0;
     while (alive_triangles_ > target) {
       if (pass++ > 0) {
@@ -71,8 +112,17 @@ class Simplifier {
       if (opt_.progress && start_tris > target)
         opt_.progress(float(start_tris - alive_triangles_) / float(start_tris - target));
       if (collapsed == 0) {
-        stalled = true;
-        break;
+        // Slots of rejected collapses are +inf until re-evaluated: before giving up, evaluate every edge
+        // again once (a neighbour's collapse may have made one of them valid).
+        if (!rejected_ || retried) {
+          stalled = true;
+          break;
+        }
+        retried = true;
+        rejected_ = false;
+        slots_.clear();
+      } else {
+        retried = false;
       }
     }
     // Reached: within 1 % of the triangle target, or stopped by the error bound before it.
@@ -101,17 +151,25 @@ class Simplifier {
   std::vector<uint32_t> open_out_, open_in_;
   glm::vec3 origin_{0.0f};
   float scale_ = 1.0f;
-  double bound_ = 0.0;  // max of radius_
   double max_error_ = 0.0;
   bool error_limited_ = false;  // a collapse was refused because of Options::max_error
 
   std::vector<uint32_t> indices_;  // alive faces; dead ones have indices_[3f] == kNone during a pass
   size_t alive_triangles_ = 0;
   std::vector<uint32_t> offsets_, faces_;  // vertex -> faces (CSR), rebuilt each pass
-  std::vector<Candidate> slots_, order_, sorted_;
+  std::vector<Candidate> slots_;
+  std::vector<Ranked> order_, sorted_;
   std::vector<float> bucket_;    // goal_cost's candidate costs in one histogram bucket
   std::vector<uint32_t> dirty_;  // vertices of the faces around touched vertices, this pass
   std::vector<uint8_t> vertex_mark_;
+  // Two spatial halves of the vertices (split at the median along one axis, the next axis each time, so
+  // that no band of the mesh is always left to the serial part) for the parallel part of the collapse loop;
+  // pending_: per order_ entry, left by its half's thread for the serial part.
+  std::vector<uint8_t> region_, pending_;
+  glm::vec3 split_{0.0f};
+  int split_axis_ = 0;
+  std::array<Scratch, 2> scratch_;
+  bool rejected_ = false;  // slots were set to +inf by failed collapses since the last full evaluation
   uint32_t step_ = 0;
   std::vector<Collapse>* record_ = nullptr;
 
@@ -361,6 +419,20 @@ class Simplifier {
     }
   }
 
+  // The median of the vertices along each axis: the planes that split them into the two halves of
+  // collapse_in_order. O(V) (nth_element on a copy).
+  void choose_split() {
+    const size_t m = pos_.size();
+    region_.assign(m, 0);
+    if (m == 0) return;
+    std::vector<float> c(m);
+    for (int axis = 0; axis < 3; ++axis) {
+      for (size_t v = 0; v < m; ++v) c[v] = pos_[v][axis];
+      std::nth_element(c.begin(), c.begin() + m / 2, c.end());
+      split_[axis] = c[m / 2];
+    }
+  }
+
   void channel_values(uint32_t v, float* s) const {
     int j = 0;
     if (nrm_.size() && opt_.normal_weight > 0)
@@ -513,23 +585,92 @@ class Simplifier {
       // permutation): the radix sort keeps this order among equal costs, so that flat regions (all costs
       // equal) collapse spread out rather than row by row in face order, the same way on every run.
       order_.clear();
-      for (const Candidate& c : slots_)
-        if (c.a != kNone && std::isfinite(c.cost) && c.cost <= limit) order_.push_back(c);
+      for (size_t i = 0; i < slots_.size(); ++i)
+        if (const Candidate& c = slots_[i]; c.a != kNone && std::isfinite(c.cost) && c.cost <= limit)
+          order_.push_back({c.cost, uint32_t(i)});
       constexpr uint64_t kScatter = 2654435761u;  // prime, above any candidate count
       sorted_.resize(order_.size());
       for (size_t i = 0; i < order_.size(); ++i) sorted_[i * kScatter % order_.size()] = order_[i];
       order_.swap(sorted_);
       radix_sort_by_cost();
-      for (const Candidate& c : order_) {
-        if (c.cost > limit || alive_triangles_ <= target) break;
-        Plan p;
-        if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
-        if (p.a2 != kNone && (touched_[p.a2] || touched_[p.b2])) continue;
-        if (try_collapse(p)) ++collapsed;
-      }
+      collapsed = collapse_in_order(limit, target);
       if (collapsed > 0 || std::isinf(limit)) break;
     }
     return collapsed;
+  }
+
+  // The collapse loop over order_ (cost order, up to `limit`, until the target): independent collapses,
+  // none touching a vertex an earlier one in this pass touched. Large passes (not recording collapses) run
+  // it on both halves of the mesh at once first, each thread taking the candidates of its half in order up
+  // to half the triangles still to remove; collapses whose faces cross the split, and what a thread left,
+  // follow serially in order. Each half's outcome depends only on its own faces, so the result is the same
+  // on every run. Returns the number of collapses.
+  size_t collapse_in_order(float limit, size_t target) {
+    size_t collapsed = 0;
+    // The order_ index from which a half's candidates are left to the serial part.
+    std::array<size_t, 2> stop{0, 0};
+    constexpr size_t kParallelMin = 1024;
+    const bool parallel = !record_ && order_.size() >= kParallelMin && alive_triangles_ > target + 8;
+    if (parallel) {
+      const size_t quota = (alive_triangles_ - target) / 2;
+      const int axis = split_axis_;
+      split_axis_ = (split_axis_ + 1) % 3;
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, region_.size(), 4096), [&](const auto& r) {
+        for (size_t v = r.begin(); v < r.end(); ++v) region_[v] = pos_[v][axis] < split_[axis] ? 0 : 1;
+      });
+      pending_.assign(order_.size(), 0);
+      std::array<size_t, 2> count{0, 0};
+      auto half = [&](uint8_t r) {
+        Scratch& s = scratch_[r];
+        s.region = r;
+        size_t i = 0;
+        for (; i < order_.size(); ++i) {
+          if (order_[i].cost > limit || s.removed_triangles + 2 > quota) break;
+          const Candidate& c = slots_[order_[i].slot];
+          if (region_[c.a] != r || region_[c.b] != r) continue;
+          Plan p;
+          if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
+          p.slot = order_[i].slot;
+          if (p.a2 != kNone && (touched_[p.a2] || touched_[p.b2])) continue;
+          switch (try_collapse(p, s)) {
+            case Outcome::kCollapsed:
+              ++count[r];
+              break;
+            case Outcome::kOutsideRegion:
+              pending_[i] = 1;
+              break;
+            case Outcome::kRejected:
+              break;
+          }
+        }
+        stop[r] = i;
+      };
+      tbb::parallel_invoke([&] { half(0); }, [&] { half(1); });
+      collapsed = count[0] + count[1];
+      gather(scratch_[0]), gather(scratch_[1]);
+    }
+    Scratch& s = scratch_[0];
+    s.region = kAnyRegion;
+    for (size_t i = 0; i < order_.size(); ++i) {
+      if (order_[i].cost > limit || alive_triangles_ - s.removed_triangles <= target) break;
+      const Candidate& c = slots_[order_[i].slot];
+      if (parallel && region_[c.a] == region_[c.b] && !pending_[i] && i < stop[region_[c.a]]) continue;
+      Plan p;
+      if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
+      p.slot = order_[i].slot;
+      if (p.a2 != kNone && (touched_[p.a2] || touched_[p.b2])) continue;
+      if (try_collapse(p, s) == Outcome::kCollapsed) ++collapsed;
+    }
+    gather(s);
+    return collapsed;
+  }
+
+  // Adds a thread's changes to the mesh's totals and clears them.
+  void gather(Scratch& s) {
+    alive_triangles_ -= s.removed_triangles;
+    error_limited_ = error_limited_ || s.error_limited;
+    rejected_ = rejected_ || s.rejected;
+    s.removed_triangles = 0, s.error_limited = false, s.rejected = false;
   }
 
   // The cost of rank `goal` (0-based) among the valid candidates in slots_, or +inf when there are no more
@@ -560,21 +701,21 @@ class Simplifier {
   // 11 + 11 + 10 bits.
   void radix_sort_by_cost() {
     sorted_.resize(order_.size());
-    std::vector<Candidate>*src = &order_, *dst = &sorted_;
+    std::vector<Ranked>*src = &order_, *dst = &sorted_;
     for (int shift : {0, 11, 22}) {
       uint32_t count[2048] = {};
-      auto digit = [shift](const Candidate& c) {
+      auto digit = [shift](const Ranked& c) {
         uint32_t u;
         std::memcpy(&u, &c.cost, 4);
         return (u >> shift) & 2047u;
       };
-      for (const Candidate& c : *src) ++count[digit(c)];
+      for (const Ranked& c : *src) ++count[digit(c)];
       uint32_t sum = 0;
       for (uint32_t& n : count) {
         uint32_t k = n;
         n = sum, sum += k;
       }
-      for (const Candidate& c : *src) (*dst)[count[digit(c)]++] = c;
+      for (const Ranked& c : *src) (*dst)[count[digit(c)]++] = c;
       std::swap(src, dst);
     }
     if (src != &order_) order_.swap(sorted_);
@@ -592,70 +733,61 @@ class Simplifier {
     } while (w != v);
   }
 
-  std::vector<uint32_t> na_, nb_, apex_, removed_;
-  std::vector<uint32_t> mark_a_, mark_b_;
-  struct Corners {  // one changed face for vertical_bound
-    glm::dvec3 p[3];
-    glm::dvec2 y[3];
-    double h[3], r[3];
-    bool moving[3];
-    bool dies;
-  };
-  std::vector<Corners> old_;
-  struct Segment {  // a projected edge for vertical_bound: origin + t direction, heights and radii at its
-                    // ends
-    glm::dvec2 origin, direction;
-    double h0, h1, r0, r1;
-  };
-  std::vector<Segment> old_edges_, spokes_;  // spokes: direction from x, origin unused
-  // neighbour marks (stamp_ = this collapse)
-  uint32_t stamp_ = 0;
-
   // Validity (link condition, boundary pinch, lost surface, normal change), bound, then the collapse. The
   // topological checks come first: they do not need the placement, which `place` computes only for the
-  // collapses that pass them.
-  bool try_collapse(Plan& p) {
+  // collapses that pass them. With a region in `s`, a collapse whose faces (those around a and b) are not
+  // all inside it is left alone (kOutsideRegion): two threads then never read or write the same face or
+  // vertex. A rejected collapse sets its slot to +inf until an end is touched (rejected_slot).
+  Outcome try_collapse(Plan& p, Scratch& s) {
     const uint32_t pa = pid_[p.a], pb = pid_[p.b];
 
-    na_.clear(), nb_.clear(), apex_.clear(), removed_.clear();
+    s.na.clear(), s.nb.clear(), s.apex.clear(), s.removed.clear();
     size_t kept_faces = 0;
+    bool inside = true;
+    auto in_region = [&](const uint32_t* t) {
+      return s.region == kAnyRegion ||
+             (region_[t[0]] == s.region && region_[t[1]] == s.region && region_[t[2]] == s.region);
+    };
     for_faces(p.a, [&](uint32_t f) {
       const uint32_t* t = &indices_[3 * size_t(f)];
+      inside = inside && in_region(t);
       uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
       if (q[0] == pb || q[1] == pb || q[2] == pb) {
-        removed_.push_back(f);
+        s.removed.push_back(f);
         for (uint32_t x : q)
-          if (x != pa && x != pb) apex_.push_back(x);
+          if (x != pa && x != pb) s.apex.push_back(x);
       } else {
         ++kept_faces;
         for (uint32_t x : q)
-          if (x != pa) na_.push_back(x);
+          if (x != pa) s.na.push_back(x);
       }
     });
     for_faces(p.b, [&](uint32_t f) {
       const uint32_t* t = &indices_[3 * size_t(f)];
+      inside = inside && in_region(t);
       uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
       if (q[0] == pa || q[1] == pa || q[2] == pa) return;
       ++kept_faces;
       for (uint32_t x : q)
-        if (x != pb) nb_.push_back(x);
+        if (x != pb) s.nb.push_back(x);
     });
+    if (!inside) return Outcome::kOutsideRegion;
     const size_t expected = p.a2 == kNone ? (kind_[p.a] == kManifold ? 2 : 1) : 2;
-    if (removed_.size() == 0 || removed_.size() > expected || apex_.size() != removed_.size()) return false;
-    if (apex_.size() == 2 && apex_[0] == apex_[1]) return false;
+    if (s.removed.size() == 0 || s.removed.size() > expected || s.apex.size() != s.removed.size())
+      return rejected_slot(p, s);
+    if (s.apex.size() == 2 && s.apex[0] == s.apex[1]) return rejected_slot(p, s);
     const bool interior = kind_[p.a] == kManifold && kind_[p.b] == kManifold;
-    if (kept_faces < (interior ? 3u : 1u)) return false;
+    if (kept_faces < (interior ? 3u : 1u)) return rejected_slot(p, s);
     // Link condition: the neighbours a and b share are exactly the apexes of the removed faces; each apex
     // keeps an edge to x (else a removed face's image would be a dangling edge and the bound would fail).
-    // Neighbour sets are marked with this collapse's stamp instead of sorted.
-    if (mark_a_.size() != source_.size() || ++stamp_ == 0)
-      mark_a_.assign(source_.size(), 0), mark_b_.assign(source_.size(), 0), stamp_ = 1;
-    for (uint32_t v : na_) mark_a_[v] = stamp_;
-    for (uint32_t v : nb_) mark_b_[v] = stamp_;
-    for (uint32_t v : nb_)
-      if (mark_a_[v] == stamp_ && std::find(apex_.begin(), apex_.end(), v) == apex_.end()) return false;
-    for (uint32_t c : apex_)
-      if (mark_a_[c] != stamp_ && mark_b_[c] != stamp_) return false;
+    // The neighbour lists hold a few dozen entries: linear search, no per-vertex marks.
+    auto has = [](const std::vector<uint32_t>& list, uint32_t v) {
+      return std::find(list.begin(), list.end(), v) != list.end();
+    };
+    for (uint32_t v : s.nb)
+      if (has(s.na, v) && !has(s.apex, v)) return rejected_slot(p, s);
+    for (uint32_t c : s.apex)
+      if (!has(s.na, c) && !has(s.nb, c)) return rejected_slot(p, s);
 
     place(p);
     const glm::vec3 x(p.x);  // as stored: the bounds use the rounded position
@@ -683,15 +815,15 @@ class Simplifier {
     };
     for_faces(p.a, check);
     if (p.move) for_faces(p.b, check);
-    if (!ok) return false;
-    const double r_new = std::min(r_natural, vertical_bound(p, x));
+    if (!ok) return rejected_slot(p, s);
+    const double r_new = std::min(r_natural, vertical_bound(p, x, s, r_natural));
     if (r_new > max_error_) {
-      error_limited_ = true;
-      return false;
+      s.error_limited = true;
+      return rejected_slot(p, s);
     }
 
     // Apply.
-    for (uint32_t f : removed_) indices_[3 * size_t(f)] = kNone;
+    for (uint32_t f : s.removed) indices_[3 * size_t(f)] = kNone;
     for_faces(p.a, [&](uint32_t f) {
       uint32_t* t = &indices_[3 * size_t(f)];
       for (int k = 0; k < 3; ++k) {
@@ -699,7 +831,7 @@ class Simplifier {
         if (p.a2 != kNone && t[k] == p.a2) t[k] = p.b2;
       }
     });
-    alive_triangles_ -= removed_.size();
+    s.removed_triangles += s.removed.size();
     merge(p.a, p.b, p);
     if (p.a2 != kNone) merge(p.a2, p.b2, p);
     uint32_t v = p.b;
@@ -711,17 +843,26 @@ class Simplifier {
     } while (v != p.b);
     touched_[p.a] = 1;
     if (p.a2 != kNone) touched_[p.a2] = 1;
-    bound_ = std::max(bound_, r_new);
-    if (record_) {
-      const float e = reported(bound_);
+    s.bound = std::max(s.bound, r_new);
+    if (record_) {  // serial (collapse_in_order): s.bound is the mesh's bound
+      const float e = reported(s.bound);
       record_->push_back({p.a, p.b, step_, e});
       if (p.a2 != kNone) record_->push_back({p.a2, p.b2, step_, e});
       ++step_;
     }
-    return true;
+    return Outcome::kCollapsed;
   }
 
-  // Radius of x under the vertical mapping (simplify.hpp), or +inf where it does not apply. The changed
+  // Sets the candidate's slot (in a face around a and b) to +inf: it is not tried again until an end is
+  // touched and re-evaluates it, or a pass that collapses nothing re-evaluates every edge.
+  Outcome rejected_slot(const Plan& p, Scratch& s) {
+    slots_[p.slot].cost = std::numeric_limits<float>::infinity();
+    s.rejected = true;
+    return Outcome::kRejected;
+  }
+
+  // Radius of x under the vertical mapping (simplify.hpp), or +inf where it does not apply or would not be
+  // below `cap`. The changed
   // region (a's faces, and b's when x moves) must be a closed star at the position level whose old and new
   // faces all project with positive orientation onto the plane of its mean normal n: both then cover the
   // same region of that plane, and the mapping pairs the points over the same place, |p' - p| = the height
@@ -729,12 +870,12 @@ class Simplifier {
   // the right side is piecewise linear and concave-kinked over the common refinement of both fans, so it is
   // enough to check the refinement's vertices: x in the old fan, a (and b) in the new fan, and the crossings
   // of old edges at a or b with the new edges at x (ring vertices are shared and hold trivially).
-  double vertical_bound(const Plan& p, const glm::vec3& x) {
+  double vertical_bound(const Plan& p, const glm::vec3& x, Scratch& sc, double cap) {
     constexpr double kInf = std::numeric_limits<double>::infinity();
     auto closed = [&](uint32_t v) { return kind_[v] == kManifold || kind_[v] == kSeam; };
     if (!closed(p.a) || (p.move && !closed(p.b))) return kInf;
     const uint32_t pa = pid_[p.a], pb = pid_[p.b];
-    old_.clear();
+    sc.old.clear();
     glm::dvec3 nsum(0.0);
     auto gather = [&](uint32_t f) {
       const uint32_t* t = &indices_[3 * size_t(f)];
@@ -748,7 +889,7 @@ class Simplifier {
       }
       c.dies = moving > 1;
       nsum += glm::cross(c.p[1] - c.p[0], c.p[2] - c.p[0]);
-      old_.push_back(c);
+      sc.old.push_back(c);
     };
     for_faces(p.a, gather);
     if (p.move)
@@ -767,7 +908,7 @@ class Simplifier {
     const glm::dvec3 xd(x);
     const glm::dvec2 yx = proj(xd);
     const double hx = glm::dot(n, xd);
-    for (Corners& c : old_) {
+    for (Corners& c : sc.old) {
       for (int k = 0; k < 3; ++k) c.y[k] = proj(c.p[k]), c.h[k] = glm::dot(n, c.p[k]);
       if (!(cross2(c.y[1] - c.y[0], c.y[2] - c.y[0]) > 0)) return kInf;
       if (c.dies) continue;
@@ -786,7 +927,7 @@ class Simplifier {
     double need = 0;
     // x over the old fan.
     bool found = false;
-    for (const Corners& c : old_) {
+    for (const Corners& c : sc.old) {
       double l[3];
       if (!inside(c.y, yx, l)) continue;
       need = std::abs(hx - (l[0] * c.h[0] + l[1] * c.h[1] + l[2] * c.h[2])) + l[0] * c.r[0] + l[1] * c.r[1] +
@@ -794,11 +935,12 @@ class Simplifier {
       found = true;
       break;
     }
-    if (!found) return kInf;
+    if (!found || need >= cap) return kInf;
     // Requirement mu_x r_x + rest >= rhs at a point of a new face: a lower bound on r_x.
+    // False when it cannot hold, or when r_x would reach `cap` (the natural bound, which then wins anyway).
     auto require = [&](double mu_x, double rest, double rhs) {
       if (mu_x > 1e-7) need = std::max(need, (rhs - rest) / mu_x);
-      return mu_x > 1e-7 || rest >= rhs - 1e-9;
+      return (mu_x > 1e-7 || rest >= rhs - 1e-9) && need < cap;
     };
     // The moved old vertices over the new fan.
     for (uint32_t v : {p.a, p.b}) {
@@ -806,7 +948,7 @@ class Simplifier {
       const glm::dvec3 pv(pos_[v]);
       const glm::dvec2 yv = proj(pv);
       found = false;
-      for (const Corners& c : old_) {
+      for (const Corners& c : sc.old) {
         if (c.dies) continue;
         glm::dvec2 y[3];
         for (int k = 0; k < 3; ++k) y[k] = c.moving[k] ? yx : c.y[k];
@@ -828,18 +970,18 @@ class Simplifier {
     }
     // Old edges at a or b against new edges at x: both lists once, then every pair (division-free rejection
     // first: most pairs do not cross).
-    old_edges_.clear(), spokes_.clear();
-    for (const Corners& c : old_)
+    sc.old_edges.clear(), sc.spokes.clear();
+    for (const Corners& c : sc.old)
       for (int i = 0; i < 3; ++i) {
         const int j = (i + 1) % 3;
         if (c.moving[i])  // each edge at a or b leaves a or b in exactly one of its faces
-          old_edges_.push_back({c.y[i], c.y[j] - c.y[i], c.h[i], c.h[j], c.r[i], c.r[j]});
+          sc.old_edges.push_back({c.y[i], c.y[j] - c.y[i], c.h[i], c.h[j], c.r[i], c.r[j]});
         if (!c.dies && c.moving[(i + 2) % 3])  // the new edge x -> ring vertex i (once per spoke)
-          spokes_.push_back({{}, c.y[i] - yx, c.h[i], 0.0, c.r[i], 0.0});
+          sc.spokes.push_back({{}, c.y[i] - yx, c.h[i], 0.0, c.r[i], 0.0});
       }
-    for (const Segment& o : old_edges_) {
+    for (const Segment& o : sc.old_edges) {
       const glm::dvec2 rel = o.origin - yx;
-      for (const Segment& e : spokes_) {
+      for (const Segment& e : sc.spokes) {
         const double den = cross2(e.direction, o.direction);
         if (std::abs(den) < 1e-30) continue;
         // s = cross2(rel, od) / den, t = cross2(rel, nd) / den, both strictly inside (0, 1).

@@ -105,6 +105,28 @@ TEST(EdgeCollapse, LockedVerticesNeverMoveOrDisappear) {
   EXPECT_LT(r.mesh.triangle_count(), in.triangle_count() / 2);
 }
 
+TEST(EdgeCollapse, ParallelHalvesGiveOneResultAndKeepTheGuarantees) {
+  // Large enough for each pass's collapse loop to run on both halves of the mesh at once; recording the
+  // collapses runs it serially, which gives the reference quality.
+  Mesh in = lumpy(sphere(1.0f, 32, 64), 8);
+  const size_t target = in.triangle_count() / 10;
+  auto r1 = simplify_mesh(in, with_target(target));
+  auto r2 = simplify_mesh(in, with_target(target));
+  EXPECT_EQ(r1.mesh.indices, r2.mesh.indices);
+  EXPECT_EQ(r1.mesh.positions, r2.mesh.positions);
+  EXPECT_TRUE(r1.target_reached);
+  EXPECT_LE(r1.mesh.triangle_count(), target);
+  EXPECT_TRUE(is_edge_manifold(r1.mesh));
+  EXPECT_TRUE(boundary_edges(r1.mesh).empty());
+  EXPECT_LE(sampled_hausdorff(in, r1.mesh), r1.error_bound);
+  Options serial = with_target(target);
+  serial.record_collapses = true;
+  auto rs = simplify_mesh(in, serial);
+  const float h1 = sampled_hausdorff(in, r1.mesh), hs = sampled_hausdorff(in, rs.mesh);
+  EXPECT_LE(h1, 1.25f * hs) << hs;
+  EXPECT_LE(r1.error_bound, 1.5 * rs.error_bound) << rs.error_bound;
+}
+
 TEST(EdgeCollapse, NoTriangleFlips) {
   // On a star-shaped surface a flipped triangle faces the centre.
   Mesh in = lumpy(sphere(1.0f, 24, 48), 5);
