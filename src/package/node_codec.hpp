@@ -29,6 +29,18 @@ struct PositionGrid {
   // The grid with origin at the box minimum and step = diagonal * 2^-bits (bits = 14 gives the ≤ 2^-14 of the
   // diagonal that DESIGN.md requires of the finest level; the error per axis is at most step / 2).
   static PositionGrid for_bounds(const Bounds& bounds, int bits = 14);
+
+  // The grid for_bounds(mesh.bounds(), b) with the fewest bits b in [min_bits, max_bits] on which the mesh's
+  // distinct positions stay distinct (no two of them round to one grid point), or max_bits when none is.
+  // Why: a vertex that the grid merges with another makes the finest level weld (by position) into
+  // degenerate, non-manifold slivers, and position is how shared vertices are identified across nodes
+  // (crack-free cuts); e.g. buildings.obj tessellates footprints with vertices 0.013 apart, under the 2^-14
+  // step (0.017) of its 279-unit diagonal, and gets 16 bits. Only the finest level pays for the extra bits:
+  // coarser nodes drop low bits in proportion to their error (the bake's position_shift). Cost: O(V) per bit
+  // count tried (a hash set of grid points).
+  static PositionGrid separating(const Mesh& mesh, int min_bits = 14, int max_bits = 20);
+  // log2(diagonal / step), rounded: the bits a grid spends per diagonal (what for_bounds was given).
+  int bits(const Bounds& bounds) const;
 };
 
 // One node's geometry as the caller hands it to a codec.
