@@ -11,8 +11,11 @@
 // together.
 //
 // Precision (how the codec's position_shift is spent): level-0 clusters are stored on the finest grid of their
-// mesh: 2^-b of its diagonal with b the fewest bits in [14, 20] that keep its distinct positions distinct
-// (PositionGrid::separating). A coarser cluster made by a group of error e drops k low bits of its
+// mesh: 2^-b of its diagonal with b the fewest bits in [14, --max-grid-bits = 20] that keep its distinct
+// positions distinct (PositionGrid::separating), and the mesh is snapped to that grid before its DAG is built
+// (what still collides is welded). Measured on buildings.obj (near-duplicate vertices 1e-5 apart, which no
+// grid separates): 20 bits verifies (200 random cuts) at 9.26 bytes per input triangle; 14 and 16 bits with
+// the snap weld its near-duplicates into non-manifold ground footprints whose cuts fail the boundary test. A coarser cluster made by a group of error e drops k low bits of its
 // free vertices, k = floor(log2(e / (4 * step))) clamped to [0, 16], so that the rounding adds at most
 // q(e) = sqrt(3)/2 * 2^k * step <= e / 4 * sqrt(3)/2; the stored error and sphere radius are raised by q(e).
 // q is a non-decreasing function of e, so stored errors stay monotonic and spheres containing. Vertices on
@@ -48,6 +51,7 @@ struct BakeArgs {
   std::string output;
   bool json = false, no_hlod = false;
   uint32_t normal_bits = 10;
+  int max_grid_bits = 20;
 };
 
 uint64_t peak_rss_bytes() {
@@ -148,6 +152,7 @@ int run_bake(const BakeArgs& args) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
   if (args.normal_bits < 4 || args.normal_bits > 16) throw Error("--normal-bits: must be in 4..16");
+  if (args.max_grid_bits < 14 || args.max_grid_bits > 20) throw Error("--max-grid-bits: must be in 14..20");
   Scene scene = import_all(args.models);
   const uint64_t input_triangles = scene.triangle_count();
   const size_t unique_triangles = scene.unique_triangle_count();
@@ -170,7 +175,8 @@ int run_bake(const BakeArgs& args) {
   };
   tbb::parallel_for(size_t(0), scene.meshes.size(), [&](size_t m) {
     bounds[m] = scene.meshes[m].bounds();
-    grids[m] = PositionGrid::separating(scene.meshes[m]);
+    grids[m] = PositionGrid::separating(scene.meshes[m], 14, args.max_grid_bits);
+    grids[m].snap(scene.meshes[m]);
     hierarchy::DagOptions options;
     const size_t triangles = scene.meshes[m].triangle_count();
     size_t reported = 0;
@@ -445,6 +451,9 @@ const bool registered = register_command(
            ->required();
        sub.add_option("-o,--output", args->output, "the package to write (.lods)")->required();
        sub.add_option("--normal-bits", args->normal_bits, "octahedral normal bits per component (4..16)");
+       sub.add_option("--max-grid-bits", args->max_grid_bits,
+                      "finest grid: at most 2^-N of a mesh's diagonal (14..20, default 20), fewer when its "
+                      "vertices stay apart with fewer");
        sub.add_flag("--no-hlod", args->no_hlod, "no HLOD over the objects (for comparisons)");
        sub.add_flag("--json", args->json,
                     "print one JSON object: input_triangles, objects, nodes, pages, levels, bytes, time_s, "

@@ -50,6 +50,23 @@ PositionGrid PositionGrid::separating(const Mesh& mesh, int min_bits, int max_bi
   return for_bounds(bounds, max_bits);
 }
 
+void PositionGrid::snap(Mesh& mesh) const {
+  for (glm::vec3& p : mesh.positions)
+    for (int a = 0; a < 3; ++a) {
+      // The codec's formulas: q = round((p - origin) / step), decoded as origin + q * step (float).
+      const double q = std::round((double(p[a]) - double(origin[a])) / double(step));
+      p[a] = origin[a] + float(q) * step;
+    }
+  size_t kept = 0;
+  for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const uint32_t a = mesh.indices[t], b = mesh.indices[t + 1], c = mesh.indices[t + 2];
+    const glm::vec3 &pa = mesh.positions[a], &pb = mesh.positions[b], &pc = mesh.positions[c];
+    if (pa == pb || pb == pc || pc == pa) continue;
+    mesh.indices[kept++] = a, mesh.indices[kept++] = b, mesh.indices[kept++] = c;
+  }
+  mesh.indices.resize(kept);
+}
+
 int PositionGrid::bits(const Bounds& bounds) const {
   const float diagonal = bounds.diagonal();
   return diagonal > 0.0f ? int(std::lround(std::log2(double(diagonal) / double(step)))) : 0;
