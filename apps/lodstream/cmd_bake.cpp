@@ -1,8 +1,8 @@
 // `lodstream bake MODEL... -o SCENE.lods [--json] [--no-hlod]`: every mesh of the imported models becomes a
 // cluster DAG (hierarchy/cluster_dag.hpp), written into one .lods package (package/writer.hpp). Objects keep
 // their transforms; objects that instance one mesh share its representation. A scene of two or more objects
-// also gets an HLOD (hierarchy/hlod.hpp) over its objects' roots: one more representation, of kind hlod, whose
-// nodes are world-space proxies listing the objects they stand for.
+// also gets an HLOD (hierarchy/hlod.hpp) over its objects' roots: one more representation, of kind hlod,
+// whose nodes are world-space proxies listing the objects they stand for.
 //
 // Node order (ids) and page order: first the HLOD's top levels (its root, children and grandchildren) and the
 // roots of every representation (the root index, enough for a first frame), then the other HLOD nodes, each
@@ -10,18 +10,19 @@
 // simplification as one page group: refining a group needs exactly its input clusters, so they travel
 // together.
 //
-// Precision (how the codec's position_shift is spent): level-0 clusters are stored on the finest grid of their
-// mesh: 2^-b of its diagonal with b the fewest bits in [14, --max-grid-bits = 20] that keep its distinct
-// positions distinct (PositionGrid::separating), and the mesh is snapped to that grid before its DAG is built
-// (what still collides is welded). Measured on buildings.obj (near-duplicate vertices 1e-5 apart, which no
-// grid separates): 20 bits verifies (200 random cuts) at 9.26 bytes per input triangle; 14 and 16 bits with
-// the snap weld its near-duplicates into non-manifold ground footprints whose cuts fail the boundary test. A coarser cluster made by a group of error e drops k low bits of its
-// free vertices, k = floor(log2(e / (4 * step))) clamped to [0, 16], so that the rounding adds at most
-// q(e) = sqrt(3)/2 * 2^k * step <= e / 4 * sqrt(3)/2; the stored error and sphere radius are raised by q(e).
-// q is a non-decreasing function of e, so stored errors stay monotonic and spheres containing. Vertices on
-// the border of the group that made or consumes a cluster are flagged locked and decode exactly, so cuts stay
-// crack-free (free vertices are shared only by clusters of one group, which use one shift). HLOD proxies are
-// stored on a 2^-14 grid of the scene's world bounds, shift 0; the rounding is part of their errors.
+// Precision (how the codec's position_shift is spent): level-0 clusters are stored on the finest grid of
+// their mesh: 2^-b of its diagonal with b the fewest bits in [14, --max-grid-bits = 20] that keep its
+// distinct positions distinct (PositionGrid::separating), and the mesh is snapped to that grid before its DAG
+// is built (what still collides is welded). Measured on buildings.obj (near-duplicate vertices 1e-5 apart,
+// which no grid separates): 20 bits verifies (200 random cuts) at 9.26 bytes per input triangle; 14 and 16
+// bits with the snap weld its near-duplicates into non-manifold ground footprints whose cuts fail the
+// boundary test. A coarser cluster made by a group of error e drops k low bits of its free vertices, k =
+// floor(log2(e / (4 * step))) clamped to [0, 16], so that the rounding adds at most q(e) = sqrt(3)/2 * 2^k *
+// step <= e / 4 * sqrt(3)/2; the stored error and sphere radius are raised by q(e). q is a non-decreasing
+// function of e, so stored errors stay monotonic and spheres containing. Vertices on the border of the group
+// that made or consumes a cluster are flagged locked and decode exactly, so cuts stay crack-free (free
+// vertices are shared only by clusters of one group, which use one shift). HLOD proxies are stored on a 2^-14
+// grid of the scene's world bounds, shift 0; the rounding is part of their errors.
 #include <tbb/parallel_for.h>
 
 #include <atomic>
@@ -89,9 +90,11 @@ Sphere float_sphere(const schedule::WorldSphere& w) {
 
 // The HLOD's input: each object's DAG roots (errors and spheres as stored) under its transform, its bounds'
 // sphere included (what culling tests). Objects of an empty mesh are left out; `ids` maps back.
-std::vector<hierarchy::HlodObject> hlod_inputs(const Scene& scene, const std::vector<hierarchy::ClusterDag>& dags,
+std::vector<hierarchy::HlodObject> hlod_inputs(const Scene& scene,
+                                               const std::vector<hierarchy::ClusterDag>& dags,
                                                const std::vector<Bounds>& bounds,
-                                               const std::vector<PositionGrid>& grids, std::vector<uint32_t>& ids) {
+                                               const std::vector<PositionGrid>& grids,
+                                               std::vector<uint32_t>& ids) {
   for (uint32_t o = 0; o < scene.objects.size(); ++o)
     if (!bounds[scene.objects[o].mesh].empty()) ids.push_back(o);
   std::vector<hierarchy::HlodObject> out(ids.size());
@@ -109,14 +112,16 @@ std::vector<hierarchy::HlodObject> hlod_inputs(const Scene& scene, const std::ve
                         corner & 4 ? b.max.z : b.min.z);
       h.bounds.add(glm::vec3(t * glm::vec4(p, 1.0f)));
     }
-    std::vector<Sphere> spheres{float_sphere(schedule::to_world({b.center(), 0.5f * b.diagonal()}, t, scale))};
+    std::vector<Sphere> spheres{
+        float_sphere(schedule::to_world({b.center(), 0.5f * b.diagonal()}, t, scale))};
     double error = 0.0;
     for (uint32_t r : dag.roots) {
       const hierarchy::DagCluster& c = dag.clusters[r];
       error = std::max(error, double(stored_error(c.error, grid)) * scale);
       spheres.push_back(float_sphere(schedule::to_world(stored_sphere(c.sphere, c.error, grid), t, scale)));
       const uint32_t base = uint32_t(h.coarse.positions.size());
-      for (const glm::vec3& p : c.mesh.positions) h.coarse.positions.push_back(glm::vec3(t * glm::vec4(p, 1.0f)));
+      for (const glm::vec3& p : c.mesh.positions)
+        h.coarse.positions.push_back(glm::vec3(t * glm::vec4(p, 1.0f)));
       for (const glm::vec3& n : c.mesh.normals) h.coarse.normals.push_back(glm::normalize(normal_matrix * n));
       for (uint32_t k : c.mesh.indices) h.coarse.indices.push_back(base + k);
       h.coarse.material = c.mesh.material;
@@ -404,11 +409,12 @@ int run_bake(const BakeArgs& args) {
                 {"bytes_per_input_triangle", per_triangle},
                 {"stored_triangles", stored_triangles},
                 {"grid_bits_max", grid_bits},
-                {"hlod", {{"nodes", hlod.nodes.size()},
-                          {"levels", hlod.levels},
-                          {"triangles", hlod_triangles},
-                          {"root_index_nodes", hlod_top},
-                          {"time_s", hlod_time}}},
+                {"hlod",
+                 {{"nodes", hlod.nodes.size()},
+                  {"levels", hlod.levels},
+                  {"triangles", hlod_triangles},
+                  {"root_index_nodes", hlod_top},
+                  {"time_s", hlod_time}}},
                 {"root_index_bytes", written.root_index_bytes},
                 {"index_bytes", written.index_bytes},
                 {"page_bytes", written.page_bytes},
@@ -438,8 +444,8 @@ int run_bake(const BakeArgs& args) {
     std::printf("  fallbacks: %zu partial, %zu positions-only, %zu abandoned groups, %zu stalled meshes\n",
                 partial, positions_only, abandoned, stalled);
     if (!hlod.nodes.empty())
-      std::printf("  hlod: %zu proxies (%zu triangles), %u levels, %.2f s\n", hlod.nodes.size(), hlod_triangles,
-                  hlod.levels, hlod_time);
+      std::printf("  hlod: %zu proxies (%zu triangles), %u levels, %.2f s\n", hlod.nodes.size(),
+                  hlod_triangles, hlod.levels, hlod_time);
   }
   return 0;
 }

@@ -3,10 +3,10 @@
 // holds: the content hash, monotonic errors (a node's parents' pair is its parents' own pair and at least its
 // own), containing spheres, every page and node decodes and matches its record, and crack-free cuts: for N
 // random eyes and thresholds per representation, the cut chosen by the cut rule, welded by decoded position,
-// has exactly the boundary edges of the full-resolution (level-0) surface; and for an HLOD (check_hlod): proxy
-// object sets nest (an inner proxy's objects are the disjoint union of its children's, the root's cover every
-// object it lists once per leaf) and a leaf proxy bounds its objects' roots (error at least theirs in world
-// units, sphere containing theirs and the object's bounds). Exits 1 naming the first violation.
+// has exactly the boundary edges of the full-resolution (level-0) surface; and for an HLOD (check_hlod):
+// proxy object sets nest (an inner proxy's objects are the disjoint union of its children's, the root's cover
+// every object it lists once per leaf) and a leaf proxy bounds its objects' roots (error at least theirs in
+// world units, sphere containing theirs and the object's bounds). Exits 1 naming the first violation.
 #include <tbb/parallel_for.h>
 
 #include <cmath>
@@ -72,7 +72,8 @@ std::string check_hlod(const PackageScene& scene, const std::vector<NodeRecord>&
       const NodeRecord& n = nodes[id];
       const std::string where = "HLOD node " + std::to_string(id) + ": ";
       if (seen[id]++) return where + "is reached twice (not a tree)";
-      if (n.kind != NodeKind::hlod_proxy || n.representation != r) return where + "is not a proxy of its HLOD";
+      if (n.kind != NodeKind::hlod_proxy || n.representation != r)
+        return where + "is not a proxy of its HLOD";
       if (n.objects.empty() || !std::is_sorted(n.objects.begin(), n.objects.end()) ||
           std::adjacent_find(n.objects.begin(), n.objects.end()) != n.objects.end())
         return where + "its objects are not a non-empty sorted set";
@@ -99,7 +100,8 @@ std::string check_hlod(const PackageScene& scene, const std::vector<NodeRecord>&
           const NodeRecord& rr = nodes[root];
           const schedule::WorldSphere ws = schedule::to_world(rr.sphere, object.transform, scale);
           if (double(n.error) < double(rr.error) * scale)
-            return where + "its error is below object " + std::to_string(o) + "'s root " + std::to_string(root);
+            return where + "its error is below object " + std::to_string(o) + "'s root " +
+                   std::to_string(root);
           if (!hierarchy::sphere_contains(n.sphere, Sphere{glm::vec3(ws.center), float(ws.radius)}))
             return where + "its sphere does not contain object " + std::to_string(o) + "'s root " +
                    std::to_string(root);

@@ -116,11 +116,12 @@ void make_proxy(Hlod& hlod, uint32_t id, std::span<const HlodObject> objects, co
   so.allow_topology_change = true;
   simplify::Result r = simplify::simplify_mesh(merged, so);
   node.mesh = std::move(r.mesh);
-  node.mesh.material = per_material.empty()
-                           ? 0
-                           : std::max_element(per_material.begin(), per_material.end(),
-                                              [](const auto& a, const auto& b) { return a.second < b.second; })
-                                 ->first;
+  node.mesh.material =
+      per_material.empty()
+          ? 0
+          : std::max_element(per_material.begin(), per_material.end(), [](const auto& a, const auto& b) {
+              return a.second < b.second;
+            })->first;
   node.simplification_bound = r.error_bound;
   const double tolerance = double(options.position_tolerance);
   node.error = round_up(replaced_error + r.error_bound + tolerance);

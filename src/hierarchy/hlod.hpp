@@ -1,13 +1,13 @@
 // HLOD (DESIGN.md, Data model; LOD book, glossary "hierarchical LOD"): a bounding-volume hierarchy over a
-// scene's objects whose nodes carry a merged, simplified proxy of the objects below, so that a distant part of
-// a scene with many objects is drawn as a few proxies instead of every object's coarsest nodes.
+// scene's objects whose nodes carry a merged, simplified proxy of the objects below, so that a distant part
+// of a scene with many objects is drawn as a few proxies instead of every object's coarsest nodes.
 //   BVH: top-down over the objects' world bounds; a node of more than `leaf_objects` objects is split into
 //   `branching` parts by repeatedly halving its largest part at the median of the object centres along the
 //   longest axis of their extent (a median split keeps the tree balanced: depth log_b(objects / leaf)).
 //   Proxies, bottom-up (nodes of one level in parallel): a leaf proxy merges its objects' coarsest
 //   representations (in world space, as the caller gives them), an inner proxy merges its children's proxies;
-//   the merge is simplified (quadric edge collapse with vertex clustering allowed, so separate parts may fuse;
-//   positions and normals) to min(max_proxy_triangles, ratio x its input).
+//   the merge is simplified (quadric edge collapse with vertex clustering allowed, so separate parts may
+//   fuse; positions and normals) to min(max_proxy_triangles, ratio x its input).
 // Errors are totals in world units with the cluster DAG's semantics: error(node) = max over what it replaces
 // (its children's proxies, or its objects' coarsest representations) of their error + the simplification's
 // two-sided bound + `position_tolerance` (what the package's quantization adds), rounded up to float; so
@@ -53,8 +53,8 @@ struct HlodNode {
   Sphere sphere;
   uint32_t level = 1;  // 1 = leaf (its children are objects), parents one more than their highest child
   uint32_t parent = kNoHlodNode;
-  std::vector<uint32_t> children;  // HLOD nodes; empty for a leaf
-  std::vector<uint32_t> objects;   // every object below, sorted (a leaf: the objects it replaces)
+  std::vector<uint32_t> children;     // HLOD nodes; empty for a leaf
+  std::vector<uint32_t> objects;      // every object below, sorted (a leaf: the objects it replaces)
   double simplification_bound = 0.0;  // this proxy's own simplification bound
 };
 

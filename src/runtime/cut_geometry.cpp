@@ -104,8 +104,7 @@ Scene CutGeometry::scene() const {
     auto [it, inserted] = mesh_of_node.emplace(item.node, uint32_t(scene.meshes.size()));
     if (inserted) scene.meshes.push_back(*item.mesh);
     const std::string owner = item.object == package::kNone ? "hlod" : "object" + std::to_string(item.object);
-    scene.objects.push_back({owner + "/node" + std::to_string(item.node),
-                             item.transform, it->second});
+    scene.objects.push_back({owner + "/node" + std::to_string(item.node), item.transform, it->second});
   }
   return scene;
 }

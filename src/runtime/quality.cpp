@@ -23,7 +23,8 @@ FrameQuality frame_quality(const package::PackageScene& scene, const NodeSource&
     const package::NodeRecord& r = *nodes.record(d.node);
     if (d.object == package::kNone) {  // an HLOD proxy: each object it stands for is drawn at its error
       for (uint32_t o : r.objects)
-        if (o < n && cut.objects[o] != ObjectState::culled) add(o, projected_area(object_sphere(scene, o), view), d);
+        if (o < n && cut.objects[o] != ObjectState::culled)
+          add(o, projected_area(object_sphere(scene, o), view), d);
       continue;
     }
     const package::ObjectRecord& o = scene.objects[d.object];

@@ -28,16 +28,15 @@
 // NodeSource, so the caller decides what is known (index pages) and available (cache).
 //
 // HLOD (hierarchy/hlod.hpp; a representation of kind hlod, drawn without an object: its nodes are world
-// space): the objects listed by its roots' records are covered; a covered object's own roots are not where its
-// traversal starts. Instead the HLOD's roots are drawn, and an exchange replaces a proxy P by its children
-// (G = the child proxies in the frustum) or, for a leaf proxy, by the roots of its objects in the frustum
-// (then traversed as above). The same rule and order apply (P's projected error > tau, largest first); a
-// leaf's exchange needs every root of its non-culled objects available. A proxy whose sphere is outside the
-// frustum is neither drawn nor refined (its objects, inside its sphere, are culled). Proxy errors bound their
-// objects' roots' errors and their spheres contain theirs, so the cut rule extends across HLOD -> objects.
-// Until every HLOD root is available, nothing of a covered object is drawn (like an object whose roots are
-// not all available).
-// Not handled yet: imposters, progressive-mesh prefixes.
+// space): the objects listed by its roots' records are covered; a covered object's own roots are not where
+// its traversal starts. Instead the HLOD's roots are drawn, and an exchange replaces a proxy P by its
+// children (G = the child proxies in the frustum) or, for a leaf proxy, by the roots of its objects in the
+// frustum (then traversed as above). The same rule and order apply (P's projected error > tau, largest
+// first); a leaf's exchange needs every root of its non-culled objects available. A proxy whose sphere is
+// outside the frustum is neither drawn nor refined (its objects, inside its sphere, are culled). Proxy errors
+// bound their objects' roots' errors and their spheres contain theirs, so the cut rule extends across HLOD ->
+// objects. Until every HLOD root is available, nothing of a covered object is drawn (like an object whose
+// roots are not all available). Not handled yet: imposters, progressive-mesh prefixes.
 #pragma once
 
 #include <cstdint>

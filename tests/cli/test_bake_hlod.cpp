@@ -24,8 +24,9 @@ std::string csv(const std::vector<double>& v) {
 // Nodes drawn at 1 px by `render --json` of `package` from `eye` towards `target`.
 size_t nodes_drawn(const std::filesystem::path& package, const std::vector<double>& eye,
                    const std::vector<double>& target, const std::filesystem::path& image) {
-  auto r = run_lodstream({"render", package.string(), "--eye", csv(eye), "--target", csv(target), "--up", "0,0,1",
-                          "--size", "320x240", "--pixel-error", "1", "-o", image.string(), "--json"});
+  auto r =
+      run_lodstream({"render", package.string(), "--eye", csv(eye), "--target", csv(target), "--up", "0,0,1",
+                     "--size", "320x240", "--pixel-error", "1", "-o", image.string(), "--json"});
   EXPECT_EQ(r.status, 0) << r.err;
   return r.status == 0 ? r.json()["nodes"].get<size_t>() : 0;
 }
@@ -33,8 +34,8 @@ size_t nodes_drawn(const std::filesystem::path& package, const std::vector<doubl
 TEST(CliBakeHlod, ALayoutOfManyObjectsVerifiesAndIsFewNodesFromAfar) {
   const auto dir = temp_dir();
   const auto layout = dir / "layout.obj";
-  auto gen = run_lodstream({"gen", "layout", data_file("elephant.off").string(), "--copies", "36", "-o",
-                            layout.string()});
+  auto gen = run_lodstream(
+      {"gen", "layout", data_file("elephant.off").string(), "--copies", "36", "-o", layout.string()});
   ASSERT_EQ(gen.status, 0) << gen.err;
   const auto with = dir / "with.lods", without = dir / "without.lods";
   auto bake = run_lodstream({"bake", layout.string(), "-o", with.string(), "--json"});
