@@ -143,7 +143,9 @@ class Traversal {
       const package::NodeRecord* r = nodes_.record(id);
       if (!r) {
         known = false;
-        if (ideal_) missing_.push_back({object, id, 0.0, c.error_px, false});
+        if (ideal_)
+          missing_.push_back(
+              {object, id, 0.0, c.error_px, false, object == package::kNone ? package::kNone : c.node});
       } else if (object != package::kNone || in_frustum(proxy_sphere(*r), view_)) {
         g.push_back({object, id, r});
       }
@@ -172,7 +174,8 @@ class Traversal {
     triangles_ -= p.triangles;
     for (const Member& m : g) {
       if (ideal_ && !nodes_.available(m.node))
-        missing_.push_back({m.object, m.node, project(m.object, *m.record), c.error_px, true});
+        missing_.push_back({m.object, m.node, project(m.object, *m.record), c.error_px, true,
+                            m.object == package::kNone ? package::kNone : c.node});
       draw(m.object, m.node);
     }
     return true;

@@ -80,6 +80,9 @@ struct MissingNode {
   double error_px = 0.0;
   double parent_error_px = 0.0;
   bool record_known = true;
+  // For the roots of an object covered by HLOD: the leaf proxy whose exchange they are (it must be drawn for
+  // them to be); package::kNone otherwise.
+  uint32_t proxy = package::kNone;
 };
 
 enum class ObjectState : uint8_t { drawn, culled, incomplete /* a root is not available */ };

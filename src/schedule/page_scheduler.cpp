@@ -125,6 +125,7 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
     e.object = m.object;
     if (root) {
       e.g = scene.representations[proxy ? r.representation : scene.objects[m.object].representation].roots;
+      if (m.proxy != package::kNone) e.p = {m.proxy};  // refines an HLOD leaf: eligible once it is held
     } else {
       e.p = r.parents;
       std::sort(e.p.begin(), e.p.end());
