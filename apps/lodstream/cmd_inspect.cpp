@@ -3,8 +3,11 @@
 // holds: the content hash, monotonic errors (a node's parents' pair is its parents' own pair and at least its
 // own), containing spheres, every page and node decodes and matches its record, and crack-free cuts: for N
 // random eyes and thresholds per representation, the cut chosen by the cut rule, welded by decoded position,
-// has exactly the boundary edges of the full-resolution (level-0) surface. Exits 1 naming the first
-// violation. Every embedded texture (blob) must decode as an image.
+// has exactly the boundary edges of the full-resolution (level-0) surface; and for an HLOD (check_hlod):
+// proxy object sets nest (an inner proxy's objects are the disjoint union of its children's, the root's cover
+// every object it lists once per leaf) and a leaf proxy bounds its objects' roots (error at least theirs in
+// world units, sphere containing theirs and the object's bounds). Every embedded texture (blob) must
+// decode as an image. Exits 1 naming the first violation.
 #include <tbb/parallel_for.h>
 
 #include <cmath>
@@ -19,6 +22,7 @@
 #include "hierarchy/bounding_sphere.hpp"
 #include "hierarchy/cut.hpp"
 #include "package/reader.hpp"
+#include "schedule/cut.hpp"
 
 namespace lodstream::cli {
 namespace {
@@ -56,6 +60,60 @@ std::string check_records(const std::vector<NodeRecord>& nodes) {
   return "";
 }
 
+// The first violation of the HLOD invariants (header), or "".
+std::string check_hlod(const PackageScene& scene, const std::vector<NodeRecord>& nodes) {
+  for (uint32_t r = 0; r < scene.representations.size(); ++r) {
+    const Representation& rep = scene.representations[r];
+    if (rep.kind != RepresentationKind::hlod) continue;
+    std::vector<uint32_t> leaf_of(scene.objects.size(), kNone);
+    std::vector<uint32_t> stack(rep.roots.begin(), rep.roots.end());
+    std::vector<uint8_t> seen(nodes.size(), 0);
+    while (!stack.empty()) {
+      const uint32_t id = stack.back();
+      stack.pop_back();
+      const NodeRecord& n = nodes[id];
+      const std::string where = "HLOD node " + std::to_string(id) + ": ";
+      if (seen[id]++) return where + "is reached twice (not a tree)";
+      if (n.kind != NodeKind::hlod_proxy || n.representation != r)
+        return where + "is not a proxy of its HLOD";
+      if (n.objects.empty() || !std::is_sorted(n.objects.begin(), n.objects.end()) ||
+          std::adjacent_find(n.objects.begin(), n.objects.end()) != n.objects.end())
+        return where + "its objects are not a non-empty sorted set";
+      if (!n.children.empty()) {
+        std::vector<uint32_t> below;
+        for (uint32_t c : n.children) {
+          below.insert(below.end(), nodes[c].objects.begin(), nodes[c].objects.end());
+          stack.push_back(c);
+        }
+        std::sort(below.begin(), below.end());
+        if (below != n.objects) return where + "its objects are not the disjoint union of its children's";
+        continue;
+      }
+      for (uint32_t o : n.objects) {
+        if (leaf_of[o] != kNone)
+          return where + "object " + std::to_string(o) + " is also under leaf " + std::to_string(leaf_of[o]);
+        leaf_of[o] = id;
+        const ObjectRecord& object = scene.objects[o];
+        const double scale = schedule::max_scale(object.transform);
+        const schedule::WorldSphere os = schedule::object_sphere(scene, o);
+        if (!hierarchy::sphere_contains(n.sphere, Sphere{glm::vec3(os.center), float(os.radius)}))
+          return where + "its sphere does not contain object " + std::to_string(o) + "'s bounds";
+        for (uint32_t root : scene.representations[object.representation].roots) {
+          const NodeRecord& rr = nodes[root];
+          const schedule::WorldSphere ws = schedule::to_world(rr.sphere, object.transform, scale);
+          if (double(n.error) < double(rr.error) * scale)
+            return where + "its error is below object " + std::to_string(o) + "'s root " +
+                   std::to_string(root);
+          if (!hierarchy::sphere_contains(n.sphere, Sphere{glm::vec3(ws.center), float(ws.radius)}))
+            return where + "its sphere does not contain object " + std::to_string(o) + "'s root " +
+                   std::to_string(root);
+        }
+      }
+    }
+  }
+  return "";
+}
+
 struct Summary {
   nlohmann::json json;
   std::string text;
@@ -89,6 +147,7 @@ int run_inspect(const InspectArgs& args) {
   if (args.verify) {
     reader.verify();  // header = trailer, content hash (throws on mismatch)
     violation = check_records(nodes);
+    if (violation.empty()) violation = check_hlod(root.scene, nodes);
     // Decode every page and node; weld each representation's nodes by decoded position.
     std::vector<hierarchy::SurfaceWelder> welders(root.scene.representations.size());
     std::vector<std::vector<uint32_t>> welded(nodes.size());

@@ -190,7 +190,8 @@ PackageFacts PackageFacts::of(package::PackageReader& reader) {
   }
   p.finest_nodes.resize(p.scene.representations.size());
   for (uint32_t id = 0; id < p.nodes.size(); ++id)
-    if (p.nodes[id].children.empty()) p.finest_nodes[p.nodes[id].representation].push_back(id);
+    if (p.nodes[id].children.empty() && p.nodes[id].kind != package::NodeKind::hlod_proxy)
+      p.finest_nodes[p.nodes[id].representation].push_back(id);
   for (const package::IndexPage& ip : root.index_pages) p.index_page_bytes.push_back(ip.range.size);
   for (const package::Range& r : root.pages) p.page_bytes.push_back(r.size);
   const uint64_t file = reader.source().size();

@@ -82,7 +82,7 @@ struct PackageFacts {
   std::vector<uint32_t> index_page_bytes;           // stored size of each index page
   std::vector<uint32_t> page_bytes;                 // stored size of each data page
   uint64_t root_fetch_bytes = 0;                    // the first suffix request's answer
-  std::vector<std::vector<uint32_t>> finest_nodes;  // per representation: its nodes with no children
+  std::vector<std::vector<uint32_t>> finest_nodes;  // per representation: its nodes with no children, no proxy
   std::shared_ptr<const package::PackageReader> reader;  // every index page loaded (the push server's)
 
   // Reads every index page of `reader` (one read each) and keeps a copy of it.

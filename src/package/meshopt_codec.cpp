@@ -120,14 +120,6 @@ class BitWriter {
 
 }  // namespace
 
-PositionGrid PositionGrid::for_bounds(const Bounds& bounds, int bits) {
-  PositionGrid g;
-  float diagonal = bounds.diagonal();
-  g.origin = bounds.empty() ? glm::vec3(0.0f) : bounds.min;
-  g.step = diagonal > 0.0f ? std::ldexp(diagonal, -bits) : 1.0f;
-  return g;
-}
-
 MeshoptCodec::MeshoptCodec() {
   meshopt_encodeIndexVersion(1);
 }

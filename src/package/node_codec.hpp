@@ -29,6 +29,23 @@ struct PositionGrid {
   // The grid with origin at the box minimum and step = diagonal * 2^-bits (bits = 14 gives the ≤ 2^-14 of the
   // diagonal that DESIGN.md requires of the finest level; the error per axis is at most step / 2).
   static PositionGrid for_bounds(const Bounds& bounds, int bits = 14);
+
+  // The grid for_bounds(mesh.bounds(), b) with the fewest bits b in [min_bits, max_bits] on which the mesh's
+  // distinct positions stay distinct (no two of them round to one grid point), or max_bits when none is.
+  // Used with snap(): e.g. buildings.obj tessellates footprints with vertices 0.013 apart, under the 2^-14
+  // step (0.017) of its 279-unit diagonal, and also holds near-duplicate vertices 1e-5 apart (float noise,
+  // which no grid separates): it gets max_bits, and the 92 near-duplicates that still collide there are
+  // welded by snap(). Only the finest level pays for the extra bits: coarser nodes drop low bits in
+  // proportion to their error (the bake's position_shift). Cost: O(V) per bit count tried.
+  static PositionGrid separating(const Mesh& mesh, int min_bits = 14, int max_bits = 20);
+  // Moves every position to the grid point the codec decodes it to and drops the triangles this makes
+  // degenerate (two corners on one grid point). A hierarchy built on the snapped mesh has a finest level
+  // that decodes to exactly the surface it was built from, so distinct vertices never merge at decoding into
+  // slivers that the hierarchy did not see (which made buildings.obj fail the crack test of inspect
+  // --verify). Moves positions by at most sqrt(3)/2 step. Cost: O(V + T).
+  void snap(Mesh& mesh) const;
+  // log2(diagonal / step), rounded: the bits a grid spends per diagonal (what for_bounds was given).
+  int bits(const Bounds& bounds) const;
 };
 
 // One node's geometry as the caller hands it to a codec.

@@ -104,6 +104,11 @@ PageUsefulness page_usefulness(const package::PackageScene& scene, const NodeSou
   for (uint32_t id : cached_nodes) {
     const package::NodeRecord& r = *nodes.record(id);
     double best = 0.0;
+    if (r.kind == package::NodeKind::hlod_proxy)  // world space: no object instances it
+      for (const View& v : views)
+        if (in_frustum(to_world(r.sphere, glm::mat4(1.0f), 1.0), v))
+          best = std::max(
+              best, screen_error(double(r.parent_error), to_world(r.parent_sphere, glm::mat4(1.0f), 1.0), v));
     for (const Instance& in : instances[r.representation]) {
       const glm::mat4& t = scene.objects[in.object].transform;
       for (size_t v = 0; v < views.size(); ++v)

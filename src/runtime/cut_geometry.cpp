@@ -124,7 +124,8 @@ size_t CutGeometry::update(const schedule::Cut& cut, const PageSource& pages) {
   const auto& objects = reader_->scene().objects;
   for (const schedule::DrawnNode& d : cut.drawn) {
     const Mesh& mesh = decoded_.at(d.node).mesh;
-    items_.push_back({d.object, d.node, objects[d.object].transform, &mesh});
+    const glm::mat4 transform = d.object == package::kNone ? glm::mat4(1.0f) : objects[d.object].transform;
+    items_.push_back({d.object, d.node, transform, &mesh});  // HLOD proxies are world space
     triangles_ += mesh.triangle_count();
   }
   evict();
@@ -156,8 +157,8 @@ Scene CutGeometry::scene() const {
   for (const CutItem& item : items_) {
     auto [it, inserted] = mesh_of_node.emplace(item.node, uint32_t(scene.meshes.size()));
     if (inserted) scene.meshes.push_back(*item.mesh);
-    scene.objects.push_back({"object" + std::to_string(item.object) + "/node" + std::to_string(item.node),
-                             item.transform, it->second});
+    const std::string owner = item.object == package::kNone ? "hlod" : "object" + std::to_string(item.object);
+    scene.objects.push_back({owner + "/node" + std::to_string(item.node), item.transform, it->second});
   }
   return scene;
 }

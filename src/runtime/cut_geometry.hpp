@@ -61,7 +61,8 @@ class ReaderNodes final : public schedule::NodeSource {
   package::PackageReader* reader_;
 };
 
-// One drawn (object, node): the node's decoded mesh (object space) under the object's transform.
+// One drawn (object, node): the node's decoded mesh (object space) under the object's transform; an HLOD
+// proxy (object package::kNone) is world space (identity transform).
 struct CutItem {
   uint32_t object = 0, node = 0;
   glm::mat4 transform{1.0f};   // object to world

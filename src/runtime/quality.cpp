@@ -11,16 +11,24 @@ FrameQuality frame_quality(const package::PackageScene& scene, const NodeSource&
   std::vector<double> weight(n, 0.0), accuracy(n, 0.0), error(n, 0.0);
   std::vector<size_t> count(n, 0);
   std::vector<double> plain(n, 0.0);  // unweighted sum, for an object whose nodes all have zero area
-  for (const DrawnNode& d : cut.drawn) {
-    const package::ObjectRecord& o = scene.objects[d.object];
-    const package::NodeRecord& r = *nodes.record(d.node);
-    const double a = projected_area(to_world(r.sphere, o.transform, max_scale(o.transform)), view);
+  auto add = [&](uint32_t object, double a, const DrawnNode& d) {
     const double alpha = d.error_px > 0.0 ? std::min(1.0, tau / d.error_px) : 1.0;
-    weight[d.object] += a;
-    accuracy[d.object] += a * alpha;
-    plain[d.object] += alpha;
-    ++count[d.object];
-    error[d.object] = std::max(error[d.object], d.error_px);
+    weight[object] += a;
+    accuracy[object] += a * alpha;
+    plain[object] += alpha;
+    ++count[object];
+    error[object] = std::max(error[object], d.error_px);
+  };
+  for (const DrawnNode& d : cut.drawn) {
+    const package::NodeRecord& r = *nodes.record(d.node);
+    if (d.object == package::kNone) {  // an HLOD proxy: each object it stands for is drawn at its error
+      for (uint32_t o : r.objects)
+        if (o < n && cut.objects[o] != ObjectState::culled)
+          add(o, projected_area(object_sphere(scene, o), view), d);
+      continue;
+    }
+    const package::ObjectRecord& o = scene.objects[d.object];
+    add(d.object, projected_area(to_world(r.sphere, o.transform, max_scale(o.transform)), view), d);
   }
   FrameQuality q;
   double covered = 0.0, benefit = 0.0;

@@ -6,7 +6,8 @@
 //     (pixels, clipped to the viewport) of object i's bounding sphere's projection, alpha_i = the
 //     area-weighted mean over its drawn nodes of min(1, tau / e_px(node)) (weights: each node's sphere's
 //     clipped screen area), 0 when nothing of it is drawn. It is 1 exactly when everything visible is drawn
-//     at tau or better.
+//     at tau or better. An object covered by a drawn HLOD proxy (cut.hpp) is drawn at the proxy's error:
+//     its alpha_i is min(1, tau / e_px(proxy)) and its pixel error the proxy's.
 // Pure computation; cost O(drawn nodes) plus a 256-strip integration per sphere.
 #pragma once
 

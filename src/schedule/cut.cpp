@@ -36,26 +36,61 @@ std::vector<uint32_t> sorted(std::vector<uint32_t> ids) {
   return ids;
 }
 
+// The scene's HLOD (cut.hpp): its roots (those whose records are known) and the objects they cover.
+struct HlodCover {
+  std::vector<uint32_t> roots;
+  std::vector<uint8_t> covered;  // per object
+};
+
+HlodCover hlod_cover(const package::PackageScene& scene, const NodeSource& nodes) {
+  HlodCover h;
+  h.covered.assign(scene.objects.size(), 0);
+  for (const package::Representation& rep : scene.representations) {
+    if (rep.kind != package::RepresentationKind::hlod) continue;
+    for (uint32_t root : rep.roots) {
+      const package::NodeRecord* r = nodes.record(root);
+      if (!r) continue;
+      h.roots.push_back(root);
+      for (uint32_t o : r->objects)
+        if (o < h.covered.size()) h.covered[o] = 1;
+    }
+  }
+  return h;
+}
+
+WorldSphere proxy_sphere(const package::NodeRecord& r) {
+  return {glm::dvec3(r.sphere.center), double(r.sphere.radius)};
+}
+
 class Traversal {
  public:
   Traversal(const package::PackageScene& scene, const NodeSource& nodes, const View& view,
             const CutOptions& options, bool ideal)
       : scene_(scene), nodes_(nodes), view_(view), options_(options), ideal_(ideal) {}
 
-  // Runs the greedy refinement over the objects in state `drawn`.
-  void run(const std::vector<ObjectState>& states, const std::vector<ObjectView>& objects) {
+  // Runs the greedy refinement over the objects in state `drawn`: those not covered by `hlod` from their
+  // roots, the covered ones from the HLOD's roots in the frustum.
+  void run(const std::vector<ObjectState>& states, const std::vector<ObjectView>& objects,
+           const HlodCover& hlod) {
     objects_ = &objects;
+    states_ = &states;
     tau_ = options_.tau;
     for (uint32_t o = 0; o < states.size(); ++o) {
-      if (states[o] != ObjectState::drawn) continue;
+      if (states[o] != ObjectState::drawn || hlod.covered[o]) continue;
       for (uint32_t root : scene_.representations[scene_.objects[o].representation].roots) draw(o, root);
     }
+    for (uint32_t root : hlod.roots)
+      if (in_frustum(proxy_sphere(*nodes_.record(root)), view_)) draw(package::kNone, root);
     while (!heap_.empty()) {
       const Candidate c = heap_.top();
       heap_.pop();
       if (!(c.error_px > options_.tau)) break;
       if (!drawn_.count(key(c.object, c.node))) continue;  // refined already through another P member
       const package::NodeRecord& p = *nodes_.record(c.node);
+      if (c.object == package::kNone) {
+        if (!refine_proxy(c, p)) break;
+        continue;
+      }
       // G and P of the exchange, checked to be one.
       std::vector<const package::NodeRecord*> g(p.children.size());
       bool known = true;
@@ -95,15 +130,68 @@ class Traversal {
     }
   }
 
+  // The exchange below drawn proxy `p` (cut.hpp, HLOD): its child proxies in the frustum, or for a leaf the
+  // roots of its objects in the frustum. Returns false when the budget stops the refinement.
+  bool refine_proxy(const Candidate& c, const package::NodeRecord& p) {
+    struct Member {
+      uint32_t object, node;
+      const package::NodeRecord* record;
+    };
+    std::vector<Member> g;
+    bool known = true;
+    auto add = [&](uint32_t object, uint32_t id) {
+      const package::NodeRecord* r = nodes_.record(id);
+      if (!r) {
+        known = false;
+        if (ideal_)
+          missing_.push_back(
+              {object, id, 0.0, c.error_px, false, object == package::kNone ? package::kNone : c.node});
+      } else if (object != package::kNone || in_frustum(proxy_sphere(*r), view_)) {
+        g.push_back({object, id, r});
+      }
+    };
+    if (!p.children.empty()) {
+      for (uint32_t child : p.children) add(package::kNone, child);
+    } else {
+      for (uint32_t o : p.objects)
+        if (o < states_->size() && (*states_)[o] != ObjectState::culled)
+          for (uint32_t root : scene_.representations[scene_.objects[o].representation].roots) add(o, root);
+    }
+    if (!known) return true;
+    uint64_t added = 0;
+    bool available = true;
+    for (const Member& m : g) {
+      added += m.record->triangles;
+      available = available && nodes_.available(m.node);
+    }
+    if (!available && !ideal_) return true;  // the proxy stays drawn
+    if (triangles_ - p.triangles + added > options_.triangle_budget) {
+      budget_limited_ = true;
+      tau_ = c.error_px;
+      return false;
+    }
+    drawn_.erase(key(c.object, c.node));
+    triangles_ -= p.triangles;
+    for (const Member& m : g) {
+      if (ideal_ && !nodes_.available(m.node))
+        missing_.push_back({m.object, m.node, project(m.object, *m.record), c.error_px, true,
+                            m.object == package::kNone ? package::kNone : c.node});
+      draw(m.object, m.node);
+    }
+    return true;
+  }
+
   // Marks node `id` of `object` drawn (its record must be known) and queues the exchange below it.
   void draw(uint32_t object, uint32_t id) {
     const package::NodeRecord& r = *nodes_.record(id);
     drawn_.insert(key(object, id));
     triangles_ += r.triangles;
-    if (!r.children.empty()) heap_.push({project(object, r), object, id});
+    if (!r.children.empty() || r.kind == package::NodeKind::hlod_proxy)
+      heap_.push({project(object, r), object, id});
   }
 
   double project(uint32_t object, const package::NodeRecord& r) const {
+    if (object == package::kNone) return screen_error(double(r.error), proxy_sphere(r), view_);
     const ObjectView& o = (*objects_)[object];
     return screen_error(double(r.error) * o.scale, to_world(r.sphere, o.transform, o.scale), view_);
   }
@@ -130,6 +218,7 @@ class Traversal {
   const CutOptions& options_;
   const bool ideal_;
   const std::vector<ObjectView>* objects_ = nullptr;
+  const std::vector<ObjectState>* states_ = nullptr;
   std::priority_queue<Candidate> heap_;
   std::unordered_set<uint64_t> drawn_;
   uint64_t triangles_ = 0;
@@ -153,12 +242,26 @@ Cut select_cut(const package::PackageScene& scene, const NodeSource& nodes, cons
   cut.objects.assign(scene.objects.size(), ObjectState::drawn);
   std::vector<ObjectState> ideal_states = cut.objects;
   std::vector<MissingNode> missing_roots;
+  const HlodCover hlod = hlod_cover(scene, nodes);
+  bool hlod_available = true;
+  for (uint32_t root : hlod.roots) {
+    if (nodes.available(root)) continue;
+    hlod_available = false;
+    const package::NodeRecord& r = *nodes.record(root);
+    if (in_frustum(proxy_sphere(r), view))
+      missing_roots.push_back(
+          {package::kNone, root, screen_error(double(r.error), proxy_sphere(r), view), INFINITY, true});
+  }
   for (uint32_t o = 0; o < scene.objects.size(); ++o) {
     const package::ObjectRecord& object = scene.objects[o];
     const package::Representation& rep = scene.representations[object.representation];
     objects[o] = {object.transform, max_scale(object.transform)};
     if (rep.bounds.empty() || !in_frustum(object_sphere(scene, o), view)) {
       cut.objects[o] = ideal_states[o] = ObjectState::culled;
+      continue;
+    }
+    if (hlod.covered[o]) {  // its roots are reached through the HLOD's leaves
+      if (!hlod_available) cut.objects[o] = ObjectState::incomplete;
       continue;
     }
     for (uint32_t root : rep.roots) {
@@ -176,9 +279,9 @@ Cut select_cut(const package::PackageScene& scene, const NodeSource& nodes, cons
   }
 
   Traversal available(scene, nodes, view, options, false);
-  available.run(cut.objects, objects);
+  available.run(cut.objects, objects, hlod_available ? hlod : HlodCover{{}, hlod.covered});
   Traversal ideal(scene, nodes, view, options, true);
-  ideal.run(ideal_states, objects);
+  ideal.run(ideal_states, objects, hlod);
 
   for (uint64_t k : available.drawn_) {
     const uint32_t o = uint32_t(k >> 32), id = uint32_t(k);

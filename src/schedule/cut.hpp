@@ -26,7 +26,17 @@
 // Cost: O(n log n) in the nodes visited (drawn nodes plus the P nodes they replaced), twice (the available
 // cut and the ideal cut that `missing` comes from). Pure computation; node records are looked up through
 // NodeSource, so the caller decides what is known (index pages) and available (cache).
-// Not handled yet: HLOD proxies standing for several objects, imposters, progressive-mesh prefixes.
+//
+// HLOD (hierarchy/hlod.hpp; a representation of kind hlod, drawn without an object: its nodes are world
+// space): the objects listed by its roots' records are covered; a covered object's own roots are not where
+// its traversal starts. Instead the HLOD's roots are drawn, and an exchange replaces a proxy P by its
+// children (G = the child proxies in the frustum) or, for a leaf proxy, by the roots of its objects in the
+// frustum (then traversed as above). The same rule and order apply (P's projected error > tau, largest
+// first); a leaf's exchange needs every root of its non-culled objects available. A proxy whose sphere is
+// outside the frustum is neither drawn nor refined (its objects, inside its sphere, are culled). Proxy errors
+// bound their objects' roots' errors and their spheres contain theirs, so the cut rule extends across HLOD ->
+// objects. Until every HLOD root is available, nothing of a covered object is drawn (like an object whose
+// roots are not all available). Not handled yet: imposters, progressive-mesh prefixes.
 #pragma once
 
 #include <cstdint>
@@ -53,6 +63,7 @@ struct CutOptions {
   uint64_t triangle_budget = std::numeric_limits<uint64_t>::max();
 };
 
+// `object` is package::kNone for an HLOD proxy (world space; its record's `objects` are what it stands for).
 struct DrawnNode {
   uint32_t object = 0, node = 0;
   double error_px = 0.0;  // its own error, projected
@@ -61,13 +72,17 @@ struct DrawnNode {
 
 // A node the ideal cut (every node available, same tau and budget) needs that is not available: what to
 // fetch. `parent_error_px` is the projected error its group's arrival removes (its parents' error; +inf for a
-// root): the natural priority for a scheduler. For a node whose record is unknown, `record_known` is false
+// root; for the roots of an object covered by HLOD, its leaf proxy's): the natural priority for a scheduler.
+// `object` is package::kNone for an HLOD proxy. For a node whose record is unknown, `record_known` is false
 // and `error_px` is 0 (fetch its index page first); the ideal cut's traversal stops there.
 struct MissingNode {
   uint32_t object = 0, node = 0;
   double error_px = 0.0;
   double parent_error_px = 0.0;
   bool record_known = true;
+  // For the roots of an object covered by HLOD: the leaf proxy whose exchange they are (it must be drawn for
+  // them to be); package::kNone otherwise.
+  uint32_t proxy = package::kNone;
 };
 
 enum class ObjectState : uint8_t { drawn, culled, incomplete /* a root is not available */ };

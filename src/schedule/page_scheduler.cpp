@@ -100,6 +100,7 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
   // W_i: the screen area of the nodes drawn now for object i (the weights of alpha_i's mean).
   std::vector<double> drawn_area(scene.objects.size(), 0.0);
   for (const DrawnNode& d : cut.drawn) {
+    if (d.object == package::kNone) continue;  // an HLOD proxy: its exchanges weigh its own sphere
     const package::ObjectRecord& o = scene.objects[d.object];
     drawn_area[d.object] +=
         projected_area(to_world(records.record(d.node)->sphere, o.transform, max_scale(o.transform)), v.view);
@@ -112,8 +113,9 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
       continue;
     }
     const package::NodeRecord& r = *records.record(m.node);
-    const package::ObjectRecord& object = scene.objects[m.object];
-    const double scale = max_scale(object.transform);
+    const bool proxy = m.object == package::kNone;  // HLOD nodes: world space, their own sphere's area
+    const glm::mat4 transform = proxy ? glm::mat4(1.0f) : scene.objects[m.object].transform;
+    const double scale = max_scale(transform);
     const bool root = r.parents.empty();
     const uint64_t key = uint64_t(m.object) << 32 |
                          (root ? package::kNone : *std::min_element(r.parents.begin(), r.parents.end()));
@@ -122,7 +124,8 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
     Exchange e;
     e.object = m.object;
     if (root) {
-      e.g = scene.representations[object.representation].roots;
+      e.g = scene.representations[proxy ? r.representation : scene.objects[m.object].representation].roots;
+      if (m.proxy != package::kNone) e.p = {m.proxy};  // refines an HLOD leaf: eligible once it is held
     } else {
       e.p = r.parents;
       std::sort(e.p.begin(), e.p.end());
@@ -132,15 +135,20 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
       continue;  // its unknown records are in `unknown`
     // The object's share that changes: all of A_i for its roots; for P, its nodes' weight in alpha_i's mean
     // (|P| spheres of area a(P) out of W_i), at most all of it.
-    const double object_area = projected_area(object_sphere(scene, m.object), v.view);
-    double area = object_area;
-    if (!root) {
+    // A proxy's share is its parent's (or, for a root, its own) sphere's area.
+    double area = projected_area(
+        proxy ? to_world(root ? r.sphere : r.parent_sphere, transform, 1.0) : object_sphere(scene, m.object),
+        v.view);
+    if (!root && !proxy) {
       const double a_p =
-          double(e.p.size()) * projected_area(to_world(r.parent_sphere, object.transform, scale), v.view);
-      area = drawn_area[m.object] > 0.0 ? object_area * std::min(1.0, a_p / drawn_area[m.object]) : a_p;
+          double(e.p.size()) * projected_area(to_world(r.parent_sphere, transform, scale), v.view);
+      area = drawn_area[m.object] > 0.0 ? area * std::min(1.0, a_p / drawn_area[m.object]) : a_p;
     }
-    const double gain =
-        root ? kRootGain : std::log(std::max(m.parent_error_px, tau) / std::max(m.error_px, tau));
+    // Roots count kRootGain where nothing is drawn; an object's roots that refine an HLOD leaf proxy (a
+    // finite parent_error_px: the proxy's) gain the log of the error they remove, like any exchange.
+    const double gain = root && std::isinf(m.parent_error_px)
+                            ? kRootGain
+                            : std::log(std::max(m.parent_error_px, tau) / std::max(m.error_px, tau));
     auto [it, inserted] = exchanges.try_emplace(key, std::move(e));
     it->second.benefit += v.weight * area * gain / total;
     it->second.secondary = std::max(it->second.secondary, v.weight * std::min(m.parent_error_px, 1e300));

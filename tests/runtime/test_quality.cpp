@@ -114,3 +114,37 @@ TEST(Quality, AreaWeightedOverTheDrawnNodesOfASelectedCut) {
   EXPECT_LT(q.benefit_ratio, 1.0);
   EXPECT_DOUBLE_EQ(q.pixel_error_max, std::max(coarse.drawn[0].error_px, coarse.drawn[1].error_px));
 }
+
+TEST(Quality, ObjectsCoveredByADrawnProxyTakeItsError) {
+  // Objects 0 and 1 under one HLOD proxy (node 2) drawn at 4 tau; object 2 drawn on its own at tau / 2;
+  // object 3 under the proxy but culled: it does not count.
+  package::NodeRecord own, proxy;
+  own.sphere = {{0, 0, 0}, 1.0f};
+  proxy.kind = package::NodeKind::hlod_proxy;
+  proxy.objects = {0, 1, 3};
+  proxy.sphere = {{0, 0, -15}, 10.0f};
+  struct Nodes : NodeSource {
+    std::vector<package::NodeRecord> r;
+    const package::NodeRecord* record(uint32_t id) const override { return &r.at(id); }
+    bool available(uint32_t) const override { return true; }
+  } nodes;
+  nodes.r = {own, own, proxy};
+  package::PackageScene scene;
+  package::Representation rep;
+  rep.bounds.add(glm::vec3(-1.0f / std::sqrt(3.0f)));
+  rep.bounds.add(glm::vec3(1.0f / std::sqrt(3.0f)));
+  scene.representations = {rep};
+  for (float z : {-10.0f, -20.0f, -12.0f, 30.0f})
+    scene.objects.push_back({"o", glm::translate(glm::mat4(1.0f), glm::vec3(2, 0, z)), 0});
+  View v = test_view();
+  std::vector<double> a;
+  for (uint32_t o = 0; o < 3; ++o) a.push_back(projected_area(object_sphere(scene, o), v));
+  Cut cut;
+  cut.objects = {ObjectState::drawn, ObjectState::drawn, ObjectState::drawn, ObjectState::culled};
+  cut.drawn = {{2, 0, 0.5, 10}, {package::kNone, 2, 4.0, 100}};
+  const FrameQuality q = frame_quality(scene, nodes, cut, v, 1.0);
+  EXPECT_EQ(q.visible_objects, 3u);
+  EXPECT_NEAR(q.benefit_ratio, (0.25 * a[0] + 0.25 * a[1] + a[2]) / (a[0] + a[1] + a[2]), 1e-12);
+  EXPECT_DOUBLE_EQ(q.pixel_error_max, 4.0);
+  EXPECT_DOUBLE_EQ(q.pixel_error_mean, (4.0 + 4.0 + 0.5) / 3.0);
+}

@@ -1,0 +1,157 @@
+#include "hierarchy/hlod.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+
+#include "hierarchy/bounding_sphere.hpp"
+#include "simplify/simplify.hpp"
+
+namespace lodstream::hierarchy {
+namespace {
+
+// The BVH's shape before proxies: nodes with their objects, children and parent.
+struct Builder {
+  std::span<const HlodObject> objects;
+  const HlodOptions& options;
+  Hlod hlod;
+
+  glm::vec3 centre(uint32_t o) const { return objects[o].bounds.center(); }
+
+  // Splits `ids` in two at the median centre along the longest axis of the centres' extent.
+  std::pair<std::vector<uint32_t>, std::vector<uint32_t>> halve(std::vector<uint32_t> ids) const {
+    Bounds extent;
+    for (uint32_t o : ids) extent.add(centre(o));
+    const glm::vec3 size = extent.max - extent.min;
+    const int axis = size.x >= size.y && size.x >= size.z ? 0 : (size.y >= size.z ? 1 : 2);
+    const auto middle = ids.begin() + ptrdiff_t(ids.size() / 2);
+    std::nth_element(ids.begin(), middle, ids.end(), [&](uint32_t a, uint32_t b) {
+      return std::make_pair(centre(a)[axis], a) < std::make_pair(centre(b)[axis], b);
+    });
+    return {std::vector<uint32_t>(ids.begin(), middle), std::vector<uint32_t>(middle, ids.end())};
+  }
+
+  // Breadth-first: parents get lower ids than their children.
+  void build(std::vector<uint32_t> all) {
+    std::vector<std::vector<uint32_t>> parts{std::move(all)};
+    std::vector<uint32_t> parent_of{kNoHlodNode};
+    for (size_t i = 0; i < parts.size(); ++i) {
+      HlodNode node;
+      node.parent = parent_of[i];
+      node.objects = parts[i];
+      std::sort(node.objects.begin(), node.objects.end());
+      const uint32_t id = uint32_t(hlod.nodes.size());
+      if (node.parent != kNoHlodNode) hlod.nodes[node.parent].children.push_back(id);
+      if (parts[i].size() > options.leaf_objects) {
+        std::vector<std::vector<uint32_t>> split{parts[i]};
+        while (split.size() < std::max<size_t>(2, options.branching)) {
+          auto largest = std::max_element(split.begin(), split.end(),
+                                          [](const auto& a, const auto& b) { return a.size() < b.size(); });
+          if (largest->size() <= 1) break;
+          auto [a, b] = halve(std::move(*largest));
+          *largest = std::move(a);
+          split.push_back(std::move(b));
+        }
+        for (auto& part : split) {
+          parts.push_back(std::move(part));
+          parent_of.push_back(id);
+        }
+      }
+      hlod.nodes.push_back(std::move(node));
+    }
+    hlod.root = 0;
+  }
+};
+
+// World-space mesh with positions and normals only, appended to `merged`; counts triangles per material.
+void append(Mesh& merged, const Mesh& part, std::map<uint32_t, size_t>& per_material) {
+  Mesh m;
+  m.positions = part.positions;
+  m.indices = part.indices;
+  if (part.has_normals())
+    m.normals = part.normals;
+  else
+    compute_smooth_normals(m);
+  const uint32_t base = uint32_t(merged.positions.size());
+  merged.positions.insert(merged.positions.end(), m.positions.begin(), m.positions.end());
+  merged.normals.insert(merged.normals.end(), m.normals.begin(), m.normals.end());
+  for (uint32_t i : m.indices) merged.indices.push_back(base + i);
+  per_material[part.material] += part.triangle_count();
+}
+
+float round_up(double value) {
+  const float f = float(value);
+  return double(f) >= value ? f : std::nextafter(f, INFINITY);
+}
+
+// Makes node `id`'s proxy from its children's proxies (or its objects' coarse meshes).
+void make_proxy(Hlod& hlod, uint32_t id, std::span<const HlodObject> objects, const HlodOptions& options) {
+  HlodNode& node = hlod.nodes[id];
+  Mesh merged;
+  std::map<uint32_t, size_t> per_material;
+  std::vector<Sphere> spheres;
+  double replaced_error = 0.0;
+  if (node.children.empty()) {
+    for (uint32_t o : node.objects) {
+      append(merged, objects[o].coarse, per_material);
+      spheres.push_back(objects[o].sphere);
+      replaced_error = std::max(replaced_error, double(objects[o].error));
+    }
+  } else {
+    for (uint32_t c : node.children) {
+      const HlodNode& child = hlod.nodes[c];
+      append(merged, child.mesh, per_material);
+      spheres.push_back(child.sphere);
+      replaced_error = std::max(replaced_error, double(child.error));
+      node.level = std::max(node.level, child.level + 1);
+    }
+  }
+  simplify::Options so;
+  so.target_triangles = std::min(options.max_proxy_triangles,
+                                 size_t(std::ceil(options.ratio * double(merged.triangle_count()))));
+  so.uv_weight = so.color_weight = 0.0f;
+  so.allow_topology_change = true;
+  simplify::Result r = simplify::simplify_mesh(merged, so);
+  node.mesh = std::move(r.mesh);
+  node.mesh.material =
+      per_material.empty()
+          ? 0
+          : std::max_element(per_material.begin(), per_material.end(), [](const auto& a, const auto& b) {
+              return a.second < b.second;
+            })->first;
+  node.simplification_bound = r.error_bound;
+  const double tolerance = double(options.position_tolerance);
+  node.error = round_up(replaced_error + r.error_bound + tolerance);
+  Sphere s = sphere_of_spheres(spheres, node.mesh.positions);
+  s.radius = round_up(double(s.radius) + tolerance);
+  node.sphere = s;
+}
+
+}  // namespace
+
+Hlod build_hlod(std::span<const HlodObject> objects, const HlodOptions& options) {
+  if (objects.size() <= 1) return {};
+  Builder b{objects, options, {}};
+  std::vector<uint32_t> all(objects.size());
+  std::iota(all.begin(), all.end(), 0u);
+  b.build(std::move(all));
+  Hlod hlod = std::move(b.hlod);
+  // Bottom-up by depth (children have higher ids, so deepest first): one depth at a time, in parallel.
+  std::vector<uint32_t> depth(hlod.nodes.size(), 0);
+  uint32_t max_depth = 0;
+  for (uint32_t id = 1; id < hlod.nodes.size(); ++id)
+    max_depth = std::max(max_depth, depth[id] = depth[hlod.nodes[id].parent] + 1);
+  for (uint32_t d = max_depth + 1; d-- > 0;) {
+    std::vector<uint32_t> at;
+    for (uint32_t id = 0; id < hlod.nodes.size(); ++id)
+      if (depth[id] == d) at.push_back(id);
+    tbb::parallel_for(size_t(0), at.size(), [&](size_t i) { make_proxy(hlod, at[i], objects, options); });
+  }
+  hlod.levels = hlod.nodes[hlod.root].level;
+  return hlod;
+}
+
+}  // namespace lodstream::hierarchy

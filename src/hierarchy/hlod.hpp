@@ -1,0 +1,73 @@
+// HLOD (DESIGN.md, Data model; LOD book, glossary "hierarchical LOD"): a bounding-volume hierarchy over a
+// scene's objects whose nodes carry a merged, simplified proxy of the objects below, so that a distant part
+// of a scene with many objects is drawn as a few proxies instead of every object's coarsest nodes.
+//   BVH: top-down over the objects' world bounds; a node of more than `leaf_objects` objects is split into
+//   `branching` parts by repeatedly halving its largest part at the median of the object centres along the
+//   longest axis of their extent (a median split keeps the tree balanced: depth log_b(objects / leaf)).
+//   Proxies, bottom-up (nodes of one level in parallel): a leaf proxy merges its objects' coarsest
+//   representations (in world space, as the caller gives them), an inner proxy merges its children's proxies;
+//   the merge is simplified (quadric edge collapse with vertex clustering allowed, so separate parts may
+//   fuse; positions and normals) to min(max_proxy_triangles, ratio x its input).
+// Errors are totals in world units with the cluster DAG's semantics: error(node) = max over what it replaces
+// (its children's proxies, or its objects' coarsest representations) of their error + the simplification's
+// two-sided bound + `position_tolerance` (what the package's quantization adds), rounded up to float; so
+// errors are monotonic up the tree and across HLOD -> object roots. sphere(node) contains the spheres of what
+// it replaces and its own proxy's vertices. The cut rule (draw a node when its own error projects to <= tau
+// and its parent's to > tau) then extends from the HLOD root down to each object's roots.
+// A scene of at most one object has no HLOD (an empty result): a proxy would only duplicate that object.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include "core/bounds.hpp"
+#include "core/mesh.hpp"
+
+namespace lodstream::hierarchy {
+
+inline constexpr uint32_t kNoHlodNode = UINT32_MAX;
+
+// One object as the HLOD sees it, in world space.
+struct HlodObject {
+  Bounds bounds;  // of the whole object (its centre orders the BVH split)
+  // Its coarsest representation (e.g. its cluster DAG's roots), transformed to world space; normals optional
+  // (computed from the triangles when absent).
+  Mesh coarse;
+  float error = 0.0f;  // of `coarse` against the object's full resolution, world units
+  Sphere sphere;       // contains `coarse` and everything the object's own cut may draw (its roots' spheres)
+};
+
+struct HlodOptions {
+  size_t leaf_objects = 4;            // objects per leaf, at most
+  size_t branching = 4;               // children per inner node, at most
+  size_t max_proxy_triangles = 2048;  // budget of one proxy
+  double ratio = 0.5;                 // a proxy keeps at most this fraction of its merged input
+  float position_tolerance = 0.0f;    // added to every error and radius (the package's rounding)
+};
+
+struct HlodNode {
+  Mesh mesh;  // the proxy: world space, positions and normals, one material (the input's most used)
+  float error = 0.0f;
+  Sphere sphere;
+  uint32_t level = 1;  // 1 = leaf (its children are objects), parents one more than their highest child
+  uint32_t parent = kNoHlodNode;
+  std::vector<uint32_t> children;     // HLOD nodes; empty for a leaf
+  std::vector<uint32_t> objects;      // every object below, sorted (a leaf: the objects it replaces)
+  double simplification_bound = 0.0;  // this proxy's own simplification bound
+};
+
+struct Hlod {
+  std::vector<HlodNode> nodes;  // nodes[root] first; parents before children (breadth-first)
+  uint32_t root = kNoHlodNode;  // kNoHlodNode when there is no HLOD
+  uint32_t levels = 0;
+};
+
+// Builds the HLOD of `objects` (object i = index i). Cost: one simplification per node of at most
+// branching x max_proxy_triangles triangles (leaves: their objects' coarse meshes), so about
+// O(objects / leaf_objects x proxy cost); memory: the proxies. Never throws on odd input (empty or
+// degenerate coarse meshes give empty proxies).
+Hlod build_hlod(std::span<const HlodObject> objects, const HlodOptions& options = {});
+
+}  // namespace lodstream::hierarchy

@@ -1,0 +1,115 @@
+// HLOD over many objects (hierarchy/hlod.hpp): errors monotonic up the tree and bounding the objects',
+// spheres containing the children's and the proxies' own vertices, object sets that nest and partition, a
+// bounded proxy size, and no HLOD for a single object.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numeric>
+
+#include "hierarchy/bounding_sphere.hpp"
+#include "hierarchy/hlod.hpp"
+#include "support/shapes.hpp"
+
+using namespace lodstream;
+using namespace lodstream::hierarchy;
+
+namespace {
+
+// A `side` x `side` grid of small spheres (as their own coarse meshes) 3 units apart, error growing with the
+// index so that the maximum is not always the first object's.
+std::vector<HlodObject> sphere_field(int side) {
+  std::vector<HlodObject> objects;
+  for (int i = 0; i < side; ++i)
+    for (int j = 0; j < side; ++j) {
+      HlodObject o;
+      o.coarse = test::sphere(1.0f, 8, 16);
+      const glm::vec3 at(3.0f * float(i), 0.0f, 3.0f * float(j));
+      for (glm::vec3& p : o.coarse.positions) p += at;
+      o.bounds = o.coarse.bounds();
+      o.error = 0.001f * float(objects.size() % 7);
+      o.sphere = sphere_of_points(o.coarse.positions);
+      objects.push_back(std::move(o));
+    }
+  return objects;
+}
+
+TEST(Hlod, OneObjectOrNoneHasNoHlod) {
+  EXPECT_EQ(build_hlod(sphere_field(1)).root, kNoHlodNode);
+  EXPECT_TRUE(build_hlod(std::vector<HlodObject>{}).nodes.empty());
+}
+
+TEST(Hlod, ErrorsMonotonicSpheresContainingObjectsPartitioned) {
+  const std::vector<HlodObject> objects = sphere_field(10);  // 100 objects
+  HlodOptions options;
+  options.position_tolerance = 1e-4f;
+  const Hlod hlod = build_hlod(objects, options);
+  ASSERT_NE(hlod.root, kNoHlodNode);
+  ASSERT_EQ(hlod.root, 0u);
+  EXPECT_EQ(hlod.nodes[hlod.root].parent, kNoHlodNode);
+  // 100 objects, leaves of <= 4, 4 children each: at least 3 levels.
+  EXPECT_GE(hlod.levels, 3u);
+  std::vector<int> leaf_count(objects.size(), 0);
+  for (uint32_t id = 0; id < hlod.nodes.size(); ++id) {
+    const HlodNode& n = hlod.nodes[id];
+    SCOPED_TRACE("node " + std::to_string(id));
+    EXPECT_GT(n.mesh.triangle_count(), 0u);
+    EXPECT_LE(n.mesh.triangle_count(), options.max_proxy_triangles);
+    EXPECT_EQ(n.mesh.normals.size(), n.mesh.positions.size());
+    for (const glm::vec3& p : n.mesh.positions)
+      EXPECT_LE(glm::length(p - n.sphere.center), n.sphere.radius * (1.0f + 1e-6f));
+    ASSERT_TRUE(std::is_sorted(n.objects.begin(), n.objects.end()));
+    if (n.children.empty()) {
+      EXPECT_EQ(n.level, 1u);
+      EXPECT_LE(n.objects.size(), options.leaf_objects);
+      for (uint32_t o : n.objects) {
+        ++leaf_count[o];
+        // The proxy replaces the object: at least its error plus its own bound, and a sphere around it.
+        EXPECT_GE(n.error, objects[o].error + options.position_tolerance);
+        EXPECT_TRUE(sphere_contains(n.sphere, objects[o].sphere)) << "object " << o;
+      }
+      continue;
+    }
+    EXPECT_LE(n.children.size(), options.branching);
+    std::vector<uint32_t> below;
+    for (uint32_t c : n.children) {
+      const HlodNode& child = hlod.nodes[c];
+      EXPECT_EQ(child.parent, id);
+      EXPECT_GT(c, id) << "breadth-first: parents first";
+      EXPECT_GE(n.error, child.error + options.position_tolerance) << "child " << c;
+      EXPECT_LT(child.level, n.level);
+      EXPECT_TRUE(sphere_contains(n.sphere, child.sphere)) << "child " << c;
+      below.insert(below.end(), child.objects.begin(), child.objects.end());
+    }
+    std::sort(below.begin(), below.end());
+    EXPECT_EQ(below, n.objects) << "an inner node's objects are the disjoint union of its children's";
+  }
+  // The leaves partition the objects, and the root stands for all of them.
+  for (size_t o = 0; o < objects.size(); ++o) EXPECT_EQ(leaf_count[o], 1) << "object " << o;
+  std::vector<uint32_t> all(objects.size());
+  std::iota(all.begin(), all.end(), 0u);
+  EXPECT_EQ(hlod.nodes[hlod.root].objects, all);
+  // The root proxy is far coarser than the objects together (100 x 224 triangles).
+  EXPECT_LE(hlod.nodes[hlod.root].mesh.triangle_count(), options.max_proxy_triangles);
+}
+
+TEST(Hlod, SplitsAlongTheLongestAxis) {
+  // 16 objects on a line along x: the root's four children each hold a contiguous run of four.
+  std::vector<HlodObject> objects;
+  for (int i = 0; i < 16; ++i) {
+    HlodObject o;
+    o.coarse = test::sphere(0.5f, 6, 12);
+    for (glm::vec3& p : o.coarse.positions) p.x += 2.0f * float(i);
+    o.bounds = o.coarse.bounds();
+    o.sphere = sphere_of_points(o.coarse.positions);
+    objects.push_back(std::move(o));
+  }
+  const Hlod hlod = build_hlod(objects);
+  ASSERT_EQ(hlod.nodes[hlod.root].children.size(), 4u);
+  for (uint32_t c : hlod.nodes[hlod.root].children) {
+    const std::vector<uint32_t>& run = hlod.nodes[c].objects;
+    ASSERT_EQ(run.size(), 4u);
+    EXPECT_EQ(run.back() - run.front(), 3u) << "a contiguous run along x";
+  }
+}
+
+}  // namespace

@@ -1,0 +1,65 @@
+// The finest grid of a representation (package/node_codec.hpp, PositionGrid): separating() spends the bits
+// that keep distinct positions apart (within a cap), snap() moves positions to the points the codec decodes
+// and drops the triangles that degenerate.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "package/node_codec.hpp"
+
+using namespace lodstream;
+using namespace lodstream::package;
+
+namespace {
+
+// Two triangles sharing an edge, in a box of diagonal ~1, plus a third triangle whose corner c sits `gap`
+// from corner b.
+Mesh with_gap(float gap) {
+  Mesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1.0f + gap, 0.0f, 0.0f}};
+  m.indices = {0, 1, 2, 2, 1, 3, 1, 4, 3};
+  return m;
+}
+
+TEST(PositionGrid, SeparatingSpendsTheBitsThatKeepVerticesApart) {
+  const Mesh far_apart = with_gap(0.3f);
+  EXPECT_EQ(PositionGrid::separating(far_apart).bits(far_apart.bounds()), 14);
+  // A gap of 2^-15.5 of the diagonal: 14 bits merge the two vertices, some count up to 20 keeps them apart.
+  const Mesh close = with_gap(std::ldexp(1.0f, -15) * 0.7f);
+  const PositionGrid g = PositionGrid::separating(close);
+  EXPECT_GT(g.bits(close.bounds()), 14);
+  EXPECT_LE(g.bits(close.bounds()), 20);
+  Mesh snapped = close;
+  g.snap(snapped);
+  EXPECT_NE(snapped.positions[1], snapped.positions[4]);
+  EXPECT_EQ(snapped.triangle_count(), 3u);
+  // With a cap of 14 bits they cannot be separated: the cap is returned, and snap welds them and drops
+  // the triangle between them.
+  const PositionGrid capped = PositionGrid::separating(close, 14, 14);
+  EXPECT_EQ(capped.bits(close.bounds()), 14);
+  Mesh welded = close;
+  capped.snap(welded);
+  EXPECT_EQ(welded.positions[1], welded.positions[4]);
+  EXPECT_EQ(welded.triangle_count(), 2u);
+}
+
+TEST(PositionGrid, SnappedPositionsAreWhatTheCodecDecodes) {
+  Mesh m = with_gap(0.123456f);
+  for (glm::vec3& p : m.positions) p = p * 37.1f + glm::vec3(-5.3f, 2.2f, 0.7f);
+  const PositionGrid g = PositionGrid::separating(m);
+  g.snap(m);
+  NodeGeometry geometry;
+  geometry.mesh = &m;
+  const NodeCodec& codec = default_node_codec();
+  const DecodedNode d = codec.decode(codec.encode(geometry, g), g, "test");
+  ASSERT_EQ(d.mesh.vertex_count(), m.vertex_count());
+  std::vector<glm::vec3> a = m.positions, b = d.mesh.positions;
+  auto less = [](const glm::vec3& x, const glm::vec3& y) {
+    return std::tie(x.x, x.y, x.z) < std::tie(y.x, y.y, y.z);
+  };
+  std::sort(a.begin(), a.end(), less);
+  std::sort(b.begin(), b.end(), less);
+  EXPECT_EQ(a, b) << "decoding a snapped mesh gives its positions bit for bit";
+}
+
+}  // namespace
