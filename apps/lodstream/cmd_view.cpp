@@ -18,6 +18,7 @@
 #include "command.hpp"
 #include "core/error.hpp"
 #include "core/image.hpp"
+#include "full_fetch.hpp"
 #include "net/http_source.hpp"
 #include "net/page_inbox.hpp"
 #include "net/pull_fetcher.hpp"
@@ -46,6 +47,7 @@ struct ViewOptions {
   double cache_mb = 1024.0;
   uint64_t budget = 0;  // 0: none
   std::string order = "benefit";
+  int window = 0;        // pull: requests outstanding at most, over as many connections (0: from the BDP)
   int frames_every = 0;  // 0: no images
   bool json = false;
 };
@@ -105,12 +107,19 @@ int run_view(const ViewOptions& opt) {
   if (!(opt.settle_s >= 0.0) || !std::isfinite(opt.settle_s)) throw Error("--settle must be >= 0 seconds");
   if (!(opt.cache_mb > 0.0) || !std::isfinite(opt.cache_mb))
     throw Error("--cache must be a positive MB count");
-  if (opt.order != "benefit" && opt.order != "sse") throw Error("--order must be 'benefit' or 'sse'");
+  if (opt.order != "benefit" && opt.order != "sse" && opt.order != "full")
+    throw Error("--order must be 'benefit', 'sse' or 'full'");
+  if (opt.window < 0 || opt.window > 64) throw Error("--window must be in 0..64");
   if (opt.frames_every < 0) throw Error("--frames-every must be >= 0 (0: no images)");
   const schedule::CameraPath path = schedule::load_camera_path(opt.path);
+  // The clock starts before the package is opened: time to first frame includes connecting and the root
+  // index, as the user waits for them (and as bench stream's simulation counts them).
+  const Clock::time_point start = Clock::now();
 
   // The package's root index, and the transport.
   const bool push = opt.source.rfind("ws://", 0) == 0, pull = opt.source.rfind("http://", 0) == 0;
+  if (push && (opt.order != "benefit" || opt.window))
+    throw Error("--order and --window are for pulling (http:// or a file), not ws://");
   std::string http_url = opt.source;
   if (push) {
     const UrlParts u = split_url(opt.source, "ws://");
@@ -137,8 +146,10 @@ int run_view(const ViewOptions& opt) {
     hello.viewport_height = uint16_t(path.height());
     pusher = std::make_unique<PushClient>(opt.source, hello, inbox);
   } else if (pull) {
-    fetcher =
-        std::make_unique<PullFetcher>([url = http_url] { return std::make_shared<HttpSource>(url); }, inbox);
+    PullOptions o;
+    if (opt.window) o.connections = opt.window;
+    fetcher = std::make_unique<PullFetcher>([url = http_url] { return std::make_shared<HttpSource>(url); },
+                                            inbox, o);
   } else {
     PullOptions local;
     local.connections = 1;
@@ -147,6 +158,7 @@ int run_view(const ViewOptions& opt) {
         [file = opt.source] { return std::make_shared<package::FileSource>(file); }, inbox, local);
   }
 
+  std::unique_ptr<FullFetch> full = opt.order == "full" ? std::make_unique<FullFetch>() : nullptr;
   schedule::CutOptions cut_options;
   cut_options.tau = opt.pixel_error;
   if (opt.budget) cut_options.triangle_budget = opt.budget;
@@ -178,10 +190,13 @@ int run_view(const ViewOptions& opt) {
   runtime::Frame last;
   bool converged = false;
   double t = 0.0;
-  const Clock::time_point start = Clock::now();
+  // Frames keep to the 1/30 s slots since the start; the first is the first slot after the set-up.
+  const double first_slot =
+      std::ceil(std::chrono::duration<double>(Clock::now() - start).count() * kFrameRate);
   for (uint64_t i = 0;; ++i) {
-    std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
-                                              std::chrono::duration<double>(double(i) / kFrameRate)));
+    std::this_thread::sleep_until(start +
+                                  std::chrono::duration_cast<Clock::duration>(
+                                      std::chrono::duration<double>((first_slot + double(i)) / kFrameRate)));
     const Clock::time_point frame_start = Clock::now();
     t = std::chrono::duration<double>(frame_start - start).count();
     if (std::string error = inbox.error(); !error.empty()) throw Error(error);
@@ -191,10 +206,15 @@ int run_view(const ViewOptions& opt) {
     const auto predicted = schedule::predicted_views(now, 0.0);
     std::vector<schedule::View> ahead;
     for (size_t k = 1; k < predicted.size(); ++k) ahead.push_back(predicted[k].view);
-    if (fetcher) {
+    if (full) {
+      full->request(client, *fetcher);
+    } else if (fetcher) {
       const uint64_t in_flight = fetcher->in_flight_bytes(), window = fetcher->window_bytes();
-      if (in_flight < window) {
-        const schedule::ScheduleOptions s{opt.pixel_error, window - in_flight, SIZE_MAX};
+      const size_t requests = client.in_flight(), max_requests = size_t(opt.window);
+      if (opt.window ? requests < max_requests : in_flight < window) {
+        const schedule::ScheduleOptions s =
+            opt.window ? schedule::ScheduleOptions{opt.pixel_error, UINT64_MAX, max_requests - requests}
+                       : schedule::ScheduleOptions{opt.pixel_error, window - in_flight, SIZE_MAX};
         const auto pages =
             opt.order == "sse"
                 ? client.scheduler().next_sse(client.scene(), client.nodes(), predicted[0].view, s)
@@ -207,7 +227,8 @@ int run_view(const ViewOptions& opt) {
     } else {
       pusher->send_view(view_update(now));
     }
-    last = client.frame(predicted[0].view, ahead, cut_options);
+    last = full ? full->frame(client, predicted[0].view, opt.pixel_error)
+                : client.frame(predicted[0].view, ahead, cut_options);
     const bool final_pose = t >= path.end();
     const bool done = final_pose && (last.cut.converged() || t >= path.end() + opt.settle_s);
     if (geometry && (i % uint64_t(opt.frames_every) == 0 || done)) draw(i, last, path.pose_at(t));
@@ -274,7 +295,14 @@ const bool registered = register_command(
            ->capture_default_str();
        sub.add_option("--cache", opt->cache_mb, "page cache budget, MB")->capture_default_str();
        sub.add_option("--budget", opt->budget, "triangles drawn per frame at most (0: no limit)");
-       sub.add_option("--order", opt->order, "pull order: benefit (benefit per byte, predicted) or sse")
+       sub.add_option("--order", opt->order,
+                      "pull order: benefit (benefit per byte, predicted), sse, or full (the finest level's "
+                      "pages in file order, nothing drawn until all arrived)")
+           ->capture_default_str();
+       sub.add_option(
+              "--window", opt->window,
+              "pull: at most N requests outstanding, over N connections (0: a window of bytes from the "
+              "measured bandwidth-delay product)")
            ->capture_default_str();
        sub.add_option("--frames-every", opt->frames_every,
                       "write DIR/frame_NNNNN.png every N frames and the final frame (0: none)");

@@ -127,11 +127,9 @@ struct SimResult {
 SimResult simulate(const PackageFacts& package, const schedule::CameraPath& path, Policy policy,
                    const SimOptions& options);
 
-// The data pages holding finest-level nodes, sorted (file order): what `full` fetches.
+// finest_cut.hpp's finest_pages and finest_cut over the whole package: what `full` fetches and draws, and
+// what image metrics compare against.
 std::vector<uint32_t> finest_pages(const PackageFacts& package);
-
-// The finest cut for `view`: every finest-level node (no children) of every object in the frustum, each with
-// its projected error. What `full` draws and what image metrics compare against.
 schedule::Cut finest_cut(const PackageFacts& package, const schedule::View& view);
 
 }  // namespace lodstream::cli
