@@ -312,8 +312,8 @@ std::string agreement_table(const std::vector<Run>& real, const std::vector<Run>
   return out;
 }
 
-// benefit.png, psnr.png and bytes.png through gnuplot (skipped with a warning when it is not installed), one
-// line per run, from out/NAME.csv.
+// benefit.png, psnr.png (when a frame was measured) and bytes.png through gnuplot (skipped with a warning
+// when it is not installed), one line per run, from out/NAME.csv.
 void plot(const fs::path& out, const std::vector<Run>& runs, double window_s) {
   std::string script =
       "set terminal pngcairo size 1000,560 font ',11'\nset datafile separator ','\n"
@@ -333,7 +333,15 @@ void plot(const fs::path& out, const std::vector<Run>& runs, double window_s) {
     script += cmd + "\n";
   };
   plot_one("benefit", "benefit ratio", "$7", "steps lw 2");
-  plot_one("psnr", "PSNR (dB) against the full-resolution frame", "valid(9) ? $9 : NaN", "linespoints lw 2");
+  bool measured = false;  // gnuplot fails on a plot without a single point
+  for (const Run& r : runs)
+    for (double p : r.metrics.psnr) measured = measured || !std::isnan(p);
+  std::vector<std::string> plots{"benefit", "bytes"};
+  if (measured) {
+    plot_one("psnr", "PSNR (dB) against the full-resolution frame", "valid(9) ? $9 : NaN",
+             "linespoints lw 2");
+    plots.push_back("psnr");
+  }
   plot_one("bytes", "MB received", "$2/1e6", "steps lw 2");
   const fs::path gp = out / ".plots.gp";
   write_text(gp, script);
@@ -345,8 +353,7 @@ void plot(const fs::path& out, const std::vector<Run>& runs, double window_s) {
     return;
   }
   fs::remove(gp);
-  for (const char* name : {"benefit", "psnr", "bytes"})
-    fs::rename(out / ("." + std::string(name) + ".png.tmp"), out / (std::string(name) + ".png"));
+  for (const std::string& name : plots) fs::rename(out / ("." + name + ".png.tmp"), out / (name + ".png"));
 }
 
 // Records frame k's PSNR and SSIM against the full-resolution `reference` (PSNR of identical images capped

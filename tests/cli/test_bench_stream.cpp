@@ -185,7 +185,7 @@ TEST(BenchStream, RealModeRunsEveryPolicyThroughServeLinkAndView) {
   EXPECT_EQ(summary, nlohmann::json::parse(slurp(dir / "summary.json")));
   const std::string md = slurp(dir / "summary.md");
   EXPECT_NE(md.find("How far the two modes agree"), std::string::npos) << md;
-  for (const std::string& p : {"full", "sse-pull", "sse-pull-3", "push"}) {
+  for (const std::string p : {"full", "sse-pull", "sse-pull-3", "push"}) {
     SCOPED_TRACE(p);
     const auto& s = summary["policies"][p];
     EXPECT_EQ(s["mode"], "real");
@@ -211,8 +211,11 @@ TEST(BenchStream, RealModeRunsEveryPolicyThroughServeLinkAndView) {
   EXPECT_EQ(summary["policies"]["oracle"]["mode"], "simulated only");
   EXPECT_NE(md.find("| oracle (simulated only) |"), std::string::npos) << md;
   // full drew nothing before all it fetched had arrived
-  for (const Row& row : rows(dir / "full.csv"))
-    if (row.bytes < summary["policies"]["full"]["bytes"].get<uint64_t>()) EXPECT_EQ(row.nodes, 0u) << row.t;
+  for (const Row& row : rows(dir / "full.csv")) {
+    if (row.bytes < summary["policies"]["full"]["bytes"].get<uint64_t>()) {
+      EXPECT_EQ(row.nodes, 0u) << row.t;
+    }
+  }
   EXPECT_NE(slurp(dir / "real" / "serve.log").find("stopped by signal"), std::string::npos);
 }
 
