@@ -42,6 +42,9 @@ ChildProcess::ChildProcess(const std::vector<std::string>& args, const std::file
   if (stdout_file.empty()) {
     if (pipe2(pipe_fds, O_CLOEXEC) != 0) throw Error("cannot create a pipe for " + args.at(0));
     out = pipe_fds[1];
+  } else if (stdout_file == "-") {
+    out = fcntl(2, F_DUPFD_CLOEXEC, 3);
+    if (out < 0) throw Error("cannot duplicate standard error for " + args.at(0));
   } else {
     out = open_for_writing(stdout_file);
   }

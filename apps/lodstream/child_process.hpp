@@ -15,9 +15,10 @@ namespace lodstream::cli {
 
 class ChildProcess {
  public:
-  // Starts `lodstream ARGS…`. Its standard output goes to `stdout_file`, or to a pipe that read_line() reads
-  // when it is empty; its standard error to `stderr_file`, or to this process's when it is empty. Throws
-  // lodstream::Error when it cannot be started.
+  // Starts `lodstream ARGS…`. Its standard output goes to `stdout_file`; when that is empty, to a pipe that
+  // read_line() reads; when it is "-", to this process's standard error (a report for the user, where this
+  // process's standard output is --json's). Its standard error goes to `stderr_file`, or to this process's
+  // when it is empty. Throws lodstream::Error when it cannot be started.
   ChildProcess(const std::vector<std::string>& args, const std::filesystem::path& stdout_file,
                const std::filesystem::path& stderr_file);
   ~ChildProcess();

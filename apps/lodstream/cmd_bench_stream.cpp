@@ -9,9 +9,6 @@
 // view on loopback; POLICY.csv, the table and the plots are then the real runs', image metrics at the frames
 // the views wrote, and summary.json/.md set each real figure beside the simulated one (simulated/: the
 // simulated CSVs; oracle is reported from the simulation only).
-#include <spawn.h>
-#include <sys/wait.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -22,6 +19,7 @@
 #include <sstream>
 
 #include "bench.hpp"
+#include "child_process.hpp"
 #include "core/error.hpp"
 #include "core/image.hpp"
 #include "measure/image_metrics.hpp"
@@ -33,8 +31,6 @@
 #include "runtime/cut_geometry.hpp"
 #include "schedule/path_gen.hpp"
 #include "stream_sim.hpp"
-
-extern char** environ;
 
 namespace lodstream::cli {
 namespace {
@@ -72,20 +68,11 @@ LinkSettings parse_link(const std::string& text) {
   return link;
 }
 
-// Runs this program's `bake MODEL -o PACKAGE` (a child process: bake owns its own memory and threads).
+// Runs this program's `bake MODEL -o PACKAGE` (a child process: bake owns its own memory and threads; its
+// report goes to standard error, standard output being --json's).
 void bake(const std::string& model, const fs::path& package) {
-  const std::string self = fs::read_symlink("/proc/self/exe").string();
-  std::vector<std::string> args{self, "bake", model, "-o", package.string()};
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  if (posix_spawn(&pid, self.c_str(), nullptr, nullptr, argv.data(), environ) != 0)
-    throw Error("bench stream: cannot run " + self + " bake");
-  int status = 0;
-  waitpid(pid, &status, 0);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-    throw Error("bench stream: baking " + model + " failed (see above)");
+  ChildProcess child({"bake", model, "-o", package.string()}, "-", "");
+  if (child.wait() != 0) throw Error("bench stream: baking " + model + " failed (see above)");
 }
 
 fs::path package_of(const StreamArgs& args) {
