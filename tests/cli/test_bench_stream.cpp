@@ -65,6 +65,15 @@ std::vector<Row> rows(const fs::path& csv) {
   return out;
 }
 
+// A fixed camera looking at the elephant, written into `dir` (created).
+fs::path static_path(const fs::path& dir) {
+  fs::create_directories(dir);
+  const fs::path path = dir / "static-path.json";
+  std::ofstream(path) << R"({"fov": 50, "size": [320, 180], "keyframes": [{"t": 0, "eye": [0.2, 0.3, 1.4],
+                           "target": [0, 0, 0]}]})";
+  return path;
+}
+
 }  // namespace
 
 // Same input, same outputs: every CSV (image metrics included) and summary.json, byte for byte.
@@ -89,10 +98,7 @@ TEST(BenchStream, SimulatedRunsAreReproducibleByteForByte) {
 // `full` draws nothing until every byte it fetches has arrived.
 TEST(BenchStream, EveryPolicyConvergesOnAStaticPathAndFullWaitsForEverything) {
   const fs::path dir = test::temp_dir() / "static";
-  fs::create_directories(dir);
-  const fs::path path = dir / "path.json";
-  std::ofstream(path) << R"({"fov": 50, "size": [320, 180], "keyframes": [{"t": 0, "eye": [0.2, 0.3, 1.4],
-                           "target": [0, 0, 0]}]})";
+  const fs::path path = static_path(dir);
   auto r = bench(dir, {"--path", path.string(), "--psnr-every", "0", "--settle", "20", "--json"});
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json summary = r.json();
@@ -172,10 +178,7 @@ TEST(BenchStream, OutputsFollowTheContract) {
 // process was stopped (serve and link log their stop signal).
 TEST(BenchStream, RealModeRunsEveryPolicyThroughServeLinkAndView) {
   const fs::path dir = test::temp_dir() / "real";
-  fs::create_directories(dir);
-  const fs::path path = dir / "path.in.json";
-  std::ofstream(path) << R"({"fov": 50, "size": [320, 180], "keyframes": [{"t": 0, "eye": [0.2, 0.3, 1.4],
-                           "target": [0, 0, 0]}]})";
+  const fs::path path = static_path(dir);
   auto r = test::run_lodstream({"bench", "stream", elephant_package().string(), "--real", "--path",
                                 path.string(), "--link", "bandwidth=20mbit,rtt=20ms", "--settle", "5",
                                 "--psnr-every", "1", "--out", dir.string(), "--json"});
