@@ -182,19 +182,24 @@ std::optional<double> time_to_095(const std::vector<FrameRow>& frames, double fr
   return std::nullopt;
 }
 
-// PSNR of the last sampled frame at or before `t` + `slack_s` (the run stops once converged after the path:
-// later frames repeat the last one); null when no frame in time was sampled. Real runs' frames come a few
-// milliseconds after their time on the wall clock: they are given a slack.
+// PSNR at `t`. Simulated: the last sampled frame at or before t (frames are sampled at 1, 2 and 5 s
+// exactly; the run stops once converged after the path: later frames repeat the last one); null when no
+// frame by t was sampled. Real (`real`): a view's frame for the slot at t comes at or after t on the wall
+// clock, so the first sampled frame at or after t, else the last one.
 std::optional<double> psnr_at(const std::vector<FrameRow>& frames, const ImageMetrics& m, double t,
-                              double slack_s) {
+                              bool real) {
   std::optional<double> out;
-  for (size_t k = 0; k < frames.size() && frames[k].t <= t + slack_s + 1e-9; ++k)
-    if (!std::isnan(m.psnr[k])) out = m.psnr[k];
+  for (size_t k = 0; k < frames.size(); ++k) {
+    if (std::isnan(m.psnr[k])) continue;
+    if (real && frames[k].t >= t - 1e-9) return m.psnr[k];
+    if (!real && frames[k].t > t + 1e-9) break;
+    out = m.psnr[k];
+  }
   return out;
 }
 
 PolicySummary summarize(const std::vector<FrameRow>& f, const ImageMetrics& m, double window_s,
-                        const std::vector<double>& jumps, double psnr_slack_s) {
+                        const std::vector<double>& jumps, bool real) {
   PolicySummary s;
   for (const FrameRow& row : f)
     if (row.nodes > 0 && !s.first_frame_s) s.first_frame_s = row.t;
@@ -213,9 +218,9 @@ PolicySummary summarize(const std::vector<FrameRow>& f, const ImageMetrics& m, d
   for (const FrameRow& row : f) ms.push_back(row.frame_ms);
   s.frame_ms_p50 = percentile(ms, 50.0);
   s.frame_ms_p99 = percentile(ms, 99.0);
-  s.psnr_1s = psnr_at(f, m, 1.0, psnr_slack_s);
-  s.psnr_2s = psnr_at(f, m, 2.0, psnr_slack_s);
-  s.psnr_5s = psnr_at(f, m, 5.0, psnr_slack_s);
+  s.psnr_1s = psnr_at(f, m, 1.0, real);
+  s.psnr_2s = psnr_at(f, m, 2.0, real);
+  s.psnr_5s = psnr_at(f, m, 5.0, real);
   return s;
 }
 
@@ -440,7 +445,7 @@ int run_bench_stream(const StreamArgs& args) {
     }
   }
   if (total > 0) std::fprintf(stderr, "\n");
-  for (Run& r : simulated) r.summary = summarize(r.frames, r.metrics, window_s, jumps, 0.0);
+  for (Run& r : simulated) r.summary = summarize(r.frames, r.metrics, window_s, jumps, false);
 
   // --real: each policy but oracle through serve, link and view; image metrics at the frames each view drew.
   std::vector<Run> real;
@@ -453,7 +458,9 @@ int run_bench_stream(const StreamArgs& args) {
     o.tau = args.tau;
     o.settle_s = args.settle_s;
     o.path_duration_s = path.end() - path.start();
-    o.frames_every = int(std::lround(args.sample_every_s * options.fps));
+    // Cuts recorded every second; those at 1, 2 and 5 s, every --psnr-every and the last are measured.
+    o.cuts_every = args.sample_every_s > 0.0 ? int(std::lround(options.fps)) : 0;
+    const long every_s = std::max(1L, std::lround(args.sample_every_s));
     RealStream stream(o);
     size_t count = 0;
     for (Policy p : policies)
@@ -465,15 +472,16 @@ int run_bench_stream(const StreamArgs& args) {
       Run run{policy_name(p), r.frames, {}, {}};
       run.metrics.psnr.assign(r.frames.size(), NAN);
       run.metrics.ssim.assign(r.frames.size(), NAN);
-      for (size_t k = 0; k < r.frames.size(); ++k) {
-        if (r.images[k].empty()) continue;
-        // The view drew its frame at path time t (its clock since it started).
+      for (const auto& [k, drawn] : r.cuts) {
+        const long second = std::lround(r.frames[k].t);
+        if (k + 1 != r.frames.size() && second != 1 && second != 2 && second != 5 && second % every_s != 0)
+          continue;
+        // The view drew frame k at path time t (its clock since it started).
         const Camera camera = path.pose_at(r.frames[k].t);
-        measure_frame(run.metrics, k, load_image(r.images[k]),
+        measure_frame(run.metrics, k, frame_renderer().draw(camera, drawn),
                       frame_renderer().reference(r.frames[k].t, camera));
       }
-      // A real frame comes a few milliseconds after its slot: PSNR at t is the last image by t + 0.1 s.
-      run.summary = summarize(run.frames, run.metrics, window_s, jumps, 0.1);
+      run.summary = summarize(run.frames, run.metrics, window_s, jumps, true);
       real.push_back(std::move(run));
     }
     std::fprintf(stderr, "\n");
@@ -523,9 +531,9 @@ int run_bench_stream(const StreamArgs& args) {
     md +=
         "\nReal mode: lodstream serve, a fresh lodstream link per policy and one headless lodstream view per "
         "policy (fresh cache) on loopback, on the wall clock; frame ms = the client's measured frame (cut "
-        "selection, and drawing on the frames written for PSNR), not the cost model; PSNR of the last frame "
-        "the "
-        "view wrote by t + 0.1 s against the package's finest cut from the same camera. MB: page bytes the "
+        "selection), not the cost model; PSNR at t: the first frame at or after t whose cut the view "
+        "recorded, "
+        "drawn afterwards, against the package's finest cut from the same camera. MB: page bytes the "
         "client installed (the simulation also counts HTTP and WebSocket headers). Logs and CSVs under "
         "real/; "
         "the simulated runs under simulated/.\n\n## How far the two modes agree\n\n" +

@@ -49,6 +49,7 @@ struct ViewOptions {
   std::string order = "benefit";
   int window = 0;        // pull: requests outstanding at most, over as many connections (0: from the BDP)
   int frames_every = 0;  // 0: no images
+  int cuts_every = 0;    // 0: no cuts.csv
   bool json = false;
 };
 
@@ -111,6 +112,7 @@ int run_view(const ViewOptions& opt) {
     throw Error("--order must be 'benefit', 'sse' or 'full'");
   if (opt.window < 0 || opt.window > 64) throw Error("--window must be in 0..64");
   if (opt.frames_every < 0) throw Error("--frames-every must be >= 0 (0: no images)");
+  if (opt.cuts_every < 0) throw Error("--cuts-every must be >= 0 (0: none)");
   const schedule::CameraPath path = schedule::load_camera_path(opt.path);
   // The clock starts before the package is opened: time to first frame includes connecting and the root
   // index, as the user waits for them (and as bench stream's simulation counts them).
@@ -185,6 +187,7 @@ int run_view(const ViewOptions& opt) {
     save_png(renderer->read_pixels(), dir / name);
   };
   std::string csv = "t,bytes,nodes,triangles,pixel_error_max,pixel_error_mean,benefit_ratio,frame_ms\n";
+  std::string cuts = "frame,object,node\n";  // --cuts-every: the drawn nodes of recorded frames
   std::vector<double> frame_ms;
   std::optional<double> first_frame_s, time_095_s;
   runtime::Frame last;
@@ -232,6 +235,9 @@ int run_view(const ViewOptions& opt) {
     const bool final_pose = t >= path.end();
     const bool done = final_pose && (last.cut.converged() || t >= path.end() + opt.settle_s);
     if (geometry && (i % uint64_t(opt.frames_every) == 0 || done)) draw(i, last, path.pose_at(t));
+    if (opt.cuts_every && ((uint64_t(first_slot) + i) % uint64_t(opt.cuts_every) == 0 || done))
+      for (const schedule::DrawnNode& d : last.cut.drawn)
+        cuts += std::to_string(i) + "," + std::to_string(d.object) + "," + std::to_string(d.node) + "\n";
     const double ms = 1e3 * std::chrono::duration<double>(Clock::now() - frame_start).count();
     frame_ms.push_back(ms);
     if (!first_frame_s && !last.cut.drawn.empty()) first_frame_s = t;
@@ -246,13 +252,17 @@ int run_view(const ViewOptions& opt) {
     if (done) break;
   }
 
-  const auto tmp = dir / "frames.csv.tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    f << csv;
-    if (!f) throw Error((dir / "frames.csv").string() + ": cannot write");
-  }
-  std::filesystem::rename(tmp, dir / "frames.csv");
+  auto write = [&](const std::string& name, const std::string& text) {
+    const auto tmp = dir / (name + ".tmp");
+    {
+      std::ofstream f(tmp, std::ios::binary);
+      f << text;
+      if (!f) throw Error((dir / name).string() + ": cannot write");
+    }
+    std::filesystem::rename(tmp, dir / name);
+  };
+  write("frames.csv", csv);
+  if (opt.cuts_every) write("cuts.csv", cuts);
 
   nlohmann::json j;
   j["mode"] = push ? "push" : pull ? "pull" : "file";
@@ -304,6 +314,9 @@ const bool registered = register_command(
               "pull: at most N requests outstanding, over N connections (0: a window of bytes from the "
               "measured bandwidth-delay product)")
            ->capture_default_str();
+       sub.add_option("--cuts-every", opt->cuts_every,
+                      "write the drawn cut (rows frame,object,node; frame = the CSV's row) to DIR/cuts.csv "
+                      "every N frames on the 1/30 s slots since the start, and the final frame (0: none)");
        sub.add_option("--frames-every", opt->frames_every,
                       "write DIR/frame_NNNNN.png every N frames and the final frame (0: none)");
        sub.add_flag("--json", opt->json, "print a JSON summary");

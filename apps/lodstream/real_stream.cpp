@@ -79,8 +79,8 @@ RealRun RealStream::run(Policy policy, const std::string& label) {
   if (policy == Policy::sse_pull_3) args.insert(args.end(), {"--order", "sse", "--window", "3"});
   args.insert(args.end(),
               {"--headless", "--path", options_.path_file.string(), "--out", dir.string(), "--pixel-error",
-               number(options_.tau, ""), "--settle", number(options_.settle_s, ""), "--frames-every",
-               std::to_string(options_.frames_every), "--json"});
+               number(options_.tau, ""), "--settle", number(options_.settle_s, ""), "--cuts-every",
+               std::to_string(options_.cuts_every), "--json"});
   const fs::path view_log = dir / "view.log";
   ChildProcess view(args, dir / "view.json", view_log);
   using Clock = std::chrono::steady_clock;
@@ -110,11 +110,19 @@ RealRun RealStream::run(Policy policy, const std::string& label) {
   if (j.is_discarded() || !j.contains("converged"))
     throw Error((dir / "view.json").string() + ": not view's JSON summary");
   if (!run.frames.empty()) run.frames.back().converged = j["converged"].get<bool>();
-  run.images.resize(run.frames.size());
-  for (size_t k = 0; k < run.frames.size(); ++k) {
-    char file[32];
-    std::snprintf(file, sizeof file, "frame_%05zu.png", k);
-    if (fs::exists(dir / file)) run.images[k] = dir / file;
+  if (options_.cuts_every) {
+    std::ifstream cuts(dir / "cuts.csv");
+    std::string line;
+    std::getline(cuts, line);  // the header
+    for (size_t number = 2; std::getline(cuts, line); ++number) {
+      size_t frame = 0;
+      schedule::DrawnNode d;
+      if (std::sscanf(line.c_str(), "%zu,%u,%u", &frame, &d.object, &d.node) != 3 ||
+          frame >= run.frames.size())
+        throw Error((dir / "cuts.csv").string() + ": line " + std::to_string(number) +
+                    ": not frame,object,node");
+      run.cuts[frame].push_back(d);
+    }
   }
   return run;
 }

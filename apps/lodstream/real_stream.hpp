@@ -2,7 +2,9 @@
 // the run (port 0), then per policy a fresh `lodstream link` in front of it with the run's bandwidth, RTT
 // and jitter (port 0) and one headless `lodstream view` through it (a fresh client: empty cache), one policy
 // after the other. Each view follows the camera path on the wall clock at 30 frames/s and writes its
-// per-frame CSV (DESIGN.md's columns) and, every `frames_every` frames and at the last one, its image.
+// per-frame CSV (DESIGN.md's columns) and, every `cuts_every` frames and at the last one, the cut it drew
+// (node ids: recording costs the client nothing, where drawing an image would stall its frame loop; the
+// benchmark draws the recorded cuts afterwards).
 //   full        view http://…/NAME.lods --order full        (every index page, then the finest pages in file
 //                                                              order; nothing drawn until all arrived)
 //   sse-pull    view http://…/NAME.lods --order sse --window 20   (20 requests outstanding, 20 connections)
@@ -13,6 +15,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -28,13 +31,13 @@ struct RealOptions {
   LinkSettings link;
   double tau = 1.0, settle_s = 10.0;
   double path_duration_s = 0.0;  // the camera path's length (a view that runs far longer is stopped)
-  int frames_every = 0;          // images every N frames (0: none)
+  int cuts_every = 0;            // record the drawn cut every N frames (0: none)
 };
 
-// One policy's run: its frames (the view's CSV) and, per frame, the image it wrote (empty path: none).
+// One policy's run: its frames (the view's CSV) and the cuts it recorded, by frame (row) index.
 struct RealRun {
   std::vector<FrameRow> frames;
-  std::vector<std::filesystem::path> images;
+  std::map<size_t, std::vector<schedule::DrawnNode>> cuts;
 };
 
 class RealStream {
