@@ -187,7 +187,7 @@ int run_view(const ViewOptions& opt) {
     save_png(renderer->read_pixels(), dir / name);
   };
   std::string csv = "t,bytes,nodes,triangles,pixel_error_max,pixel_error_mean,benefit_ratio,frame_ms\n";
-  std::string cuts = "frame,object,node\n";  // --cuts-every: the drawn nodes of recorded frames
+  std::string cuts = "frame,drawn\n";  // --cuts-every: the drawn nodes of recorded frames
   std::vector<double> frame_ms;
   std::optional<double> first_frame_s, time_095_s;
   runtime::Frame last;
@@ -235,9 +235,13 @@ int run_view(const ViewOptions& opt) {
     const bool final_pose = t >= path.end();
     const bool done = final_pose && (last.cut.converged() || t >= path.end() + opt.settle_s);
     if (geometry && (i % uint64_t(opt.frames_every) == 0 || done)) draw(i, last, path.pose_at(t));
-    if (opt.cuts_every && ((uint64_t(first_slot) + i) % uint64_t(opt.cuts_every) == 0 || done))
+    if (opt.cuts_every && ((uint64_t(first_slot) + i) % uint64_t(opt.cuts_every) == 0 || done)) {
+      cuts += std::to_string(i) + ",";  // then OBJECT:NODE per drawn node, space-separated (none: empty)
       for (const schedule::DrawnNode& d : last.cut.drawn)
-        cuts += std::to_string(i) + "," + std::to_string(d.object) + "," + std::to_string(d.node) + "\n";
+        cuts += (&d == last.cut.drawn.data() ? "" : " ") + std::to_string(d.object) + ":" +
+                std::to_string(d.node);
+      cuts += "\n";
+    }
     const double ms = 1e3 * std::chrono::duration<double>(Clock::now() - frame_start).count();
     frame_ms.push_back(ms);
     if (!first_frame_s && !last.cut.drawn.empty()) first_frame_s = t;
@@ -315,7 +319,8 @@ const bool registered = register_command(
               "measured bandwidth-delay product)")
            ->capture_default_str();
        sub.add_option("--cuts-every", opt->cuts_every,
-                      "write the drawn cut (rows frame,object,node; frame = the CSV's row) to DIR/cuts.csv "
+                      "write the drawn cut (a row per frame: its CSV row, then OBJECT:NODE per drawn node) "
+                      "to DIR/cuts.csv "
                       "every N frames on the 1/30 s slots since the start, and the final frame (0: none)");
        sub.add_option("--frames-every", opt->frames_every,
                       "write DIR/frame_NNNNN.png every N frames and the final frame (0: none)");

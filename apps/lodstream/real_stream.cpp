@@ -115,13 +115,17 @@ RealRun RealStream::run(Policy policy, const std::string& label) {
     std::string line;
     std::getline(cuts, line);  // the header
     for (size_t number = 2; std::getline(cuts, line); ++number) {
+      // FRAME,OBJECT:NODE OBJECT:NODE … (an empty list: nothing drawn)
+      std::istringstream in(line);
       size_t frame = 0;
-      schedule::DrawnNode d;
-      if (std::sscanf(line.c_str(), "%zu,%u,%u", &frame, &d.object, &d.node) != 3 ||
-          frame >= run.frames.size())
+      char comma = 0;
+      if (!(in >> frame >> comma) || comma != ',' || frame >= run.frames.size())
         throw Error((dir / "cuts.csv").string() + ": line " + std::to_string(number) +
-                    ": not frame,object,node");
-      run.cuts[frame].push_back(d);
+                    ": not FRAME,OBJECT:NODE…");
+      std::vector<schedule::DrawnNode>& drawn = run.cuts[frame];
+      schedule::DrawnNode d;
+      char colon = 0;
+      while (in >> d.object >> colon >> d.node) drawn.push_back(d);
     }
   }
   return run;
