@@ -5,9 +5,10 @@
 // --out: POLICY.csv per policy (DESIGN.md's columns, then psnr and ssim, empty where not sampled),
 // summary.json (DESIGN.md's keys), summary.md (the table), benefit.png, psnr.png and bytes.png (gnuplot), and
 // the sampled frames at 1, 2 and 5 s and the last one under frames/.
-#include <spawn.h>
-#include <sys/wait.h>
-
+// --real (real_stream.hpp): every policy but oracle also runs through lodstream serve, link and a headless
+// view on loopback; POLICY.csv, the table and the plots are then the real runs', image metrics at the frames
+// the views wrote, and summary.json/.md set each real figure beside the simulated one (simulated/: the
+// simulated CSVs; oracle is reported from the simulation only).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -18,10 +19,12 @@
 #include <sstream>
 
 #include "bench.hpp"
+#include "child_process.hpp"
 #include "core/error.hpp"
 #include "core/image.hpp"
 #include "measure/image_metrics.hpp"
 #include "package/reader.hpp"
+#include "real_stream.hpp"
 #include "render/context.hpp"
 #include "render/renderer.hpp"
 #include "render/scene_upload.hpp"
@@ -29,8 +32,6 @@
 #include "scene_bounds.hpp"
 #include "schedule/path_gen.hpp"
 #include "stream_sim.hpp"
-
-extern char** environ;
 
 namespace lodstream::cli {
 namespace {
@@ -68,20 +69,11 @@ LinkSettings parse_link(const std::string& text) {
   return link;
 }
 
-// Runs this program's `bake MODEL -o PACKAGE` (a child process: bake owns its own memory and threads).
+// Runs this program's `bake MODEL -o PACKAGE` (a child process: bake owns its own memory and threads; its
+// report goes to standard error, standard output being --json's).
 void bake(const std::string& model, const fs::path& package) {
-  const std::string self = fs::read_symlink("/proc/self/exe").string();
-  std::vector<std::string> args{self, "bake", model, "-o", package.string()};
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  if (posix_spawn(&pid, self.c_str(), nullptr, nullptr, argv.data(), environ) != 0)
-    throw Error("bench stream: cannot run " + self + " bake");
-  int status = 0;
-  waitpid(pid, &status, 0);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-    throw Error("bench stream: baking " + model + " failed (see above)");
+  ChildProcess child({"bake", model, "-o", package.string()}, "-", "");
+  if (child.wait() != 0) throw Error("bench stream: baking " + model + " failed (see above)");
 }
 
 fs::path package_of(const StreamArgs& args) {
@@ -137,12 +129,12 @@ class FrameRenderer {
     render::release_scene(renderer_, upload);
     return image;
   }
-  // The full-resolution frame for sampled frame `frame` (same camera for every policy), drawn once.
-  const Image& reference(size_t frame, const Camera& camera) {
-    auto it = references_.find(frame);
+  // The full-resolution frame at path time `t` (`camera`: the path's pose then), drawn once per t (the
+  // simulated policies share their frame times; real runs' frames each have their own).
+  const Image& reference(double t, const Camera& camera) {
+    auto it = references_.find(t);
     if (it == references_.end())
-      it = references_.emplace(frame, draw(camera, finest_cut(*facts_, schedule::View::of(camera)).drawn))
-               .first;
+      it = references_.emplace(t, draw(camera, finest_cut(*facts_, schedule::View::of(camera)).drawn)).first;
     return it->second;
   }
 
@@ -152,7 +144,7 @@ class FrameRenderer {
   package::PackageReader* reader_;
   const PackageFacts* facts_;
   runtime::CutGeometry geometry_;
-  std::map<size_t, Image> references_;
+  std::map<double, Image> references_;
   std::set<std::string> warned_;
 };
 
@@ -184,19 +176,25 @@ std::optional<double> time_to_095(const std::vector<FrameRow>& frames, double fr
   return std::nullopt;
 }
 
-// PSNR of the last sampled frame at or before `t` (the run stops once converged after the path: later frames
-// repeat the last one); null when no frame at or before t was sampled.
-std::optional<double> psnr_at(const std::vector<FrameRow>& frames, const ImageMetrics& m, double t) {
+// PSNR at `t`. Simulated: the last sampled frame at or before t (frames are sampled at 1, 2 and 5 s
+// exactly; the run stops once converged after the path: later frames repeat the last one); null when no
+// frame by t was sampled. Real (`real`): a view's frame for the slot at t comes at or after t on the wall
+// clock, so the first sampled frame at or after t, else the last one.
+std::optional<double> psnr_at(const std::vector<FrameRow>& frames, const ImageMetrics& m, double t,
+                              bool real) {
   std::optional<double> out;
-  for (size_t k = 0; k < frames.size() && frames[k].t <= t + 1e-9; ++k)
-    if (!std::isnan(m.psnr[k])) out = m.psnr[k];
+  for (size_t k = 0; k < frames.size(); ++k) {
+    if (std::isnan(m.psnr[k])) continue;
+    if (real && frames[k].t >= t - 1e-9) return m.psnr[k];
+    if (!real && frames[k].t > t + 1e-9) break;
+    out = m.psnr[k];
+  }
   return out;
 }
 
-PolicySummary summarize(const SimResult& r, const ImageMetrics& m, double window_s,
-                        const std::vector<double>& jumps) {
+PolicySummary summarize(const std::vector<FrameRow>& f, const ImageMetrics& m, double window_s,
+                        const std::vector<double>& jumps, bool real) {
   PolicySummary s;
-  const auto& f = r.frames;
   for (const FrameRow& row : f)
     if (row.nodes > 0 && !s.first_frame_s) s.first_frame_s = row.t;
   s.to_095_s = time_to_095(f, 0.0);
@@ -214,9 +212,9 @@ PolicySummary summarize(const SimResult& r, const ImageMetrics& m, double window
   for (const FrameRow& row : f) ms.push_back(row.frame_ms);
   s.frame_ms_p50 = percentile(ms, 50.0);
   s.frame_ms_p99 = percentile(ms, 99.0);
-  s.psnr_1s = psnr_at(f, m, 1.0);
-  s.psnr_2s = psnr_at(f, m, 2.0);
-  s.psnr_5s = psnr_at(f, m, 5.0);
+  s.psnr_1s = psnr_at(f, m, 1.0, real);
+  s.psnr_2s = psnr_at(f, m, 2.0, real);
+  s.psnr_5s = psnr_at(f, m, 5.0, real);
   return s;
 }
 
@@ -231,12 +229,12 @@ std::string fixed(const std::optional<double>& v, const char* format) {
   return buf;
 }
 
-std::string csv(const SimResult& r, const ImageMetrics& m) {
+std::string csv(const std::vector<FrameRow>& frames, const ImageMetrics& m) {
   std::string out =
       "t,bytes,nodes,triangles,pixel_error_max,pixel_error_mean,benefit_ratio,frame_ms,psnr,ssim\n";
   char buf[256];
-  for (size_t k = 0; k < r.frames.size(); ++k) {
-    const FrameRow& f = r.frames[k];
+  for (size_t k = 0; k < frames.size(); ++k) {
+    const FrameRow& f = frames[k];
     std::snprintf(buf, sizeof buf, "%.4f,%llu,%u,%llu,%.6g,%.6g,%.6f,%.3f,", f.t, (unsigned long long)f.bytes,
                   f.nodes, (unsigned long long)f.triangles, f.pixel_error_max, f.pixel_error_mean,
                   f.benefit_ratio, f.frame_ms);
@@ -256,23 +254,53 @@ void write_text(const fs::path& file, const std::string& text) {
   write_file_atomically(file, text.data(), text.size());
 }
 
-std::string summary_table(const std::vector<Policy>& policies, const std::vector<PolicySummary>& s) {
+// One policy's run in this benchmark: its frames (simulated or real), their image metrics and its summary.
+struct Run {
+  std::string name;  // the policy's name
+  std::vector<FrameRow> frames;
+  ImageMetrics metrics;
+  PolicySummary summary;
+};
+
+std::string table_row(const std::string& name, const PolicySummary& p) {
+  return "| " + name + " | " + fixed(p.first_frame_s, "%.2f") + " | " + fixed(p.to_095_s, "%.2f") + " | " +
+         fixed(p.benefit_auc, "%.3f") + " | " + fixed(double(p.bytes) / 1e6, "%.2f") + " | " +
+         fixed(p.psnr_1s, "%.1f") + " | " + fixed(p.psnr_2s, "%.1f") + " | " + fixed(p.psnr_5s, "%.1f") +
+         " | " + fixed(p.frame_ms_p50, "%.1f") + " / " + fixed(p.frame_ms_p99, "%.1f") + " |\n";
+}
+
+std::string summary_table(const std::vector<Run>& runs) {
   std::string out =
       "| policy | first frame (s) | benefit 0.95 (s) | benefit AUC | MB received | PSNR 1 s | PSNR 2 s | "
       "PSNR 5 s | frame ms p50 / p99 |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-  for (size_t i = 0; i < policies.size(); ++i) {
-    const PolicySummary& p = s[i];
-    out += "| " + std::string(policy_name(policies[i])) + " | " + fixed(p.first_frame_s, "%.2f") + " | " +
-           fixed(p.to_095_s, "%.2f") + " | " + fixed(p.benefit_auc, "%.3f") + " | " +
-           fixed(double(p.bytes) / 1e6, "%.2f") + " | " + fixed(p.psnr_1s, "%.1f") + " | " +
-           fixed(p.psnr_2s, "%.1f") + " | " + fixed(p.psnr_5s, "%.1f") + " | " +
-           fixed(p.frame_ms_p50, "%.1f") + " / " + fixed(p.frame_ms_p99, "%.1f") + " |\n";
-  }
+  for (const Run& r : runs) out += table_row(r.name, r.summary);
   return out;
 }
 
-// benefit.png, psnr.png and bytes.png through gnuplot (skipped with a warning when it is not installed).
-void plot(const fs::path& out, const std::vector<Policy>& policies, double window_s) {
+// How far the two modes agree: each real run's figures beside the simulated run of the same policy.
+std::string agreement_table(const std::vector<Run>& real, const std::vector<Run>& simulated) {
+  std::string out =
+      "| policy | first frame real / sim (s) | benefit 0.95 real / sim (s) | real - sim (s) | AUC real / sim "
+      "| "
+      "MB real / sim |\n|---|---:|---:|---:|---:|---:|\n";
+  for (const Run& r : real)
+    for (const Run& sim : simulated) {
+      if (sim.name != r.name) continue;
+      const PolicySummary &a = r.summary, &b = sim.summary;
+      const std::optional<double> difference =
+          a.to_095_s && b.to_095_s ? std::optional<double>(*a.to_095_s - *b.to_095_s) : std::nullopt;
+      out += "| " + r.name + " | " + fixed(a.first_frame_s, "%.2f") + " / " + fixed(b.first_frame_s, "%.2f") +
+             " | " + fixed(a.to_095_s, "%.2f") + " / " + fixed(b.to_095_s, "%.2f") + " | " +
+             fixed(difference, "%+.2f") + " | " + fixed(a.benefit_auc, "%.3f") + " / " +
+             fixed(b.benefit_auc, "%.3f") + " | " + fixed(double(a.bytes) / 1e6, "%.2f") + " / " +
+             fixed(double(b.bytes) / 1e6, "%.2f") + " |\n";
+    }
+  return out;
+}
+
+// benefit.png, psnr.png (when a frame was measured) and bytes.png through gnuplot (skipped with a warning
+// when it is not installed), one line per run, from out/NAME.csv.
+void plot(const fs::path& out, const std::vector<Run>& runs, double window_s) {
   std::string script =
       "set terminal pngcairo size 1000,560 font ',11'\nset datafile separator ','\n"
       "set key bottom right\nset grid\nset xlabel 'time (s)'\nset xrange [0:" +
@@ -282,16 +310,24 @@ void plot(const fs::path& out, const std::vector<Policy>& policies, double windo
     script +=
         "set output '" + (out / ("." + name + ".png.tmp")).string() + "'\nset ylabel '" + ylabel + "'\n";
     std::string cmd = "plot ";
-    for (size_t i = 0; i < policies.size(); ++i) {
+    for (size_t i = 0; i < runs.size(); ++i) {
       if (i) cmd += ", ";
-      const std::string file = (out / (std::string(policy_name(policies[i])) + ".csv")).string();
-      cmd += "'" + file + "' every ::1 using 1:(" + column + ") with " + style + " title '" +
-             policy_name(policies[i]) + "'";
+      const std::string file = (out / (runs[i].name + ".csv")).string();
+      cmd +=
+          "'" + file + "' every ::1 using 1:(" + column + ") with " + style + " title '" + runs[i].name + "'";
     }
     script += cmd + "\n";
   };
   plot_one("benefit", "benefit ratio", "$7", "steps lw 2");
-  plot_one("psnr", "PSNR (dB) against the full-resolution frame", "valid(9) ? $9 : NaN", "linespoints lw 2");
+  bool measured = false;  // gnuplot fails on a plot without a single point
+  for (const Run& r : runs)
+    for (double p : r.metrics.psnr) measured = measured || !std::isnan(p);
+  std::vector<std::string> plots{"benefit", "bytes"};
+  if (measured) {
+    plot_one("psnr", "PSNR (dB) against the full-resolution frame", "valid(9) ? $9 : NaN",
+             "linespoints lw 2");
+    plots.push_back("psnr");
+  }
   plot_one("bytes", "MB received", "$2/1e6", "steps lw 2");
   const fs::path gp = out / ".plots.gp";
   write_text(gp, script);
@@ -303,12 +339,36 @@ void plot(const fs::path& out, const std::vector<Policy>& policies, double windo
     return;
   }
   fs::remove(gp);
-  for (const char* name : {"benefit", "psnr", "bytes"})
-    fs::rename(out / ("." + std::string(name) + ".png.tmp"), out / (std::string(name) + ".png"));
+  for (const std::string& name : plots) fs::rename(out / ("." + name + ".png.tmp"), out / (name + ".png"));
+}
+
+// Records frame k's PSNR and SSIM against the full-resolution `reference` (PSNR of identical images capped
+// at 99 for the CSV).
+void measure_frame(ImageMetrics& m, size_t k, const Image& image, const Image& reference) {
+  const double p = psnr(image, reference);
+  m.psnr[k] = std::isinf(p) ? 99.0 : p;
+  m.ssim[k] = ssim(image, reference);
+}
+
+nlohmann::json policy_json(const Run& r) {
+  const PolicySummary& s = r.summary;
+  nlohmann::json after = nlohmann::json::array();
+  for (const auto& v : s.to_095_after_teleport_s) after.push_back(maybe(v));
+  return {{"time_to_first_frame_s", maybe(s.first_frame_s)},
+          {"time_to_095_s", maybe(s.to_095_s)},
+          {"benefit_auc", s.benefit_auc},
+          {"bytes", s.bytes},
+          {"psnr_at_1s", maybe(s.psnr_1s)},
+          {"psnr_at_2s", maybe(s.psnr_2s)},
+          {"psnr_at_5s", maybe(s.psnr_5s)},
+          {"frame_ms_p50", s.frame_ms_p50},
+          {"frame_ms_p99", s.frame_ms_p99},
+          {"time_to_095_after_teleport_s", after},
+          {"converged_s", maybe(s.converged_s)},
+          {"frames", r.frames.size()}};
 }
 
 int run_bench_stream(const StreamArgs& args) {
-  if (args.real) throw Error("--real is not implemented yet: run the simulated mode (without --real)");
   const LinkSettings link = parse_link(args.link);
   const std::vector<Policy> policies = parse_policies(args.policies);
   if (!(args.tau > 0.0)) throw Error("--pixel-error must be positive");
@@ -316,6 +376,8 @@ int run_bench_stream(const StreamArgs& args) {
   if (!(args.sample_every_s >= 0.0)) throw Error("--psnr-every must be at least 0");
   if (args.path.empty()) throw Error("--path: give a camera path file or gen:orbit|fly|drive|teleport");
   if (args.path.rfind("gen:", 0) != 0 && !fs::exists(args.path)) throw Error(args.path + ": no such file");
+  if (args.real && policies.size() == 1 && policies[0] == Policy::oracle)
+    throw Error("--real: oracle has no real counterpart (it needs the future path); add another policy");
   fs::create_directories(args.out);
   const fs::path out(args.out);
 
@@ -328,8 +390,11 @@ int run_bench_stream(const StreamArgs& args) {
   options.link = link;
   options.tau = args.tau;
   options.settle_s = args.settle_s;
-  options.sample_every_s = args.sample_every_s;
+  // --real simulates too, for the agreement figures, without image metrics (the real runs have theirs).
+  options.sample_every_s = args.real ? 0.0 : args.sample_every_s;
   const double window_s = path.end() - path.start() + options.settle_s;
+  write_text(out / "path.json",
+             path_json(path).dump() + "\n");  // the run's path (the real clients follow it)
 
   std::vector<SimResult> results;
   for (Policy p : policies) {
@@ -337,60 +402,103 @@ int run_bench_stream(const StreamArgs& args) {
     results.push_back(simulate(facts, path, p, options));
   }
   std::fprintf(stderr, "\n");
+  std::vector<Run> simulated;
+  for (const SimResult& r : results) {
+    Run run{policy_name(r.policy), r.frames, {}, {}};
+    run.metrics.psnr.assign(r.frames.size(), NAN);
+    run.metrics.ssim.assign(r.frames.size(), NAN);
+    simulated.push_back(std::move(run));
+  }
 
-  // Image metrics at the sampled frames.
-  std::vector<ImageMetrics> metrics(results.size());
+  std::unique_ptr<FrameRenderer> renderer;
+  auto frame_renderer = [&]() -> FrameRenderer& {
+    if (!renderer) renderer = std::make_unique<FrameRenderer>(reader, facts, file.parent_path());
+    return *renderer;
+  };
+  // Simulated mode: image metrics at the sampled frames; frames at 1, 2 and 5 s and the last one saved.
   size_t total = 0, done = 0;
   for (const SimResult& r : results) total += r.samples.size();
-  std::unique_ptr<FrameRenderer> renderer;
-  if (total > 0) {
-    renderer = std::make_unique<FrameRenderer>(reader, facts, file.parent_path());
-    fs::create_directories(out / "frames");
-  }
+  if (total > 0) fs::create_directories(out / "frames");
   for (size_t i = 0; i < results.size(); ++i) {
     const SimResult& r = results[i];
-    metrics[i].psnr.assign(r.frames.size(), NAN);
-    metrics[i].ssim.assign(r.frames.size(), NAN);
     for (const FrameSample& s : r.samples) {
       std::fprintf(stderr, "\rbench stream: image metrics %zu/%zu", ++done, total);
-      const Image& reference = renderer->reference(s.frame, s.camera);
-      const Image image = renderer->draw(s.camera, s.drawn);
-      const double p = psnr(image, reference);
-      metrics[i].psnr[s.frame] = std::isinf(p) ? 99.0 : p;  // identical images: capped for the CSV
-      metrics[i].ssim[s.frame] = ssim(image, reference);
+      const double t = r.frames[s.frame].t;
+      const Image& reference = frame_renderer().reference(t, s.camera);
+      const Image image = frame_renderer().draw(s.camera, s.drawn);
+      measure_frame(simulated[i].metrics, s.frame, image, reference);
       const bool saved = s.frame + 1 == r.frames.size() || s.frame == size_t(std::lround(options.fps)) ||
                          s.frame == size_t(std::lround(2 * options.fps)) ||
                          s.frame == size_t(std::lround(5 * options.fps));
       if (saved) {
         char name[64];
-        std::snprintf(name, sizeof name, "_%06.2fs.png", r.frames[s.frame].t);
+        std::snprintf(name, sizeof name, "_%06.2fs.png", t);
         save_png(image, out / "frames" / (policy_name(r.policy) + std::string(name)));
         save_png(reference, out / "frames" / ("reference" + std::string(name)));
       }
     }
   }
   if (total > 0) std::fprintf(stderr, "\n");
+  for (Run& r : simulated) r.summary = summarize(r.frames, r.metrics, window_s, jumps, false);
 
-  std::vector<PolicySummary> summaries;
+  // --real: each policy but oracle through serve, link and view; image metrics at the frames each view drew.
+  std::vector<Run> real;
+  if (args.real) {
+    RealOptions o;
+    o.package = fs::absolute(file);
+    o.path_file = fs::absolute(out / "path.json");
+    o.out = out / "real";
+    o.link = link;
+    o.tau = args.tau;
+    o.settle_s = args.settle_s;
+    o.path_duration_s = path.end() - path.start();
+    // Cuts recorded every second; those at 1, 2 and 5 s, every --psnr-every and the last are measured.
+    o.cuts_every = args.sample_every_s > 0.0 ? int(std::lround(options.fps)) : 0;
+    const long every_s = std::max(1L, std::lround(args.sample_every_s));
+    RealStream stream(o);
+    size_t count = 0;
+    for (Policy p : policies)
+      if (p != Policy::oracle) ++count;
+    for (Policy p : policies) {
+      if (p == Policy::oracle) continue;
+      const std::string label = "(" + std::to_string(real.size() + 1) + "/" + std::to_string(count) + ")";
+      RealRun r = stream.run(p, label);
+      Run run{policy_name(p), r.frames, {}, {}};
+      run.metrics.psnr.assign(r.frames.size(), NAN);
+      run.metrics.ssim.assign(r.frames.size(), NAN);
+      for (const auto& [k, drawn] : r.cuts) {
+        const long second = std::lround(r.frames[k].t);
+        if (k + 1 != r.frames.size() && second != 1 && second != 2 && second != 5 && second % every_s != 0)
+          continue;
+        // The view drew frame k at path time t (its clock since it started).
+        const Camera camera = path.pose_at(r.frames[k].t);
+        measure_frame(run.metrics, k, frame_renderer().draw(camera, drawn),
+                      frame_renderer().reference(r.frames[k].t, camera));
+      }
+      run.summary = summarize(run.frames, run.metrics, window_s, jumps, true);
+      real.push_back(std::move(run));
+    }
+    std::fprintf(stderr, "\n");
+  }
+
+  const std::vector<Run>& shown = args.real ? real : simulated;
   nlohmann::json json_policies = nlohmann::json::object();
-  for (size_t i = 0; i < results.size(); ++i) {
-    write_text(out / (std::string(policy_name(results[i].policy)) + ".csv"), csv(results[i], metrics[i]));
-    const PolicySummary s = summarize(results[i], metrics[i], window_s, jumps);
-    nlohmann::json after = nlohmann::json::array();
-    for (const auto& v : s.to_095_after_teleport_s) after.push_back(maybe(v));
-    json_policies[policy_name(results[i].policy)] = {{"time_to_first_frame_s", maybe(s.first_frame_s)},
-                                                     {"time_to_095_s", maybe(s.to_095_s)},
-                                                     {"benefit_auc", s.benefit_auc},
-                                                     {"bytes", s.bytes},
-                                                     {"psnr_at_1s", maybe(s.psnr_1s)},
-                                                     {"psnr_at_2s", maybe(s.psnr_2s)},
-                                                     {"psnr_at_5s", maybe(s.psnr_5s)},
-                                                     {"frame_ms_p50", s.frame_ms_p50},
-                                                     {"frame_ms_p99", s.frame_ms_p99},
-                                                     {"time_to_095_after_teleport_s", after},
-                                                     {"converged_s", maybe(s.converged_s)},
-                                                     {"frames", results[i].frames.size()}};
-    summaries.push_back(s);
+  for (const Run& r : shown) {
+    write_text(out / (r.name + ".csv"), csv(r.frames, r.metrics));
+    json_policies[r.name] = policy_json(r);
+  }
+  if (args.real) {
+    fs::create_directories(out / "simulated");
+    for (const Run& sim : simulated) {
+      write_text(out / "simulated" / (sim.name + ".csv"), csv(sim.frames, sim.metrics));
+      if (json_policies.contains(sim.name)) {
+        json_policies[sim.name]["mode"] = "real";
+        json_policies[sim.name]["simulated"] = policy_json(sim);
+      } else {
+        json_policies[sim.name] = policy_json(sim);  // oracle: no real counterpart
+        json_policies[sim.name]["mode"] = "simulated only";
+      }
+    }
   }
   const nlohmann::json summary = {
       {"policies", json_policies},
@@ -401,36 +509,52 @@ int run_bench_stream(const StreamArgs& args) {
       {"teleports_s", jumps},
       {"link", {{"bandwidth_bps", link.bandwidth_bps}, {"rtt_s", link.rtt_s}, {"jitter_s", link.jitter_s}}},
       {"pixel_error", args.tau},
-      {"mode", "simulated"}};
+      {"mode", args.real ? "real" : "simulated"}};
   write_text(out / "summary.json", summary.dump(2) + "\n");
-  write_text(out / "path.json", path_json(path).dump() + "\n");
   char head[512];
   std::snprintf(head, sizeof head,
-                "# bench stream: %s, path %s (%.1f s + %.1f s settle), link %.3g Mbit/s, RTT %.0f ms%s\n\n",
-                file.filename().c_str(), args.path.c_str(), path.end() - path.start(), options.settle_s,
-                link.bandwidth_bps / 1e6, link.rtt_s * 1e3,
+                "# bench stream%s: %s, path %s (%.1f s + %.1f s settle), link %.3g Mbit/s, RTT %.0f ms%s\n\n",
+                args.real ? " --real" : "", file.filename().c_str(), args.path.c_str(),
+                path.end() - path.start(), options.settle_s, link.bandwidth_bps / 1e6, link.rtt_s * 1e3,
                 link.jitter_s > 0 ? (", jitter " + std::to_string(link.jitter_s * 1e3) + " ms").c_str() : "");
-  const std::string md =
-      std::string(head) + summary_table(policies, summaries) +
-      "\nBenefit AUC: mean benefit ratio over the window (path + settle). PSNR against the "
-      "package's finest cut from the same camera (99.0: identical; '-': nothing sampled yet); a "
-      "policy's PSNR at t is its last sampled frame at or before t. Simulated mode; frame times from the "
-      "cost "
-      "model.\n";
+  std::string md = std::string(head) + summary_table(shown);
+  if (args.real) {
+    for (const Run& sim : simulated)
+      if (!json_policies[sim.name].contains("simulated"))
+        md += table_row(sim.name + " (simulated only)", sim.summary);
+    md +=
+        "\nReal mode: lodstream serve, a fresh lodstream link per policy and one headless lodstream view per "
+        "policy (fresh cache) on loopback, on the wall clock; frame ms = the client's measured frame (cut "
+        "selection), not the cost model; PSNR at t: the first frame at or after t whose cut the view "
+        "recorded, "
+        "drawn afterwards, against the package's finest cut from the same camera. MB: page bytes the "
+        "client installed (the simulation also counts HTTP and WebSocket headers). Logs and CSVs under "
+        "real/; "
+        "the simulated runs under simulated/.\n\n## How far the two modes agree\n\n" +
+        agreement_table(real, simulated);
+  } else {
+    md +=
+        "\nBenefit AUC: mean benefit ratio over the window (path + settle). PSNR against the package's "
+        "finest "
+        "cut from the same camera (99.0: identical; '-': nothing sampled yet); a policy's PSNR at t is its "
+        "last "
+        "sampled frame at or before t. Simulated mode; frame times from the cost model.\n";
+  }
   write_text(out / "summary.md", md);
-  plot(out, policies, window_s);
+  plot(out, shown, window_s);
   if (args.json)
     print_json(summary);
   else
     std::printf(
         "%s\nwritten to %s: summary.md, summary.json, POLICY.csv, benefit.png, psnr.png, bytes.png, "
-        "path.json, frames/\n",
-        md.c_str(), out.c_str());
+        "path.json, %s\n",
+        md.c_str(), out.c_str(), args.real ? "real/, simulated/" : "frames/");
   return 0;
 }
 
 const bool registered = register_bench(
-    {"stream", "streaming policies side by side on a simulated link: CSV, summary, plots", [](CLI::App& sub) {
+    {"stream", "streaming policies side by side on a simulated link (or --real): CSV, summary, plots",
+     [](CLI::App& sub) {
        auto args = std::make_shared<StreamArgs>();
        sub.add_option("SCENE", args->input, "a package (.lods), or a model to bake into --out first")
            ->required();
@@ -452,7 +576,8 @@ const bool registered = register_bench(
        sub.add_option("--up", args->up, "up axis X,Y,Z of a generated path")->capture_default_str();
        sub.add_option("--size", args->size, "image size WxH of a generated path")->capture_default_str();
        sub.add_flag("--real", args->real,
-                    "through lodstream serve and link on loopback (not implemented yet)");
+                    "also run each policy but oracle through lodstream serve, link and a headless view on "
+                    "loopback (wall clock), reporting them beside the simulation");
        sub.add_flag("--json", args->json, "print summary.json's object");
        sub.footer(
            "Example:\n  lodstream bench stream out/motorBike.lods --path gen:fly --up 0,0,1 --link "

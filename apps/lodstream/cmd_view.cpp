@@ -45,7 +45,9 @@ struct ViewOptions {
   std::string cache_dir;  // empty: the cache lives in memory only
   uint64_t budget = 0;    // 0: none
   std::string order = "benefit";
+  int window = 0;        // pull: requests outstanding at most, over as many connections (0: from the BDP)
   int frames_every = 0;  // 0: no images
+  int cuts_every = 0;    // 0: no cuts.csv
   bool json = false;
   // Window mode.
   uint64_t frames = 0;  // exit after this many frames (0: when the window closes)
@@ -71,6 +73,7 @@ ViewClientOptions client_options(const ViewOptions& opt, int width, int height) 
   o.cache_mb = opt.cache_mb;
   o.budget = opt.budget;
   o.order = opt.order;
+  o.window = opt.window;
   o.cache_dir = opt.cache_dir;
   o.width = width;
   o.height = height;
@@ -108,6 +111,9 @@ int run_headless(const ViewOptions& opt) {
   if (opt.path.empty()) throw Error("view --headless needs --path PATH.json");
   if (opt.out.empty()) throw Error("view --headless needs --out DIR");
   const schedule::CameraPath path = schedule::load_camera_path(opt.path);
+  // The clock starts before the package is opened: time to first frame includes connecting and the root
+  // index, as the user waits for them (and as bench stream's simulation counts them).
+  const Clock::time_point start = Clock::now();
   ViewClient client(opt.source, client_options(opt, path.width(), path.height()));
 
   const std::filesystem::path dir(opt.out);
@@ -134,16 +140,18 @@ int run_headless(const ViewOptions& opt) {
     save_png(renderer->read_pixels(), dir / name);
   };
   std::string csv = "t,bytes,nodes,triangles,pixel_error_max,pixel_error_mean,benefit_ratio,frame_ms\n";
+  std::string cuts = "frame,drawn\n";  // --cuts-every: the drawn nodes of recorded frames
   std::vector<double> frame_ms;
   std::optional<double> first_frame_s, time_095_s;
   runtime::Frame last;
   bool converged = false;
   double t = 0.0;
-  const Clock::time_point start = Clock::now();
+  // Frames keep to the 1/30 s slots since the start; the first is the first slot after the set-up.
+  const double first_slot = std::ceil(seconds_since(start) * kFrameRate);
   const double dt = 1.0 / kFrameRate;
   for (uint64_t i = 0;; ++i) {
-    std::this_thread::sleep_until(
-        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(double(i) * dt)));
+    std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
+                                              std::chrono::duration<double>((first_slot + double(i)) * dt)));
     const Clock::time_point frame_start = Clock::now();
     t = std::chrono::duration<double>(frame_start - start).count();
     const Camera pose = path.pose_at(t);
@@ -151,6 +159,13 @@ int run_headless(const ViewOptions& opt) {
     const bool final_pose = t >= path.end();
     const bool done = final_pose && (last.cut.converged() || t >= path.end() + opt.settle_s);
     if (geometry && (i % uint64_t(opt.frames_every) == 0 || done)) draw(i, last, pose);
+    if (opt.cuts_every && ((uint64_t(first_slot) + i) % uint64_t(opt.cuts_every) == 0 || done)) {
+      cuts += std::to_string(i) + ",";  // then OBJECT:NODE per drawn node, space-separated (none: empty)
+      for (const schedule::DrawnNode& d : last.cut.drawn)
+        cuts += (&d == last.cut.drawn.data() ? "" : " ") + std::to_string(d.object) + ":" +
+                std::to_string(d.node);
+      cuts += "\n";
+    }
     const double ms = 1e3 * seconds_since(frame_start);
     frame_ms.push_back(ms);
     if (!first_frame_s && !last.cut.drawn.empty()) first_frame_s = t;
@@ -165,6 +180,7 @@ int run_headless(const ViewOptions& opt) {
     if (done) break;
   }
   write_file(dir / "frames.csv", csv);
+  if (opt.cuts_every) write_file(dir / "cuts.csv", cuts);
 
   nlohmann::json j;
   j["duration_s"] = t;
@@ -288,8 +304,13 @@ int run_view(const ViewOptions& opt) {
   if (!(opt.settle_s >= 0.0) || !std::isfinite(opt.settle_s)) throw Error("--settle must be >= 0 seconds");
   if (!(opt.cache_mb > 0.0) || !std::isfinite(opt.cache_mb))
     throw Error("--cache must be a positive MB count");
-  if (opt.order != "benefit" && opt.order != "sse") throw Error("--order must be 'benefit' or 'sse'");
+  if (opt.order != "benefit" && opt.order != "sse" && opt.order != "full")
+    throw Error("--order must be 'benefit', 'sse' or 'full'");
+  if (opt.window < 0 || opt.window > 64) throw Error("--window must be in 0..64");
+  if (opt.source.rfind("ws://", 0) == 0 && (opt.order != "benefit" || opt.window))
+    throw Error("--order and --window are for pulling (http:// or a file), not ws://");
   if (opt.frames_every < 0) throw Error("--frames-every must be >= 0 (0: no images)");
+  if (opt.cuts_every < 0) throw Error("--cuts-every must be >= 0 (0: none)");
   return opt.headless ? run_headless(opt) : run_window(opt);
 }
 
@@ -314,8 +335,19 @@ const bool registered = register_command(
        sub.add_option("--cache-dir", opt->cache_dir,
                       "keep received pages in DIR/<package hash>/ and start from them (no page sent twice)");
        sub.add_option("--budget", opt->budget, "triangles drawn per frame at most (0: no limit)");
-       sub.add_option("--order", opt->order, "pull order: benefit (benefit per byte, predicted) or sse")
+       sub.add_option("--order", opt->order,
+                      "pull order: benefit (benefit per byte, predicted), sse, or full (the finest level's "
+                      "pages in file order, nothing drawn until all arrived)")
            ->capture_default_str();
+       sub.add_option(
+              "--window", opt->window,
+              "pull: at most N requests outstanding, over N connections (0: a window of bytes from the "
+              "measured bandwidth-delay product)")
+           ->capture_default_str();
+       sub.add_option("--cuts-every", opt->cuts_every,
+                      "write the drawn cut (a row per frame: its CSV row, then OBJECT:NODE per drawn node) "
+                      "to DIR/cuts.csv "
+                      "every N frames on the 1/30 s slots since the start, and the final frame (0: none)");
        sub.add_option("--frames-every", opt->frames_every,
                       "headless: write DIR/frame_NNNNN.png every N frames and the final frame (0: none)");
        sub.add_flag("--json", opt->json, "print a JSON summary");

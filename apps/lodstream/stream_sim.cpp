@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "core/error.hpp"
+#include "finest_cut.hpp"
 #include "net/push_protocol.hpp"
 #include "net/wire.hpp"
 #include "runtime/quality.hpp"
@@ -188,10 +189,7 @@ PackageFacts PackageFacts::of(package::PackageReader& reader) {
     p.nodes.push_back(reader.node(id));
     if (id >= p.root_nodes) p.index_page_of[id] = reader.index_page_of(id);
   }
-  p.finest_nodes.resize(p.scene.representations.size());
-  for (uint32_t id = 0; id < p.nodes.size(); ++id)
-    if (p.nodes[id].children.empty() && p.nodes[id].kind != package::NodeKind::hlod_proxy)
-      p.finest_nodes[p.nodes[id].representation].push_back(id);
+  p.finest_nodes = cli::finest_nodes(p.scene, AllNodes(p), uint32_t(p.nodes.size()));
   for (const package::IndexPage& ip : root.index_pages) p.index_page_bytes.push_back(ip.range.size);
   for (const package::Range& r : root.pages) p.page_bytes.push_back(r.size);
   const uint64_t file = reader.source().size();
@@ -201,32 +199,11 @@ PackageFacts PackageFacts::of(package::PackageReader& reader) {
 }
 
 std::vector<uint32_t> finest_pages(const PackageFacts& package) {
-  std::vector<uint32_t> pages;
-  for (const auto& nodes : package.finest_nodes)
-    for (uint32_t id : nodes) pages.push_back(package.nodes[id].page);
-  std::sort(pages.begin(), pages.end());
-  pages.erase(std::unique(pages.begin(), pages.end()), pages.end());
-  return pages;
+  return finest_pages(AllNodes(package), package.finest_nodes);
 }
 
 Cut finest_cut(const PackageFacts& package, const View& view) {
-  Cut cut;
-  const auto& objects = package.scene.objects;
-  cut.objects.assign(objects.size(), schedule::ObjectState::culled);
-  for (uint32_t o = 0; o < objects.size(); ++o) {
-    if (!schedule::in_frustum(schedule::object_sphere(package.scene, o), view)) continue;
-    cut.objects[o] = schedule::ObjectState::drawn;
-    const double scale = schedule::max_scale(objects[o].transform);
-    for (uint32_t id : package.finest_nodes[objects[o].representation]) {
-      const package::NodeRecord& n = package.nodes[id];
-      const double e = schedule::screen_error(
-          double(n.error) * scale, schedule::to_world(n.sphere, objects[o].transform, scale), view);
-      cut.drawn.push_back({o, id, e, n.triangles});
-      cut.triangles += n.triangles;
-    }
-  }
-  cut.ideal_triangles = cut.triangles;
-  return cut;
+  return finest_cut(package.scene, AllNodes(package), package.finest_nodes, view);
 }
 
 namespace {

@@ -76,13 +76,14 @@ struct CostModel {
 // of every part.
 struct PackageFacts {
   package::PackageScene scene;
-  std::vector<package::NodeRecord> nodes;           // every record, by id
-  uint32_t root_nodes = 0;                          // ids below are in the root index
-  std::vector<uint32_t> index_page_of;              // per node id >= root_nodes: its index page (else kNone)
-  std::vector<uint32_t> index_page_bytes;           // stored size of each index page
-  std::vector<uint32_t> page_bytes;                 // stored size of each data page
-  uint64_t root_fetch_bytes = 0;                    // the first suffix request's answer
-  std::vector<std::vector<uint32_t>> finest_nodes;  // per representation: its nodes with no children, no proxy
+  std::vector<package::NodeRecord> nodes;  // every record, by id
+  uint32_t root_nodes = 0;                 // ids below are in the root index
+  std::vector<uint32_t> index_page_of;     // per node id >= root_nodes: its index page (else kNone)
+  std::vector<uint32_t> index_page_bytes;  // stored size of each index page
+  std::vector<uint32_t> page_bytes;        // stored size of each data page
+  uint64_t root_fetch_bytes = 0;           // the first suffix request's answer
+  std::vector<std::vector<uint32_t>>
+      finest_nodes;  // per representation: its nodes with no children, no proxy
   std::shared_ptr<const package::PackageReader> reader;  // every index page loaded (the push server's)
 
   // Reads every index page of `reader` (one read each) and keeps a copy of it.
@@ -127,11 +128,9 @@ struct SimResult {
 SimResult simulate(const PackageFacts& package, const schedule::CameraPath& path, Policy policy,
                    const SimOptions& options);
 
-// The data pages holding finest-level nodes, sorted (file order): what `full` fetches.
+// finest_cut.hpp's finest_pages and finest_cut over the whole package: what `full` fetches and draws, and
+// what image metrics compare against.
 std::vector<uint32_t> finest_pages(const PackageFacts& package);
-
-// The finest cut for `view`: every finest-level node (no children) of every object in the frustum, each with
-// its projected error. What `full` draws and what image metrics compare against.
 schedule::Cut finest_cut(const PackageFacts& package, const schedule::View& view);
 
 }  // namespace lodstream::cli

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "core/error.hpp"
+#include "full_fetch.hpp"
 #include "net/http_source.hpp"
 #include "net/push_client.hpp"
 #include "net/url.hpp"
@@ -75,6 +76,15 @@ ViewClient::ViewClient(const std::string& source, const ViewClientOptions& optio
     fetch.connections = 1;
     fetch.min_window_bytes = 8u << 20;
   }
+  if (options.order == "full" || options.window > 0) {
+    if (options.window > 0) fetch.connections = options.window;
+    baseline_ = std::make_unique<PullFetcher>(std::move(make_source), arrived_, fetch);
+    if (options.order == "full") full_ = std::make_unique<FullFetch>();
+    window_ = options.window;
+    sse_ = options.order == "sse";
+    tau_ = options.pixel_error;
+    return;
+  }
   std::vector<schedule::PageRef> held;
   for (schedule::PageKind kind : {schedule::PageKind::data, schedule::PageKind::index})
     for (uint32_t id : client_.held(kind)) held.push_back({kind, id});
@@ -90,11 +100,33 @@ const char* ViewClient::mode() const {
 }
 
 uint64_t ViewClient::reconnects() const {
-  return puller_ ? puller_->reconnects() : pusher_->reconnects();
+  return puller_ ? puller_->reconnects() : baseline_ ? baseline_->reconnects() : pusher_->reconnects();
 }
 
 uint64_t ViewClient::plans() const {
   return puller_ ? puller_->plans() : 0;
+}
+
+void ViewClient::request_baseline(std::span<const schedule::WeightedView> predicted) {
+  if (full_) {
+    full_->request(client_, *baseline_);
+    return;
+  }
+  const package::RootIndex& root = client_.reader().root();
+  const uint64_t in_flight = baseline_->in_flight_bytes(), window = baseline_->window_bytes();
+  const size_t requests = client_.in_flight(), max_requests = size_t(window_);
+  if (window_ ? requests >= max_requests : in_flight >= window) return;
+  const schedule::ScheduleOptions s =
+      window_ ? schedule::ScheduleOptions{tau_, UINT64_MAX, max_requests - requests}
+              : schedule::ScheduleOptions{tau_, window - in_flight, SIZE_MAX};
+  const auto pages =
+      sse_ ? client_.scheduler().next_sse(client_.scene(), client_.nodes(), predicted[0].view, s)
+           : client_.scheduler().next(client_.scene(), client_.nodes(), predicted, s);
+  for (const schedule::PageRef& p : pages) {
+    client_.requested(p);
+    baseline_->request(p,
+                       p.kind == schedule::PageKind::data ? root.pages[p.id] : root.index_pages[p.id].range);
+  }
 }
 
 runtime::Frame ViewClient::frame(const schedule::ViewSample& now) {
@@ -103,11 +135,14 @@ runtime::Frame ViewClient::frame(const schedule::ViewSample& now) {
     client_.install(a.page.kind, a.page.id, a.bytes);
     if (disk_) disk_->store(a.page.kind, a.page.id, a.bytes);
   }
+  const auto predicted = schedule::predicted_views(now, 0.0);
   if (puller_)
     puller_->publish(now);
-  else
+  else if (pusher_)
     pusher_->send_view(view_update(now));
-  const auto predicted = schedule::predicted_views(now, 0.0);
+  else
+    request_baseline(predicted);
+  if (full_) return full_->frame(client_, predicted[0].view, tau_);
   std::vector<schedule::View> ahead;
   for (size_t k = 1; k < predicted.size(); ++k) ahead.push_back(predicted[k].view);
   runtime::Frame f = client_.frame(predicted[0].view, ahead, cut_options_);

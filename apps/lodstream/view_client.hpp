@@ -6,6 +6,8 @@
 // Threads: construct, call and destroy a ViewClient on one thread (the frame thread); it owns the
 // ClientPackage (package() is for that thread only). The transport runs on threads of its own: a pull or a
 // local file has a PullScheduler (its scheduler thread plus the fetcher's readers), a push a PushClient;
+// the benchmark's baselines (order `full`, or a window counted in requests) keep the way such clients work:
+// they schedule on the frame thread, over a PullFetcher of their own;
 // they hand pages over through a PageInbox and take view samples through their own locked slot, so a frame
 // never waits on the network or on scheduling.
 #pragma once
@@ -14,9 +16,11 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 
 #include "net/page_inbox.hpp"
+#include "net/pull_fetcher.hpp"
 #include "runtime/client_package.hpp"
 #include "runtime/disk_cache.hpp"
 #include "schedule/cut.hpp"
@@ -29,14 +33,18 @@ class PushClient;
 namespace lodstream::cli {
 
 class PullScheduler;
+class FullFetch;
 
 // Checked by the caller (cmd_view.cpp's option checks): positive finite pixel_error and cache_mb, a known
 // order.
 struct ViewClientOptions {
-  double pixel_error = 1.0;        // tau, pixels
-  double cache_mb = 1024.0;        // page cache budget
-  uint64_t budget = 0;             // triangles drawn per frame at most (0: no limit)
-  std::string order = "benefit";   // pull order: benefit or sse
+  double pixel_error = 1.0;       // tau, pixels
+  double cache_mb = 1024.0;       // page cache budget
+  uint64_t budget = 0;            // triangles drawn per frame at most (0: no limit)
+  std::string order = "benefit";  // pull order: benefit, sse or full (DESIGN.md's `full` policy)
+  // Pull: at most this many requests outstanding, over as many connections (0: a window of bytes from the
+  // measured bandwidth-delay product). The baselines of bench stream --real (sse-pull: 20, sse-pull-3: 3).
+  int window = 0;
   int width = 1280, height = 720;  // the viewport a push server is told in the hello
   // Pages received are kept under DIR/<package content hash>/ (runtime::DiskCache) and restored from it at
   // start: never fetched again, and listed in the push hello. Empty: the cache lives in memory only.
@@ -76,6 +84,9 @@ class ViewClient {
 
  private:
   enum class Mode { file, pull, push };
+  // The baselines' requests for this frame: what is due (order full), or the scheduler's next pages while
+  // the window (requests or bytes) has room. Frame thread.
+  void request_baseline(std::span<const schedule::WeightedView> predicted);
   Mode mode_;
   schedule::CutOptions cut_options_;
   std::filesystem::path package_dir_;
@@ -83,6 +94,12 @@ class ViewClient {
   std::optional<runtime::DiskCache> disk_;
   PageInbox arrived_;  // what the transport delivered, for the next frame
   std::unique_ptr<PullScheduler> puller_;
+  // The baselines: a fetcher scheduled from the frame thread; `full_` for order full.
+  std::unique_ptr<PullFetcher> baseline_;
+  std::unique_ptr<FullFetch> full_;
+  int window_ = 0;
+  bool sse_ = false;
+  double tau_ = 1.0;
   std::unique_ptr<PushClient> pusher_;
 };
 

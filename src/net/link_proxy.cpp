@@ -30,16 +30,17 @@ Clock::duration to_duration(double seconds) {
   return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
 }
 
-// One direction of one connection: reads from `from`, delays through the link model, writes to `to`.
+// One direction of one connection: reads from `from`, delays through `link` (that direction's bottleneck,
+// shared by every connection through the proxy), writes to `to`.
 class Pipe {
  public:
-  Pipe(std::shared_ptr<tcp::socket> from, std::shared_ptr<tcp::socket> to, const LinkSettings& settings,
-       Clock::time_point start)
+  Pipe(std::shared_ptr<tcp::socket> from, std::shared_ptr<tcp::socket> to,
+       std::shared_ptr<LinkDirection> link, double buffer_s, Clock::time_point start)
       : from_(std::move(from)),
         to_(std::move(to)),
-        link_(settings),
+        link_(std::move(link)),
         start_(start),
-        buffer_s_(std::max(settings.rtt_s, 0.02)),
+        buffer_s_(buffer_s),
         wake_(from_->get_executor()) {}
 
   // Coroutines take the owning pointer as a parameter: it is copied into the frame before the first
@@ -54,7 +55,7 @@ class Pipe {
     try {
       for (;;) {
         // Backpressure: the bottleneck queue holds at most buffer_s_ of transmission time.
-        double backlog = link_.busy_until() - seconds_since(start_);
+        double backlog = link_->busy_until() - seconds_since(start_);
         if (backlog > buffer_s_) {
           pause.expires_after(to_duration(backlog - buffer_s_));
           co_await pause.async_wait(use_awaitable);
@@ -62,7 +63,7 @@ class Pipe {
         size_t n = co_await from_->async_read_some(asio::buffer(buffer), use_awaitable);
         for (size_t off = 0; off < n; off += kPacket) {
           size_t len = std::min(kPacket, n - off);
-          double at = link_.send(seconds_since(start_), len);
+          double at = link_->send(seconds_since(start_), len);
           queue_.push_back({at, std::vector<uint8_t>(buffer.begin() + off, buffer.begin() + off + len)});
         }
         wake_.cancel();
@@ -70,7 +71,7 @@ class Pipe {
     } catch (const boost::system::system_error&) {
       // End of stream or error: deliver what is queued, then pass the end on.
     }
-    queue_.push_back({link_.send(seconds_since(start_), 0), {}});
+    queue_.push_back({link_->send(seconds_since(start_), 0), {}});
     wake_.cancel();
   }
 
@@ -117,7 +118,7 @@ class Pipe {
     std::vector<uint8_t> bytes;  // empty: the end of the stream
   };
   std::shared_ptr<tcp::socket> from_, to_;
-  LinkDirection link_;
+  std::shared_ptr<LinkDirection> link_;
   Clock::time_point start_;
   double buffer_s_;
   std::deque<Packet> queue_;
@@ -131,8 +132,10 @@ struct LinkProxy::Impl {
   tcp::acceptor acceptor{io};
   tcp::endpoint to;
   LinkSettings settings;
+  // One bottleneck each way, shared by every connection (as a client's access link is): a client with N
+  // connections gets the link's bandwidth, not N times it. One thread runs every pipe: no locking.
+  std::shared_ptr<LinkDirection> up, down;
   Clock::time_point start = Clock::now();
-  uint64_t connections = 0;
   std::thread thread;
 
   awaitable<void> accept_loop() {
@@ -153,13 +156,9 @@ struct LinkProxy::Impl {
     }
     client->set_option(tcp::no_delay(true));
     server->set_option(tcp::no_delay(true));
-    // Each direction gets its own jitter sequence, different for every connection but reproducible.
-    LinkSettings up = settings, down = settings;
-    up.seed = settings.seed + 2 * connections;
-    down.seed = up.seed + 1;
-    ++connections;
-    start_pipe(std::make_shared<Pipe>(client, server, up, start));
-    start_pipe(std::make_shared<Pipe>(server, client, down, start));
+    const double buffer_s = std::max(settings.rtt_s, 0.02);
+    start_pipe(std::make_shared<Pipe>(client, server, up, buffer_s, start));
+    start_pipe(std::make_shared<Pipe>(server, client, down, buffer_s, start));
   }
 
   void start_pipe(const std::shared_ptr<Pipe>& pipe) {
@@ -172,6 +171,11 @@ LinkProxy::LinkProxy(const std::string& listen_host, uint16_t listen_port, const
                      uint16_t to_port, const LinkSettings& settings)
     : impl_(std::make_unique<Impl>()) {
   impl_->settings = settings;
+  // Each direction gets its own jitter sequence, reproducible.
+  LinkSettings down = settings;
+  ++down.seed;
+  impl_->up = std::make_shared<LinkDirection>(settings);
+  impl_->down = std::make_shared<LinkDirection>(down);
   boost::system::error_code ec;
   auto listen_address = asio::ip::make_address(listen_host, ec);
   if (ec) throw Error("--listen: '" + listen_host + "' is not an IP address");

@@ -1,8 +1,10 @@
-// Link emulator: a TCP proxy that shapes each direction of every connection through it with a LinkDirection
-// (token bucket + delay line, net/link_model.hpp). `lodstream link` runs one; tests and benchmarks put it in
-// front of `lodstream serve` or nginx, so shaping is applied exactly once. The bottleneck holds at most one
-// bandwidth-delay product (at least 20 ms) of unsent bytes; beyond that the proxy stops reading and TCP's own
-// flow control pushes back on the sender, as a router's finite queue does.
+// Link emulator: a TCP proxy that shapes each direction with one LinkDirection (token bucket + delay line,
+// net/link_model.hpp) shared by every connection through it, as a client's access link is shared: N parallel
+// connections together get the link's bandwidth, in the order their bytes reached the bottleneck.
+// `lodstream link` runs one; tests and benchmarks put it in front of `lodstream serve` or nginx, so shaping
+// is applied exactly once. The bottleneck holds at most one bandwidth-delay product (at least 20 ms) of
+// unsent bytes; beyond that the proxy stops reading and TCP's own flow control pushes back on the senders, as
+// a router's finite queue does.
 #pragma once
 
 #include <cstdint>

@@ -65,6 +65,15 @@ std::vector<Row> rows(const fs::path& csv) {
   return out;
 }
 
+// A fixed camera looking at the elephant, written into `dir` (created).
+fs::path static_path(const fs::path& dir) {
+  fs::create_directories(dir);
+  const fs::path path = dir / "static-path.json";
+  std::ofstream(path) << R"({"fov": 50, "size": [320, 180], "keyframes": [{"t": 0, "eye": [0.2, 0.3, 1.4],
+                           "target": [0, 0, 0]}]})";
+  return path;
+}
+
 }  // namespace
 
 // Same input, same outputs: every CSV (image metrics included) and summary.json, byte for byte.
@@ -89,10 +98,7 @@ TEST(BenchStream, SimulatedRunsAreReproducibleByteForByte) {
 // `full` draws nothing until every byte it fetches has arrived.
 TEST(BenchStream, EveryPolicyConvergesOnAStaticPathAndFullWaitsForEverything) {
   const fs::path dir = test::temp_dir() / "static";
-  fs::create_directories(dir);
-  const fs::path path = dir / "path.json";
-  std::ofstream(path) << R"({"fov": 50, "size": [320, 180], "keyframes": [{"t": 0, "eye": [0.2, 0.3, 1.4],
-                           "target": [0, 0, 0]}]})";
+  const fs::path path = static_path(dir);
   auto r = bench(dir, {"--path", path.string(), "--psnr-every", "0", "--settle", "20", "--json"});
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json summary = r.json();
@@ -166,6 +172,56 @@ TEST(BenchStream, OutputsFollowTheContract) {
   }
 }
 
+// --real: lodstream serve, a lodstream link per policy and a headless lodstream view per policy on loopback.
+// A fixed camera and a fast link keep it to a few seconds: every real policy converges (benefit 1 at the last
+// row), the summary sets the simulated figures beside the real ones (oracle simulated only), and every child
+// process was stopped (serve and link log their stop signal).
+TEST(BenchStream, RealModeRunsEveryPolicyThroughServeLinkAndView) {
+  const fs::path dir = test::temp_dir() / "real";
+  const fs::path path = static_path(dir);
+  auto r = test::run_lodstream({"bench", "stream", elephant_package().string(), "--real", "--path",
+                                path.string(), "--link", "bandwidth=20mbit,rtt=20ms", "--settle", "5",
+                                "--psnr-every", "1", "--out", dir.string(), "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json summary = r.json();
+  EXPECT_EQ(summary["mode"], "real");
+  EXPECT_EQ(summary, nlohmann::json::parse(slurp(dir / "summary.json")));
+  const std::string md = slurp(dir / "summary.md");
+  EXPECT_NE(md.find("How far the two modes agree"), std::string::npos) << md;
+  for (const std::string p : {"full", "sse-pull", "sse-pull-3", "push"}) {
+    SCOPED_TRACE(p);
+    const auto& s = summary["policies"][p];
+    EXPECT_EQ(s["mode"], "real");
+    for (const char* key : {"time_to_first_frame_s", "time_to_095_s", "benefit_auc", "bytes", "psnr_at_1s",
+                            "psnr_at_2s", "psnr_at_5s", "frame_ms_p50", "frame_ms_p99"}) {
+      EXPECT_TRUE(s.contains(key)) << key;
+      EXPECT_TRUE(s["simulated"].contains(key)) << key;
+    }
+    EXPECT_FALSE(s["converged_s"].is_null());
+    EXPECT_FALSE(s["time_to_095_s"].is_null());
+    EXPECT_FALSE(s["simulated"]["time_to_095_s"].is_null());
+    EXPECT_FALSE(s["psnr_at_5s"].is_null());  // the view's last frame was drawn and compared
+    EXPECT_GT(s["psnr_at_5s"].get<double>(), 30.0);
+    const std::vector<Row> f = rows(dir / (p + ".csv"));
+    ASSERT_FALSE(f.empty());
+    EXPECT_EQ(f.back().benefit, 1.0);
+    EXPECT_EQ(f.back().bytes, s["bytes"].get<uint64_t>());
+    EXPECT_EQ(slurp(dir / (p + ".csv")).rfind(kHeader, 0), 0u);
+    EXPECT_TRUE(fs::exists(dir / "simulated" / (p + ".csv")));
+    EXPECT_NE(md.find("| " + p + " |"), std::string::npos) << md;
+    EXPECT_NE(slurp(dir / "real" / p / "link.log").find("stopped by signal"), std::string::npos);
+  }
+  EXPECT_EQ(summary["policies"]["oracle"]["mode"], "simulated only");
+  EXPECT_NE(md.find("| oracle (simulated only) |"), std::string::npos) << md;
+  // full drew nothing before all it fetched had arrived
+  for (const Row& row : rows(dir / "full.csv")) {
+    if (row.bytes < summary["policies"]["full"]["bytes"].get<uint64_t>()) {
+      EXPECT_EQ(row.nodes, 0u) << row.t;
+    }
+  }
+  EXPECT_NE(slurp(dir / "real" / "serve.log").find("stopped by signal"), std::string::npos);
+}
+
 TEST(BenchStream, BadArgumentsAreOneLineErrors) {
   const fs::path out = test::temp_dir() / "bad";
   const std::string pkg = elephant_package().string();
@@ -175,7 +231,7 @@ TEST(BenchStream, BadArgumentsAreOneLineErrors) {
       {{"--path", "gen:orbit", "--link", "bandwidth=fast,rtt=80ms"}, "--link bandwidth"},
       {{"--path", "gen:spiral"}, "gen:spiral"},
       {{"--path", (out / "none.json").string()}, "none.json"},
-      {{"--path", "gen:orbit", "--real"}, "--real"},
+      {{"--path", "gen:orbit", "--real", "--policy", "oracle"}, "--real"},
       {{"--path", "gen:orbit", "--up", "0,0"}, "--up"},
   };
   for (const auto& [extra, what] : cases) {

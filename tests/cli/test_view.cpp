@@ -27,6 +27,28 @@ TEST(View, ALocalFileConvergesForAFixedCamera) {
   expect_converged(v, "file");
 }
 
+// --order full (bench stream's `full` policy): nothing is drawn until every page it fetches has arrived,
+// then the finest cut (more triangles than the converged cut at tau). --window N (the sse-pull baselines'
+// request window) converges as the byte window does.
+TEST(View, OrderFullDrawsNothingUntilTheFinestLevelArrivedAndAWindowOfRequestsConverges) {
+  const auto path = camera_path({}, {0.0f, 0.5f, 8.0f}, 0);  // far: the cut at tau is coarser than the finest
+  Server server;
+  const auto full = view(server.http(), path, {"--order", "full"});
+  expect_converged(full, "pull");
+  ASSERT_FALSE(full.rows.empty());
+  const double total = full.rows.back().at(1);
+  for (const auto& row : full.rows) {
+    if (row.at(1) < total) {
+      EXPECT_EQ(row.at(2), 0.0) << "t=" << row.at(0);  // nodes
+    }
+  }
+  const auto windowed = view(server.http(), path, {"--order", "sse", "--window", "3"});
+  expect_converged(windowed, "pull");
+  // the finest level: more triangles than the converged cut at tau, and no error left
+  EXPECT_GT(full.rows.back().at(3), windowed.rows.back().at(3));
+  EXPECT_EQ(full.rows.back().at(4), 0.0);
+}
+
 TEST(View, PullsFromServeAndFromNginxAndIsPushedTo) {
   const auto path = camera_path({0.0f, 0.0f, 3.0f}, {0.8f, 0.2f, 0.8f}, 1.0);
   Server server;
@@ -171,6 +193,15 @@ TEST(View, BadInputIsAOneLineError) {
   expect_error(test::run_lodstream({"view", test::elephant_package().string(), "--headless", "--path",
                                     path.string(), "--out", out, "--pixel-error", "0"}),
                "--pixel-error");
+  expect_error(test::run_lodstream({"view", test::elephant_package().string(), "--headless", "--path",
+                                    path.string(), "--out", out, "--order", "warp"}),
+               "--order");
+  expect_error(test::run_lodstream({"view", test::elephant_package().string(), "--headless", "--path",
+                                    path.string(), "--out", out, "--window", "65"}),
+               "--window");
+  expect_error(test::run_lodstream({"view", "ws://127.0.0.1:1/elephant", "--headless", "--path",
+                                    path.string(), "--out", out, "--order", "full"}),
+               "--order");
   // A window without an X display: GLFW's reason, in one line.
   const char* display = std::getenv("DISPLAY");
   const std::string saved = display ? display : "";

@@ -118,6 +118,44 @@ TEST(LinkProxy, AddsTheRoundTripTimeAndLimitsThroughput) {
   EXPECT_EQ(server.received, 1u + bulk.size());
 }
 
+// Two connections at once share the link's bandwidth (one bottleneck each way, as an access link): 2 x 200 KB
+// at 4 Mbit/s take at least 0.8 s, where a link per connection would take 0.4 s.
+TEST(LinkProxy, ParallelConnectionsShareTheBandwidth) {
+  asio::io_context io;
+  tcp::acceptor acceptor(io, tcp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
+  // The server: reads each of two connections to its end, then closes it.
+  std::thread server([&] {
+    std::vector<std::thread> readers;
+    for (int k = 0; k < 2; ++k)
+      readers.emplace_back([s = std::make_shared<tcp::socket>(acceptor.accept())] {
+        std::vector<uint8_t> buf(65536);
+        boost::system::error_code ec;
+        while (!ec) s->read_some(asio::buffer(buf), ec);
+      });
+    for (auto& r : readers) r.join();
+  });
+  LinkProxy proxy("127.0.0.1", 0, "127.0.0.1", acceptor.local_endpoint().port(), {4e6, 0.02, 0.0, 1});
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<double> done(2, 0.0);
+  std::vector<std::thread> clients;
+  for (int k = 0; k < 2; ++k)
+    clients.emplace_back([&, k] {
+      asio::io_context cio;
+      tcp::socket s(cio);
+      s.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), proxy.port()));
+      asio::write(s, asio::buffer(std::vector<uint8_t>(200000, 7)));
+      s.shutdown(tcp::socket::shutdown_send);
+      uint8_t byte = 0;
+      boost::system::error_code ec;
+      s.read_some(asio::buffer(&byte, 1), ec);  // end of stream: the server read everything
+      done[k] = since(t0);
+    });
+  for (auto& c : clients) c.join();
+  server.join();
+  EXPECT_GE(std::max(done[0], done[1]), 0.8 + 0.01);
+  EXPECT_LT(std::max(done[0], done[1]), 0.8 + 0.01 + 1.0);
+}
+
 TEST(LinkProxy, RejectsAnAddressItCannotBind) {
   asio::io_context io;
   tcp::acceptor taken(io, tcp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
