@@ -136,37 +136,33 @@ TEST(View, AWindowUnderXvfbDrawsWhatItStreamedAndExitsAfterItsFrames) {
     EXPECT_EQ(r.status, 0) << r.err;
     return r.status == 0 ? r.json() : nlohmann::json::object();
   };
+  // The run's summary (45 frames of `mode`, bytes and triangles) and its screenshot: width x height, at least
+  // 1/min_share of it covered, mostly in the middle.
+  auto expect_drawn = [](const nlohmann::json& j, const char* mode, const std::filesystem::path& shot,
+                         int width, int height, size_t min_share) {
+    EXPECT_EQ(j["mode"], mode);
+    EXPECT_EQ(j["frames"], 45);
+    EXPECT_GT(j["bytes"].get<uint64_t>(), 0u);
+    EXPECT_GT(j["triangles"].get<uint64_t>(), 0u);
+    const Image image = load_image(shot);
+    ASSERT_EQ(image.width, width);
+    ASSERT_EQ(image.height, height);
+    const auto [covered, middle] = covered_pixels(image);
+    EXPECT_GT(covered, size_t(width * height) / min_share) << "the frame is (nearly) empty";
+    EXPECT_GT(middle, covered / 2);
+  };
   {
     // Pulled, starting at the path's first key frame: the elephant in the middle of a 640x480 window.
     SCOPED_TRACE("pull, --path");
     const auto shot = test::temp_dir() / "window_pull.png";
     const auto path = camera_path({}, {0.0f, 0.2f, 1.5f}, 0);
-    const auto j = window({"view", server.http(), "--path", path.string()}, shot);
-    EXPECT_EQ(j["mode"], "pull");
-    EXPECT_EQ(j["frames"], 45);
-    EXPECT_GT(j["bytes"].get<uint64_t>(), 0u);
-    EXPECT_GT(j["triangles"].get<uint64_t>(), 0u);
-    const Image image = load_image(shot);
-    ASSERT_EQ(image.width, 640);
-    ASSERT_EQ(image.height, 480);
-    const auto [covered, middle] = covered_pixels(image);
-    EXPECT_GT(covered, size_t(image.width * image.height / 50)) << "the frame is (nearly) empty";
-    EXPECT_GT(middle, covered / 2);
+    expect_drawn(window({"view", server.http(), "--path", path.string()}, shot), "pull", shot, 640, 480, 50);
   }
   {
     // Pushed, with no path: the start pose is fitted to the scene's bounds (3 radii out, at its centre).
     SCOPED_TRACE("push, fitted start");
     const auto shot = test::temp_dir() / "window_push.png";
-    const auto j = window({"view", server.ws(), "--size", "320x240"}, shot);
-    EXPECT_EQ(j["mode"], "push");
-    EXPECT_EQ(j["frames"], 45);
-    EXPECT_GT(j["bytes"].get<uint64_t>(), 0u);
-    EXPECT_GT(j["triangles"].get<uint64_t>(), 0u);
-    const Image image = load_image(shot);
-    ASSERT_EQ(image.width, 320);
-    const auto [covered, middle] = covered_pixels(image);
-    EXPECT_GT(covered, size_t(image.width * image.height / 200)) << "the frame is (nearly) empty";
-    EXPECT_GT(middle, covered / 2);
+    expect_drawn(window({"view", server.ws(), "--size", "320x240"}, shot), "push", shot, 320, 240, 200);
   }
   EXPECT_EQ(server.process.stop(), 0);
 }
