@@ -171,10 +171,13 @@ int run_bake(const BakeArgs& args) {
   std::vector<PositionGrid> grids(scene.meshes.size());
   std::atomic<size_t> done_triangles{0};
   std::mutex progress_mutex;
+  int shown_percent = -1;  // the bar is redrawn when the percentage changes (not per cluster batch)
   auto report = [&](size_t add) {
     const size_t done = done_triangles += add;
     std::lock_guard lock(progress_mutex);
     const int percent = int(100.0 * double(done) / double(std::max<size_t>(1, unique_triangles)));
+    if (percent == shown_percent) return;
+    shown_percent = percent;
     std::fprintf(stderr, "\rbake: hierarchy [%-40s] %3d%% %.1f s",
                  std::string(size_t(percent * 40 / 100), '#').c_str(), percent, elapsed());
     std::fflush(stderr);
