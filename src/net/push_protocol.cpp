@@ -68,7 +68,9 @@ std::optional<wire::Message> PushProtocol::on_message(const wire::Message& messa
       throw wire::WireError("wire: view message: up is parallel to forward");
     view_ = s;
     view_received_s_ = now_s;
-    planned_.clear();  // re-planned from the new prediction at the next send
+    if (!planned_view_s_ || s.time_s < *planned_view_s_ ||
+        s.time_s - *planned_view_s_ >= options_.replan_interval_s)
+      planned_.clear();  // re-planned from the new prediction at the next send
     ++counters_.views;
   } else if (std::holds_alternative<wire::Bye>(message)) {
     ended_ = true;
@@ -91,6 +93,7 @@ void PushProtocol::plan(double now_s, uint64_t bytes) {
     const double lead = (now_s - view_received_s_) + 0.5 * link_.rtt_s();
     const auto views = schedule::predicted_views(*view_, lead, options_.horizons);
     pages = scheduler_.next(reader.scene(), package_->records, views, {options_.tau, bytes, SIZE_MAX});
+    planned_view_s_ = view_->time_s;
   }
   if (pages.empty() && options_.fill_when_idle) {
     // The rest in file order, index pages first, while the client's cache has room.
@@ -119,7 +122,7 @@ std::optional<PageToSend> PushProtocol::next_page(double now_s) {
   if (in_flight >= window) return std::nullopt;
   while (!planned_.empty() && scheduler_.held(planned_.front().kind, planned_.front().id))
     planned_.pop_front();
-  if (planned_.empty()) plan(now_s, window - in_flight);
+  if (planned_.empty()) plan(now_s, uint64_t(options_.plan_windows * double(window)));
   if (planned_.empty()) return std::nullopt;
   const PageRef page = planned_.front();
   planned_.pop_front();

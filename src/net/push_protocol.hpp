@@ -10,10 +10,14 @@
 // takes to arrive), index pages before the data pages that need their records; never a page the client holds
 // (Hello's held runs, when its hash is this package's) or was sent. At most `window_bdp` estimated
 // bandwidth-delay products (schedule::LinkEstimator, fed by the acknowledgements) are in flight, at least
-// `min_window_bytes`; so what waits, waits here, where a new view re-orders it: the plan is dropped on every
-// ViewUpdate and re-made from the new prediction. When the scheduler has nothing to send (no view yet, or
-// every predicted view's ideal cut sent) and `fill_when_idle` is set, the rest of the package follows in file
-// order (index pages first), up to the client's cache budget: seed 003's "coffee break".
+// `min_window_bytes`; so what waits, waits here, where a new view re-orders it: the plan is dropped on a
+// ViewUpdate at least `replan_interval_s` (client time) after the view it was made from, and re-made from the
+// new prediction. A plan covers `plan_windows` windows, so that acknowledgements do not each cost a plan (one
+// cut per predicted view: on a 5.7M-triangle package through a 10 Mbit/s link, a plan per acknowledgement and
+// per view update kept the server's core busy and the link a fifth used). When the scheduler has nothing to
+// send (no view yet, or every predicted view's ideal cut sent) and `fill_when_idle` is set, the rest of the
+// package follows in file order (index pages first), up to the client's cache budget: seed 003's "coffee
+// break".
 //
 // Time is the caller's (seconds on any monotonic clock). Cost: a plan is one PageScheduler::next (one cut per
 // predicted view) for a window's worth of pages.
@@ -52,6 +56,8 @@ struct PushProtocolOptions {
   double tau = 1.0;                     // target pixel error of the client's cut
   schedule::PredictionHorizons horizons;
   bool fill_when_idle = true;
+  double replan_interval_s = 0.1;  // a new view drops the plan when its sample is at least this much newer
+  double plan_windows = 4.0;       // a plan covers this many windows' worth of pages
 };
 
 // A page the shell is to send now: read `page`'s stored bytes and send them as wire::Page{sequence,
@@ -107,6 +113,7 @@ class PushProtocol {
   size_t remaining_ = 0;  // pages neither held nor sent
   std::optional<schedule::ViewSample> view_;
   double view_received_s_ = 0.0;
+  std::optional<double> planned_view_s_;  // client time of the view sample the current plan was made from
   std::deque<schedule::PageRef> planned_;
   bool plan_converged_ = false;  // the scheduler had nothing for the current views
   uint32_t sequence_ = 0, acked_ = 0;
