@@ -11,7 +11,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <memory>
 #include <optional>
 #include <thread>
@@ -81,13 +80,7 @@ ViewClientOptions client_options(const ViewOptions& opt, int width, int height) 
 }
 
 void write_file(const std::filesystem::path& file, const std::string& text) {
-  const auto tmp = file.string() + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    f << text;
-    if (!f) throw Error(file.string() + ": cannot write");
-  }
-  std::filesystem::rename(tmp, file);
+  write_file_atomically(file, text.data(), text.size());
 }
 
 // Summary of a run, printed as JSON (--json) or one line.
@@ -280,10 +273,7 @@ int run_window(const ViewOptions& opt) {
     }
   }
   if (!opt.screenshot.empty()) {
-    const Image image = renderer.read_pixels();
-    const auto tmp = opt.screenshot + ".tmp.png";
-    save_png(image, tmp);
-    std::filesystem::rename(tmp, opt.screenshot);
+    save_png(renderer.read_pixels(), opt.screenshot);  // atomic: temporary file, then rename
   }
   nlohmann::json j;
   j["duration_s"] = seconds_since(start_time);
