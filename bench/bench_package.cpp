@@ -3,7 +3,8 @@
 //
 //   bench_package [--mesh=FILE] [--normal-bits=N] [--zstd-level=L] [google benchmark flags]
 //
-// Before the timings it prints the size table: bytes per triangle of the whole package and where they go
+// Every figure is measured for codec 1 (meshoptimizer's codecs) and codec 2 (predicted positions and normals)
+// side by side in one run (benchmark argument = codec id). Before the timings it prints the size table: bytes per triangle of the whole package and where they go
 // (positions, normals, UVs, connectivity, index), each measured after zstd by encoding with and without the
 // attribute. Timings report triangles per second on one core: encode (codec), write (codec + zstd + file),
 // decode (checksum + zstd + codec, from pages in memory) and decode of the codec alone.
@@ -14,6 +15,7 @@
 #include <cstring>
 #include <ctime>
 #include <filesystem>
+#include <map>
 #include <string>
 
 #include "core/error.hpp"
@@ -92,7 +94,7 @@ const Meshlets& meshlets() {
 
 enum Attributes { kPositions = 0, kNormals = 1, kUvs = 2, kAll = 3 };
 
-std::vector<std::vector<uint8_t>> encode_all(const Meshlets& m, int attributes) {
+std::vector<std::vector<uint8_t>> encode_all(const Meshlets& m, int attributes, const NodeCodec& codec) {
   std::vector<std::vector<uint8_t>> out;
   out.reserve(m.chunks.size());
   for (size_t i = 0; i < m.chunks.size(); ++i) {
@@ -108,15 +110,16 @@ std::vector<std::vector<uint8_t>> encode_all(const Meshlets& m, int attributes) 
     g.mesh = mesh;
     g.locked = m.locked[i];
     g.normal_bits = g_normal_bits;
-    out.push_back(default_node_codec().encode(g, m.grid));
+    out.push_back(codec.encode(g, m.grid));
   }
   return out;
 }
 
 WrittenPackage write_package(const Meshlets& m, const std::vector<std::vector<uint8_t>>& nodes,
-                             const std::filesystem::path& file, int zstd_level) {
+                             const std::filesystem::path& file, int zstd_level, const NodeCodec& codec) {
   WriterOptions options;
   options.zstd_level = zstd_level;
+  options.codec = codec.id();
   PackageWriter writer(file, options);
   PackageScene scene;
   scene.input_triangles = m.triangles;
@@ -148,7 +151,7 @@ std::filesystem::path temp_file(const char* name) {
 }
 
 // zstd-compressed bytes of the index streams alone, paged like the package (connectivity after zstd).
-size_t connectivity_bytes(const std::vector<std::vector<uint8_t>>& nodes, int level) {
+size_t connectivity_bytes(const std::vector<std::vector<uint8_t>>& nodes, int level, const NodeCodec& codec) {
   size_t total = 0;
   std::vector<uint8_t> page;
   auto flush = [&] {
@@ -156,7 +159,7 @@ size_t connectivity_bytes(const std::vector<std::vector<uint8_t>>& nodes, int le
     page.clear();
   };
   for (size_t i = 0; i < nodes.size(); ++i) {
-    NodeSizeBreakdown b = default_node_codec().breakdown(nodes[i], "node");
+    NodeSizeBreakdown b = codec.breakdown(nodes[i], "node");
     auto first = nodes[i].begin() + std::ptrdiff_t(b.header + b.vertices + b.locked);
     page.insert(page.end(), first, first + std::ptrdiff_t(b.indices));
     if (i % 8 == 7 && page.size() > 36 * 1024) flush();
@@ -165,8 +168,9 @@ size_t connectivity_bytes(const std::vector<std::vector<uint8_t>>& nodes, int le
   return total;
 }
 
-void print_sizes() {
+void print_sizes(const NodeCodec& codec) {
   const Meshlets& m = meshlets();
+  std::printf("== codec %u\n", codec.id());
   const double T = double(m.triangles);
   std::printf("mesh %s: %zu triangles, %zu vertices, %zu meshlets (64 v / 124 t), normals %s, uvs %s\n",
               g_mesh_file.filename().c_str(), m.triangles, m.mesh.vertex_count(), m.chunks.size(),
@@ -174,18 +178,19 @@ void print_sizes() {
   std::printf(
       "grid step %.3g = 2^-14 of the diagonal; normals %u bits octahedral; zstd level %d; 48 KiB pages\n",
       double(m.grid.step), g_normal_bits, g_zstd_level);
-  const auto all = encode_all(m, kAll);
+  const auto all = encode_all(m, kAll, codec);
   size_t pre_zstd = 0, index_pre = 0, vertex_pre = 0, locked_pre = 0, header_pre = 0;
   for (const auto& n : all) {
-    NodeSizeBreakdown b = default_node_codec().breakdown(n, "node");
+    NodeSizeBreakdown b = codec.breakdown(n, "node");
     pre_zstd += n.size(), index_pre += b.indices, vertex_pre += b.vertices, locked_pre += b.locked,
         header_pre += b.header;
   }
-  WrittenPackage full = write_package(m, all, temp_file("bench_all.lods"), g_zstd_level);
-  WrittenPackage pos = write_package(m, encode_all(m, kPositions), temp_file("bench_pos.lods"), g_zstd_level);
+  WrittenPackage full = write_package(m, all, temp_file("bench_all.lods"), g_zstd_level, codec);
+  WrittenPackage pos =
+      write_package(m, encode_all(m, kPositions, codec), temp_file("bench_pos.lods"), g_zstd_level, codec);
   WrittenPackage pos_n =
-      write_package(m, encode_all(m, kNormals), temp_file("bench_posn.lods"), g_zstd_level);
-  const size_t conn = connectivity_bytes(all, g_zstd_level);
+      write_package(m, encode_all(m, kNormals, codec), temp_file("bench_posn.lods"), g_zstd_level, codec);
+  const size_t conn = connectivity_bytes(all, g_zstd_level, codec);
   std::printf("before zstd: %.3f B/tri (vertex stream %.3f, index stream %.3f, node headers %.3f)\n",
               pre_zstd / T, vertex_pre / T, index_pre / T, header_pre / T);
   std::printf(
@@ -199,7 +204,7 @@ void print_sizes() {
       (double(full.page_bytes) - pos_n.page_bytes) / T, (full.bytes - full.page_bytes) / T);
   for (int level : {3, 9, 15, 19}) {
     const double t0 = thread_cpu_seconds();
-    WrittenPackage w = write_package(m, all, temp_file("bench_level.lods"), level);
+    WrittenPackage w = write_package(m, all, temp_file("bench_level.lods"), level, codec);
     const double s = thread_cpu_seconds() - t0;
     std::printf(
         "  zstd level %2d: %.3f B/tri, pages written at %.2f M tri/s (zstd + file, CPU time, one core)\n",
@@ -213,13 +218,16 @@ void print_sizes() {
 
 void BM_Encode(benchmark::State& state) {
   const Meshlets& m = meshlets();
-  for (auto _ : state) benchmark::DoNotOptimize(encode_all(m, kAll));
+  const NodeCodec& codec = node_codec(uint32_t(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(encode_all(m, kAll, codec));
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(m.triangles));
 }
 
 void BM_EncodeAndWrite(benchmark::State& state) {
   const Meshlets& m = meshlets();
-  for (auto _ : state) write_package(m, encode_all(m, kAll), temp_file("bench_write.lods"), g_zstd_level);
+  const NodeCodec& codec = node_codec(uint32_t(state.range(0)));
+  for (auto _ : state)
+    write_package(m, encode_all(m, kAll, codec), temp_file("bench_write.lods"), g_zstd_level, codec);
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(m.triangles));
   std::filesystem::remove(temp_file("bench_write.lods"));
 }
@@ -230,10 +238,14 @@ struct Loaded {
   std::vector<std::vector<uint32_t>> nodes_of_page;
 };
 
-const Loaded& loaded() {
-  static const Loaded l = [] {
+const Loaded& loaded(uint32_t id) {
+  static std::map<uint32_t, Loaded> all;
+  if (auto it = all.find(id); it != all.end()) return it->second;
+  return all[id] = [id] {
+    const NodeCodec& codec = node_codec(id);
     Loaded r;
-    write_package(meshlets(), encode_all(meshlets(), kAll), temp_file("bench_read.lods"), g_zstd_level);
+    write_package(meshlets(), encode_all(meshlets(), kAll, codec), temp_file("bench_read.lods"), g_zstd_level,
+                  codec);
     r.reader = std::make_unique<PackageReader>(PackageReader::open(temp_file("bench_read.lods")));
     for (uint32_t p = 0; p < r.reader->root().pages.size(); ++p) {
       const Range& range = r.reader->root().pages[p];
@@ -246,11 +258,10 @@ const Loaded& loaded() {
       r.nodes_of_page[r.reader->node(id).page].push_back(id);
     return r;
   }();
-  return l;
 }
 
 void BM_Decode(benchmark::State& state) {
-  const Loaded& l = loaded();
+  const Loaded& l = loaded(uint32_t(state.range(0)));
   for (auto _ : state) {
     for (size_t p = 0; p < l.stored.size(); ++p) {
       std::vector<uint8_t> raw = l.reader->unpack_page(uint32_t(p), l.stored[p]);
@@ -261,7 +272,7 @@ void BM_Decode(benchmark::State& state) {
 }
 
 void BM_DecodeCodecOnly(benchmark::State& state) {
-  const Loaded& l = loaded();
+  const Loaded& l = loaded(uint32_t(state.range(0)));
   std::vector<std::vector<uint8_t>> raw;
   for (size_t p = 0; p < l.stored.size(); ++p) raw.push_back(l.reader->unpack_page(uint32_t(p), l.stored[p]));
   for (auto _ : state) {
@@ -272,10 +283,10 @@ void BM_DecodeCodecOnly(benchmark::State& state) {
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(meshlets().triangles));
 }
 
-BENCHMARK(BM_Encode)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_EncodeAndWrite)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Decode)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_DecodeCodecOnly)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Encode)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EncodeAndWrite)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Decode)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DecodeCodecOnly)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
@@ -296,7 +307,7 @@ int main(int argc, char** argv) {
   int n = int(rest.size());
   benchmark::Initialize(&n, rest.data());
   try {
-    print_sizes();
+    for (uint32_t id : {1u, 2u}) print_sizes(node_codec(id));
   } catch (const lodstream::Error& e) {
     std::fprintf(stderr, "bench_package: error: %s\n", e.what());
     return 1;

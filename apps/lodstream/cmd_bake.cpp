@@ -40,6 +40,8 @@
 #include "hierarchy/cluster_dag.hpp"
 #include "hierarchy/hlod.hpp"
 #include "io/import.hpp"
+#include "package/meshopt_codec.hpp"
+#include "package/predictive_codec.hpp"
 #include "package/writer.hpp"
 #include "schedule/screen_error.hpp"
 
@@ -54,6 +56,7 @@ struct BakeArgs {
   bool json = false, hlod = false;
   uint32_t normal_bits = 10;
   int max_grid_bits = 20;
+  uint32_t codec = default_node_codec().id();
 };
 
 uint64_t peak_rss_bytes() {
@@ -159,6 +162,8 @@ int run_bake(const BakeArgs& args) {
   };
   if (args.normal_bits < 4 || args.normal_bits > 16) throw Error("--normal-bits: must be in 4..16");
   if (args.max_grid_bits < 14 || args.max_grid_bits > 20) throw Error("--max-grid-bits: must be in 14..20");
+  if (args.codec != MeshoptCodec::kId && args.codec != PredictiveCodec::kId)
+    throw Error("--codec: must be 1 or 2");
   Scene scene = import_all(args.models);
   const uint64_t input_triangles = scene.triangle_count();
   const size_t unique_triangles = scene.unique_triangle_count();
@@ -346,8 +351,10 @@ int run_bake(const BakeArgs& args) {
   });
 
   // Encode (parallel, a batch of page groups at a time) and write (serial).
-  PackageWriter writer(args.output);
-  const NodeCodec& codec = default_node_codec();
+  WriterOptions writer_options;
+  writer_options.codec = args.codec;
+  PackageWriter writer(args.output, writer_options);
+  const NodeCodec& codec = node_codec(args.codec);
   NodeSizeBreakdown breakdown;
   size_t first = 0;
   std::vector<std::vector<uint8_t>> encoded;
@@ -466,6 +473,8 @@ const bool registered = register_command(
            ->required();
        sub.add_option("-o,--output", args->output, "the package to write (.lods)")->required();
        sub.add_option("--normal-bits", args->normal_bits, "octahedral normal bits per component (4..16)");
+       sub.add_option("--codec", args->codec,
+                      "node codec: 2 = predicted positions and normals (default), 1 = meshoptimizer's codecs");
        sub.add_option("--max-grid-bits", args->max_grid_bits,
                       "finest grid: at most 2^-N of a mesh's diagonal (14..20, default 20), fewer when its "
                       "vertices stay apart with fewer");

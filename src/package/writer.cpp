@@ -106,7 +106,7 @@ WrittenPackage PackageWriter::finish(PackageScene scene, std::vector<NodeRecord>
   }
 
   RootIndex root;
-  root.codec = default_node_codec().id();
+  root.codec = node_codec(options_.codec).id();
   root.scene = std::move(scene);
   root.pages = std::move(pages_);
   root.blobs = std::move(blobs_);

@@ -33,6 +33,8 @@ struct WriterOptions {
   int zstd_level = 9;
   // Node records per index page (ids beyond the root index's).
   uint32_t nodes_per_index_page = 1024;
+  // The codec id the root index names (the one that encoded the nodes added): node_codec(codec) must exist.
+  uint32_t codec = default_node_codec().id();
 };
 
 struct WrittenPackage {

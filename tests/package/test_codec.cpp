@@ -1,13 +1,17 @@
-// The node codec on its own: octahedral normals, empty and oversized nodes, progressive-mesh chunks, wide
-// position ranges, and robustness against corrupted node bytes.
+// The node codecs on their own (every test runs on codec 1 and codec 2): octahedral normals, empty and
+// oversized nodes, progressive-mesh chunks, wide position ranges, attributes, locked vertices, and robustness
+// against corrupted node bytes.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 
 #include "core/error.hpp"
+#include "package/format.hpp"
 #include "package/meshopt_codec.hpp"
+#include "package/predictive_codec.hpp"
 #include "package/octahedral.hpp"
 #include "support/shapes.hpp"
 
@@ -36,18 +40,22 @@ TEST(Octahedral, AngularErrorShrinksWithBits) {
   EXPECT_EQ(oct_decode(0, 0, 1.0f / 127), glm::vec3(0, 0, 1));
 }
 
-TEST(MeshoptCodec, EmptyNodeRoundTrips) {
+class NodeCodecTest : public ::testing::TestWithParam<uint32_t> {};
+INSTANTIATE_TEST_SUITE_P(Codecs, NodeCodecTest, ::testing::Values(MeshoptCodec::kId, PredictiveCodec::kId),
+                         [](const auto& info) { return "codec" + std::to_string(info.param); });
+
+TEST_P(NodeCodecTest, EmptyNodeRoundTrips) {
   Mesh empty;
   NodeGeometry g;
   g.mesh = &empty;
-  const MeshoptCodec codec;
+  const NodeCodec& codec = node_codec(GetParam());
   DecodedNode d = codec.decode(codec.encode(g, PositionGrid{}), PositionGrid{}, "empty");
   EXPECT_EQ(d.mesh.vertex_count(), 0u);
   EXPECT_EQ(d.mesh.triangle_count(), 0u);
 }
 
-TEST(MeshoptCodec, RejectsInvalidInput) {
-  const MeshoptCodec codec;
+TEST_P(NodeCodecTest, RejectsInvalidInput) {
+  const NodeCodec& codec = node_codec(GetParam());
   Mesh big;
   big.positions.resize(65537);
   NodeGeometry g;
@@ -65,7 +73,7 @@ TEST(MeshoptCodec, RejectsInvalidInput) {
   EXPECT_THROW(codec.encode(g, PositionGrid::for_bounds(grid(2).bounds())), Error);
 }
 
-TEST(MeshoptCodec, ProgressiveChunkKeepsOrderExternalIndicesAndVertexData) {
+TEST_P(NodeCodecTest, ProgressiveChunkKeepsOrderExternalIndicesAndVertexData) {
   // A chunk whose vertices are 100.. of its representation and whose triangles also use earlier vertices.
   Mesh m = grid(3);
   const uint32_t first = 100;
@@ -78,7 +86,7 @@ TEST(MeshoptCodec, ProgressiveChunkKeepsOrderExternalIndicesAndVertexData) {
   g.first_vertex = first;
   g.vertex_data = data;
   const PositionGrid pg = PositionGrid::for_bounds(m.bounds());
-  const MeshoptCodec codec;
+  const NodeCodec& codec = node_codec(GetParam());
   DecodedNode d = codec.decode(codec.encode(g, pg), pg, "chunk");
   EXPECT_EQ(d.first_vertex, first);
   EXPECT_EQ(d.vertex_data, data);
@@ -95,13 +103,13 @@ TEST(MeshoptCodec, ProgressiveChunkKeepsOrderExternalIndicesAndVertexData) {
   }
 }
 
-TEST(MeshoptCodec, WidePositionRangeStaysExact) {
+TEST_P(NodeCodecTest, WidePositionRangeStaysExact) {
   // 2^20 steps across: more than 16 bits per coordinate.
   Mesh m = sphere(1.0f, 8, 16);
   const PositionGrid pg = PositionGrid::for_bounds(m.bounds(), 20);
   NodeGeometry g;
   g.mesh = &m;
-  const MeshoptCodec codec;
+  const NodeCodec& codec = node_codec(GetParam());
   DecodedNode d = codec.decode(codec.encode(g, pg), pg, "wide");
   ASSERT_EQ(d.mesh.vertex_count(), m.vertex_count());
   // Every decoded vertex lies within one (tiny) step of an original one.
@@ -112,7 +120,7 @@ TEST(MeshoptCodec, WidePositionRangeStaysExact) {
   }
 }
 
-TEST(MeshoptCodec, PositionsDecodeExactlyOnTheGrid) {
+TEST_P(NodeCodecTest, PositionsDecodeExactlyOnTheGrid) {
   // Every decoded position must be the grid value of an input vertex, bit for bit (free vertices rounded to
   // the node's shift), on a smooth mesh, a noisy one (large deltas between neighbours) and a shifted node.
   Mesh smooth = sphere(1.0f, 10, 12);
@@ -126,7 +134,7 @@ TEST(MeshoptCodec, PositionsDecodeExactlyOnTheGrid) {
       NodeGeometry g;
       g.mesh = m;
       g.position_shift = shift;
-      const MeshoptCodec codec;
+      const NodeCodec& codec = node_codec(GetParam());
       const DecodedNode d = codec.decode(codec.encode(g, pg), pg, "grid");
       ASSERT_EQ(d.mesh.vertex_count(), m->vertex_count());
       ASSERT_EQ(d.mesh.triangle_count(), m->triangle_count());
@@ -146,7 +154,80 @@ TEST(MeshoptCodec, PositionsDecodeExactlyOnTheGrid) {
     }
 }
 
-TEST(MeshoptCodec, CorruptedNodeBytesGiveErrorsOrValidMeshes) {
+TEST_P(NodeCodecTest, AttributesAndLockedVerticesRoundTrip) {
+  // A node at shift 3 with every attribute; vertex_data numbers the input vertices, so that each decoded
+  // vertex (the codec reorders them) is compared with its own input.
+  Mesh m = uv_sphere(1.0f, 9, 14);
+  m.colors.resize(m.vertex_count());
+  std::vector<uint32_t> id(m.vertex_count());
+  std::vector<uint8_t> locked(m.vertex_count());
+  for (size_t v = 0; v < m.vertex_count(); ++v) {
+    m.colors[v] = glm::vec4(float(v % 7) / 6.0f, 0.25f, 1.0f, float(v % 3) / 2.0f);
+    id[v] = uint32_t(v);
+    locked[v] = v % 4 == 0;
+  }
+  const uint32_t shift = 3, bits = 10;
+  const PositionGrid pg = PositionGrid::for_bounds(m.bounds(), 14);
+  NodeGeometry g;
+  g.mesh = &m;
+  g.locked = locked;
+  g.position_shift = shift;
+  g.normal_bits = bits;
+  g.vertex_data = id;
+  const NodeCodec& codec = node_codec(GetParam());
+  const DecodedNode d = codec.decode(codec.encode(g, pg), pg, "attributes");
+  ASSERT_EQ(d.mesh.vertex_count(), m.vertex_count());
+  ASSERT_EQ(d.vertex_data.size(), m.vertex_count());
+  const glm::vec2 uv_extent(1.0f);  // uv_sphere spans [0,1]^2
+  for (size_t v = 0; v < d.mesh.vertex_count(); ++v) {
+    const uint32_t o = d.vertex_data[v];
+    ASSERT_LT(o, m.vertex_count());
+    const glm::vec3 p = d.mesh.positions[v];
+    if (locked[o]) {  // exactly the finest-grid value
+      for (int a = 0; a < 3; ++a) {
+        const double q = std::round((double(m.positions[o][a]) - double(pg.origin[a])) / double(pg.step));
+        EXPECT_EQ(p[a], pg.origin[a] + float(q) * pg.step) << "locked vertex " << o;
+      }
+    } else {  // within half a finest step plus half a coarse step per axis
+      for (int a = 0; a < 3; ++a)
+        EXPECT_LE(std::abs(p[a] - m.positions[o][a]), (0.5f + 0.5f * float(1 << shift)) * pg.step * 1.001f);
+    }
+    const glm::dvec3 a(d.mesh.normals[v]), b(glm::normalize(m.normals[o]));
+    EXPECT_LT(std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)), std::ldexp(5.0, -int(bits)));
+    EXPECT_NEAR(d.mesh.uvs[v].x, m.uvs[o].x, uv_extent.x / 65535.0f);
+    EXPECT_NEAR(d.mesh.uvs[v].y, m.uvs[o].y, uv_extent.y / 65535.0f);
+    for (int c = 0; c < 4; ++c) EXPECT_NEAR(d.mesh.colors[v][c], m.colors[o][c], 0.5f / 255.0f + 1e-6f);
+  }
+  // The same triangles with the same winding (each possibly rotated, in another order).
+  auto canonical = [](std::array<uint32_t, 3> t) {
+    std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+    return t;
+  };
+  std::vector<std::array<uint32_t, 3>> expected, got;
+  for (size_t t = 0; t < m.triangle_count(); ++t)
+    expected.push_back(canonical({m.indices[3 * t], m.indices[3 * t + 1], m.indices[3 * t + 2]}));
+  for (size_t t = 0; t < d.mesh.triangle_count(); ++t)
+    got.push_back(canonical({d.vertex_data[d.mesh.indices[3 * t]], d.vertex_data[d.mesh.indices[3 * t + 1]],
+                             d.vertex_data[d.mesh.indices[3 * t + 2]]}));
+  std::sort(expected.begin(), expected.end());
+  std::sort(got.begin(), got.end());
+  EXPECT_EQ(got, expected);
+}
+
+TEST(PredictiveCodec, SmoothMeshTakesFewerBytesThanCodecOneAfterZstd) {
+  // On a smooth sphere, parallelogram-predicted positions and normals predicted from the decoded triangles
+  // leave small residuals: after zstd (as the writer stores pages) codec 2 must be clearly smaller.
+  Mesh m = sphere(1.0f, 24, 48);
+  compute_smooth_normals(m);
+  const PositionGrid pg = PositionGrid::for_bounds(m.bounds(), 14);
+  NodeGeometry g;
+  g.mesh = &m;
+  auto stored = [&](uint32_t id) { return zstd_compress(node_codec(id).encode(g, pg), 9).size(); };
+  const size_t one = stored(MeshoptCodec::kId), two = stored(PredictiveCodec::kId);
+  EXPECT_LT(double(two), 0.8 * double(one)) << "codec 1: " << one << " bytes, codec 2: " << two;
+}
+
+TEST_P(NodeCodecTest, CorruptedNodeBytesGiveErrorsOrValidMeshes) {
   Mesh m = uv_sphere(1.0f, 6, 12);
   std::vector<uint8_t> locked(m.vertex_count());
   for (size_t v = 0; v < locked.size(); v += 3) locked[v] = 1;
@@ -155,7 +236,7 @@ TEST(MeshoptCodec, CorruptedNodeBytesGiveErrorsOrValidMeshes) {
   g.locked = locked;
   g.position_shift = 3;
   const PositionGrid pg = PositionGrid::for_bounds(m.bounds());
-  const MeshoptCodec codec;
+  const NodeCodec& codec = node_codec(GetParam());
   const std::vector<uint8_t> good = codec.encode(g, pg);
   size_t errors = 0, decoded = 0;
   auto attempt = [&](std::span<const uint8_t> bytes) {

@@ -1,0 +1,365 @@
+#include "package/predictive_codec.hpp"
+
+#include <meshoptimizer.h>
+
+#include <algorithm>
+#include <cstring>
+
+#include "core/error.hpp"
+#include "package/bytes.hpp"
+#include "package/coarse_positions.hpp"
+#include "package/octahedral.hpp"
+#include "package/quantized_node.hpp"
+#include "package/vertex_attributes.hpp"
+
+namespace lodstream::package {
+
+namespace {
+
+constexpr uint8_t kFormat = 1;
+constexpr uint32_t kAllFlags = kHasNormals | kHasUvs | kHasColors | kHasVertexData;
+constexpr uint32_t kNone = UINT32_MAX;
+constexpr uint32_t kMaxPositionBytes = 5, kMaxNormalBytes = 3;
+// Decoded coarse coordinates stay within ±2^32 (valid ones within ±2^31), so no chain of predictions from
+// hostile residuals (< 2^40) overflows int64.
+constexpr int64_t kMaxCoarse = int64_t(1) << 32;
+
+uint64_t zigzag(int64_t v) {
+  return (static_cast<uint64_t>(v) << 1) ^ static_cast<uint64_t>(v >> 63);
+}
+int64_t unzigzag(uint64_t v) {
+  return static_cast<int64_t>(v >> 1) ^ -static_cast<int64_t>(v & 1);
+}
+uint32_t bytes_for(uint64_t largest) {
+  uint32_t n = 1;
+  while (n < 8 && (largest >> (8 * n)) != 0) ++n;
+  return n;
+}
+
+// Calls visit(v, o1, o2, o) for every vertex of the node once, in the walk order of the header comment, with
+// the predictors: o1 + o2 - o (parallelogram), o1 alone (o2 == kNone) or none (o1 == kNone; then predict
+// from the previously visited vertex, or cmin). Every predictor was visited before. `last` is scratch (V
+// entries). O(T + V).
+template <class Visit>
+void walk(std::span<const uint32_t> indices, uint32_t first_vertex, uint32_t V, std::vector<uint32_t>& last,
+          Visit&& visit) {
+  // last[v]: kNone until v is visited, then kVisited until its first triangle is done, then the latest
+  // triangle using v (set when the triangle is done, so the lookup across an edge never finds the current one).
+  constexpr uint32_t kVisited = kNone - 1;
+  const uint32_t triangles = uint32_t(indices.size() / 3);
+  last.assign(V, kNone);
+  auto across = [&](uint32_t t, uint32_t o1, uint32_t o2) -> uint32_t {
+    if (t >= triangles) return kNone;
+    const uint32_t* u = &indices[3 * size_t(t)];
+    const uint32_t a = u[0] - first_vertex, b = u[1] - first_vertex, c = u[2] - first_vertex;
+    uint32_t o = kNone;
+    if (a == o2 && b == o1) o = c;
+    if (b == o2 && c == o1) o = a;
+    if (c == o2 && a == o1) o = b;
+    return o < V && last[o] != kNone ? o : kNone;
+  };
+  uint32_t previous = kNone;
+  for (uint32_t t = 0; t < triangles; ++t) {
+    const uint32_t l[3] = {indices[3 * size_t(t)] - first_vertex, indices[3 * size_t(t) + 1] - first_vertex,
+                           indices[3 * size_t(t) + 2] - first_vertex};
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = l[k];
+      if (v >= V || last[v] != kNone) continue;
+      const uint32_t o1 = l[k == 2 ? 0 : k + 1], o2 = l[k == 0 ? 2 : k - 1];
+      const bool known1 = o1 < V && last[o1] != kNone, known2 = o2 < V && last[o2] != kNone;
+      if (known1 && known2) {
+        uint32_t o = across(last[o1], o1, o2);
+        if (o == kNone) o = across(last[o2], o1, o2);
+        if (o != kNone)
+          visit(v, o1, o2, o);
+        else
+          visit(v, o1, kNone, kNone);
+      } else if (known1 || known2) {
+        visit(v, known1 ? o1 : o2, kNone, kNone);
+      } else {
+        visit(v, previous, kNone, kNone);
+      }
+      last[v] = kVisited;
+      previous = v;
+    }
+    for (uint32_t v : l)
+      if (v < V) last[v] = t;
+  }
+  for (uint32_t v = 0; v < V; ++v)
+    if (last[v] == kNone) visit(v, previous, kNone, kNone), last[v] = kVisited, previous = v;
+}
+
+int64_t predict(const int64_t* c, uint32_t o1, uint32_t o2, uint32_t o, int a, int64_t cmin) {
+  if (o1 == kNone) return cmin;
+  if (o2 == kNone) return c[3 * size_t(o1) + a];
+  return c[3 * size_t(o1) + a] + c[3 * size_t(o2) + a] - c[3 * size_t(o) + a];
+}
+
+// Area-weighted vertex normals of the node's own triangles (those whose corners are all in the node), over
+// `positions`: sum of cross(p1 - p0, p2 - p0). O(T + V).
+void predicted_normals(std::span<const uint32_t> indices, uint32_t first_vertex, const glm::vec3* positions,
+                       uint32_t V, std::vector<glm::vec3>& sum) {
+  sum.assign(V, glm::vec3(0.0f));
+  for (size_t i = 0; i + 2 < indices.size(); i += 3) {
+    const uint32_t a = indices[i] - first_vertex, b = indices[i + 1] - first_vertex,
+                   c = indices[i + 2] - first_vertex;
+    if (a >= V || b >= V || c >= V) continue;
+    const glm::vec3 n = glm::cross(positions[b] - positions[a], positions[c] - positions[a]);
+    sum[a] += n, sum[b] += n, sum[c] += n;
+  }
+}
+
+struct Parsed {
+  uint32_t flags = 0, shift = 0, normal_bits = 0, vertices = 0, triangles = 0, first_vertex = 0;
+  uint32_t position_bytes = 0, normal_bytes = 0;
+  int64_t cmin[3] = {0, 0, 0};
+  glm::vec2 uv_min{0.0f}, uv_extent{0.0f};
+  size_t header_size = 0;
+  std::span<const uint8_t> position_planes, normal_planes, attribute_stream, locked_stream, index_stream;
+};
+
+Parsed parse(std::span<const uint8_t> bytes, const std::string& where) {
+  ByteReader r(bytes, where);
+  Parsed p;
+  if (r.u8() != kFormat) r.fail("unknown node format");
+  p.flags = r.u8();
+  if (p.flags & ~kAllFlags) r.fail("unknown node flags");
+  p.shift = r.u8();
+  if (p.shift > kMaxPositionShift) r.fail("position shift " + std::to_string(p.shift) + " too large");
+  p.normal_bits = r.u8();
+  if ((p.flags & kHasNormals) && (p.normal_bits < 4 || p.normal_bits > 16)) r.fail("invalid normal bits");
+  const uint8_t widths = r.u8();
+  p.position_bytes = widths & 15, p.normal_bytes = widths >> 4;
+  if (p.position_bytes < 1 || p.position_bytes > kMaxPositionBytes || p.normal_bytes > kMaxNormalBytes ||
+      (p.normal_bytes == 0) != !(p.flags & kHasNormals))
+    r.fail("invalid residual widths");
+  uint64_t v = r.varint();
+  if (v > kMaxNodeVertices) r.fail("vertex count " + std::to_string(v) + " exceeds 65536");
+  p.vertices = static_cast<uint32_t>(v);
+  // meshopt's index stream spends at least one byte per triangle, so a count above the node's size is a lie.
+  uint64_t t = r.varint();
+  if (t > bytes.size()) r.fail("triangle count " + std::to_string(t) + " impossible for a node of this size");
+  p.triangles = static_cast<uint32_t>(t);
+  uint64_t first = r.varint();
+  if (first > UINT32_MAX - p.vertices) r.fail("first vertex out of range");
+  p.first_vertex = static_cast<uint32_t>(first);
+  for (int64_t& c : p.cmin) {
+    c = r.svarint();
+    if (c < -kMaxGridCoordinate * 2 || c > kMaxGridCoordinate * 2) r.fail("grid coordinate out of range");
+  }
+  if (p.flags & kHasUvs) {
+    p.uv_min = {r.finite_f32("uv"), r.finite_f32("uv")};
+    p.uv_extent = {r.finite_f32("uv"), r.finite_f32("uv")};
+  }
+  const uint64_t attribute_size = r.varint(), locked_size = r.varint(), index_size = r.varint();
+  p.header_size = r.position();
+  const uint64_t planes = uint64_t(p.vertices) * (3 * p.position_bytes + 2 * p.normal_bytes);
+  if (planes > r.remaining() || attribute_size > r.remaining() - planes ||
+      locked_size > r.remaining() - planes - attribute_size ||
+      index_size != r.remaining() - planes - attribute_size - locked_size)
+    r.fail("stream sizes do not add up to the node size");
+  p.position_planes = r.bytes(size_t(3) * p.position_bytes * p.vertices, "position residuals");
+  p.normal_planes = r.bytes(size_t(2) * p.normal_bytes * p.vertices, "normal residuals");
+  p.attribute_stream = r.bytes(attribute_size, "attribute stream");
+  p.locked_stream = r.bytes(locked_size, "locked stream");
+  p.index_stream = r.bytes(index_size, "index stream");
+  return p;
+}
+
+// Value i of `count` values stored as `width` byte planes starting at plane `first` (plane stride count).
+inline uint64_t plane_value(const uint8_t* planes, size_t count, uint32_t width, uint32_t first, uint32_t step,
+                            size_t i) {
+  uint64_t value = 0;
+  for (uint32_t b = 0; b < width; ++b) value |= uint64_t(planes[(first + b * step) * count + i]) << (8 * b);
+  return value;
+}
+
+void put_planes(std::vector<uint8_t>& out, const std::vector<uint64_t>& values, uint32_t components,
+                uint32_t width) {
+  const size_t count = values.size() / components;
+  const size_t at = out.size();
+  out.resize(at + values.size() * width);
+  for (size_t i = 0; i < count; ++i)
+    for (uint32_t a = 0; a < components; ++a)
+      for (uint32_t b = 0; b < width; ++b)
+        out[at + (b * components + a) * count + i] = uint8_t(values[components * i + a] >> (8 * b));
+}
+
+}  // namespace
+
+PredictiveCodec::PredictiveCodec() {
+  meshopt_encodeIndexVersion(1);
+}
+
+std::vector<uint8_t> PredictiveCodec::encode(const NodeGeometry& g, const PositionGrid& grid) const {
+  const QuantizedNode n = quantize_node(g, grid);
+  const Mesh& m = *g.mesh;
+  const uint32_t V = uint32_t(m.positions.size());
+  const uint32_t k = g.position_shift;
+  const uint32_t flags = attribute_flags(g);
+
+  // The triangles as the decoder will see them (the index codec may rotate them).
+  const uint64_t vertex_end = uint64_t(g.first_vertex) + V;
+  std::vector<uint8_t> index_stream(meshopt_encodeIndexBufferBound(n.indices.size(), vertex_end));
+  index_stream.resize(meshopt_encodeIndexBuffer(index_stream.data(), index_stream.size(), n.indices.data(),
+                                                n.indices.size()));
+  std::vector<uint32_t> seen(n.indices.size());
+  if (meshopt_decodeIndexBuffer(seen.data(), seen.size(), sizeof(uint32_t), index_stream.data(),
+                                index_stream.size()) != 0)
+    throw Error("node codec: index codec round trip failed");
+
+  // Position residuals in walk order.
+  std::vector<uint64_t> residuals(3 * size_t(V));
+  std::vector<uint32_t> last;
+  size_t visited = 0;
+  uint64_t largest = 0;
+  walk(seen, g.first_vertex, V, last, [&](uint32_t v, uint32_t o1, uint32_t o2, uint32_t o) {
+    for (int a = 0; a < 3; ++a) {
+      const uint64_t z = zigzag(n.c[3 * size_t(v) + a] - predict(n.c.data(), o1, o2, o, a, n.cmin[a]));
+      residuals[3 * visited + a] = z;
+      largest = std::max(largest, z);
+    }
+    ++visited;
+  });
+  const uint32_t position_bytes = bytes_for(largest);
+
+  // Normal residuals against the prediction from the decoded positions.
+  std::vector<uint64_t> normal_residuals;
+  uint32_t normal_bytes = 0;
+  if (flags & kHasNormals) {
+    const std::vector<uint8_t> locked = encode_locked_stream(n, k);
+    std::vector<glm::vec3> decoded(V), sum;
+    decode_positions(n.c, LockedStream::parse(locked, V, k, "node codec"), grid, decoded.data());
+    predicted_normals(seen, g.first_vertex, decoded.data(), V, sum);
+    normal_residuals.resize(2 * size_t(V));
+    largest = 0;
+    for (uint32_t v = 0; v < V; ++v) {
+      const glm::ivec2 truth = oct_encode(m.normals[n.order[v]], int(g.normal_bits));
+      const glm::ivec2 guess = oct_encode(sum[v], int(g.normal_bits));
+      for (int a = 0; a < 2; ++a) {
+        normal_residuals[2 * size_t(v) + a] = zigzag(truth[a] - guess[a]);
+        largest = std::max(largest, normal_residuals[2 * size_t(v) + a]);
+      }
+    }
+    normal_bytes = bytes_for(largest);
+  }
+
+  // UVs, colours, vertex_data: meshopt's vertex codec over records in vertex order.
+  std::vector<uint8_t> attribute_stream;
+  const AttributeLayout layout = attribute_layout(flags, 0);
+  if (layout.end > 0) {
+    const size_t stride = (layout.end + 3) & ~size_t(3);
+    std::vector<uint8_t> records(V * stride, 0);
+    for (uint32_t v = 0; v < V; ++v) put_attributes(records.data() + v * stride, layout, flags, g, n, n.order[v]);
+    attribute_stream.resize(meshopt_encodeVertexBufferBound(V, stride));
+    attribute_stream.resize(meshopt_encodeVertexBuffer(attribute_stream.data(), attribute_stream.size(),
+                                                       records.data(), V, stride));
+  }
+  const std::vector<uint8_t> locked_stream = encode_locked_stream(n, k);
+
+  ByteWriter w;
+  w.u8(kFormat);
+  w.u8(static_cast<uint8_t>(flags));
+  w.u8(static_cast<uint8_t>(k));
+  w.u8(static_cast<uint8_t>((flags & kHasNormals) ? g.normal_bits : 0));
+  w.u8(static_cast<uint8_t>(position_bytes | normal_bytes << 4));
+  w.varint(V);
+  w.varint(n.indices.size() / 3);
+  w.varint(g.first_vertex);
+  for (int64_t cm : n.cmin) w.svarint(cm);
+  if (flags & kHasUvs) {
+    w.f32(n.uv_min.x), w.f32(n.uv_min.y), w.f32(n.uv_extent.x), w.f32(n.uv_extent.y);
+  }
+  w.varint(attribute_stream.size());
+  w.varint(locked_stream.size());
+  w.varint(index_stream.size());
+  put_planes(w.bytes, residuals, 3, position_bytes);
+  if (normal_bytes) put_planes(w.bytes, normal_residuals, 2, normal_bytes);
+  w.raw(attribute_stream);
+  w.raw(locked_stream);
+  w.raw(index_stream);
+  return std::move(w.bytes);
+}
+
+DecodedNode PredictiveCodec::decode(std::span<const uint8_t> bytes, const PositionGrid& grid,
+                                    const std::string& where) const {
+  const Parsed p = parse(bytes, where);
+  const uint32_t V = p.vertices;
+  const size_t T = p.triangles;
+  DecodedNode out;
+  out.first_vertex = p.first_vertex;
+  Mesh& m = out.mesh;
+  m.indices.resize(3 * T);
+  if (meshopt_decodeIndexBuffer(m.indices.data(), m.indices.size(), sizeof(uint32_t), p.index_stream.data(),
+                                p.index_stream.size()) != 0)
+    throw Error(where + ": corrupted index stream");
+  const uint32_t vertex_end = p.first_vertex + p.vertices;
+  uint32_t max_index = 0;
+  for (uint32_t i : m.indices) max_index = std::max(max_index, i);
+  if (T > 0 && max_index >= vertex_end)
+    throw Error(where + ": index " + std::to_string(max_index) + " out of range");
+  const LockedStream locked = LockedStream::parse(p.locked_stream, V, p.shift, where);
+
+  // Positions: the walk of the header comment, residuals in visit order.
+  thread_local std::vector<uint32_t> last;
+  thread_local std::vector<int64_t> c;
+  c.resize(3 * size_t(V));
+  const uint8_t* planes = p.position_planes.data();
+  const uint32_t width = p.position_bytes;
+  size_t visited = 0;
+  bool in_range = true;
+  walk(m.indices, p.first_vertex, V, last, [&](uint32_t v, uint32_t o1, uint32_t o2, uint32_t o) {
+    for (int a = 0; a < 3; ++a) {
+      const int64_t value = predict(c.data(), o1, o2, o, a, p.cmin[a]) +
+                            unzigzag(plane_value(planes, V, width, uint32_t(a), 3, visited));
+      const bool ok = value >= -kMaxCoarse && value <= kMaxCoarse;
+      in_range &= ok;
+      c[3 * size_t(v) + a] = ok ? value : 0;
+    }
+    ++visited;
+  });
+  if (!in_range) throw Error(where + ": predicted position out of the grid's range");
+  m.positions.resize(V);
+  decode_positions(std::span(c).first(3 * size_t(V)), locked, grid, m.positions.data());
+
+  if (p.flags & kHasNormals) {
+    thread_local std::vector<glm::vec3> sum;
+    predicted_normals(m.indices, p.first_vertex, m.positions.data(), V, sum);
+    m.normals.resize(V);
+    const int bits = int(p.normal_bits);
+    const float inv_scale = 1.0f / static_cast<float>((1 << (bits - 1)) - 1);
+    const uint8_t* normal_planes = p.normal_planes.data();
+    for (uint32_t v = 0; v < V; ++v) {
+      const glm::ivec2 guess = oct_encode(sum[v], bits);
+      const int64_t x = guess.x + unzigzag(plane_value(normal_planes, V, p.normal_bytes, 0, 2, v));
+      const int64_t y = guess.y + unzigzag(plane_value(normal_planes, V, p.normal_bytes, 1, 2, v));
+      m.normals[v] = oct_decode(int(std::clamp<int64_t>(x, -65536, 65536)),
+                                int(std::clamp<int64_t>(y, -65536, 65536)), inv_scale);
+    }
+  }
+
+  const AttributeLayout layout = attribute_layout(p.flags, 0);
+  if (layout.end > 0) {
+    const size_t stride = (layout.end + 3) & ~size_t(3);
+    std::vector<uint8_t> records(V * stride);
+    if (meshopt_decodeVertexBuffer(records.data(), V, stride, p.attribute_stream.data(),
+                                   p.attribute_stream.size()) != 0)
+      throw Error(where + ": corrupted attribute stream");
+    get_attributes(records.data(), stride, V, layout, p.flags, p.uv_min, p.uv_extent, out);
+  } else if (!p.attribute_stream.empty()) {
+    throw Error(where + ": attribute stream without attributes");
+  }
+  return out;
+}
+
+NodeSizeBreakdown PredictiveCodec::breakdown(std::span<const uint8_t> bytes, const std::string& where) const {
+  const Parsed p = parse(bytes, where);
+  NodeSizeBreakdown b;
+  b.header = p.header_size;
+  b.vertices = p.position_planes.size() + p.normal_planes.size() + p.attribute_stream.size();
+  b.locked = p.locked_stream.size();
+  b.indices = p.index_stream.size();
+  return b;
+}
+
+}  // namespace lodstream::package

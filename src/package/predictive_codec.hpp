@@ -1,0 +1,48 @@
+// The second node codec (id 2): positions and normals predicted from what the decoder already has, their
+// residuals stored as byte planes that the writer's per-page zstd entropy-codes; connectivity, UVs, colours
+// and vertex_data as codec 1 stores them (meshoptimizer's index and vertex codecs). Quantization and the
+// locked stream are codec 1's (quantized_node.hpp, coarse_positions.hpp), so positions decode to the same
+// grid values and locked vertices bit-identically on the finest grid.
+//
+// Bytes of a node:
+//   u8 format (1), u8 flags (1 normals, 2 uvs, 4 colors, 8 vertex_data), u8 position_shift k, u8 normal_bits,
+//   u8 widths (low nibble: bytes per position residual wp, 1..5; high nibble: bytes per normal residual wn,
+//   0..3); varint vertex count V (≤ 65536), varint triangle count T, varint first_vertex; svarint cmin[3];
+//   [uvs: f32 uv_min[2], f32 uv_extent[2]]; varint sizes of the attribute, locked and index streams; then the
+//   position planes (3 wp V bytes), the normal planes (2 wn V bytes), the attribute, locked and index streams.
+// Index stream: meshopt_encodeIndexBuffer (version 1). The decoder decodes it first; everything below walks
+//   the decoded triangles, so encoder and decoder predict from the same data.
+// Positions (parallelogram prediction, Touma & Gotsman 1998, "Triangle Mesh Compression", GI'98): the
+//   coarse coordinates c (quantized_node.hpp) are visited in the order the triangles first use the node's
+//   vertices (then unused vertices in index order). At its first triangle, with o1, o2 the other corners:
+//     both decoded, and the latest triangle using o1 or the latest using o2 holds edge o2 -> o1 with a third
+//       corner o:               pred = c[o1] + c[o2] - c[o]   (the parallelogram across edge o1-o2)
+//     else one of them decoded: pred = c[that corner]
+//     else:                     pred = c[previously visited vertex], or cmin for the first.
+//   Residual c - pred is stored zigzag-mapped, byte b of axis a of the i-th visited vertex at plane 3b + a,
+//   offset i (equal bytes together, so zstd models low and high bytes apart). One pass over the triangles,
+//   O(1) per corner, no hash maps. Chunk vertices below first_vertex are not in the node: never predictors.
+// Normals: predicted per vertex as the area-weighted sum of the normals of the node's own triangles over the
+//   DECODED positions (cross(p1 - p0, p2 - p0), Gouraud's smooth normal), octahedral-encoded at normal_bits
+//   (octahedral.hpp); the residual oct(n) - oct(pred) per component, zigzag-mapped, byte b of component a at
+//   plane 2b + a. Interior vertices of a smooth mesh mostly store 0. Unlike positions, normals need no
+//   bit-exact prediction: a decoder whose floating point rounds the prediction differently is off by at most
+//   one octahedral step.
+#pragma once
+
+#include "package/node_codec.hpp"
+
+namespace lodstream::package {
+
+class PredictiveCodec final : public NodeCodec {
+ public:
+  static constexpr uint32_t kId = 2;
+  PredictiveCodec();
+  uint32_t id() const override { return kId; }
+  std::vector<uint8_t> encode(const NodeGeometry& geometry, const PositionGrid& grid) const override;
+  DecodedNode decode(std::span<const uint8_t> bytes, const PositionGrid& grid,
+                     const std::string& where) const override;
+  NodeSizeBreakdown breakdown(std::span<const uint8_t> bytes, const std::string& where) const override;
+};
+
+}  // namespace lodstream::package

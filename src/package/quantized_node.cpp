@@ -1,0 +1,84 @@
+#include "package/quantized_node.hpp"
+
+#include <meshoptimizer.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "core/error.hpp"
+
+namespace lodstream::package {
+
+QuantizedNode quantize_node(const NodeGeometry& g, const PositionGrid& grid) {
+  if (!g.mesh) throw Error("node codec: no mesh given");
+  const Mesh& m = *g.mesh;
+  const size_t V = m.positions.size();
+  auto invalid = [](const std::string& what) { throw Error("node codec: " + what); };
+  if (V > kMaxNodeVertices) invalid(std::to_string(V) + " vertices exceed the 65536 a node may hold");
+  if ((m.has_normals() && m.normals.size() != V) || (m.has_uvs() && m.uvs.size() != V) ||
+      (m.has_colors() && m.colors.size() != V) || (!g.locked.empty() && g.locked.size() != V) ||
+      (!g.vertex_data.empty() && g.vertex_data.size() != V)) {
+    invalid("attribute arrays differ in length from positions");
+  }
+  if (m.indices.size() % 3 != 0) invalid("index count is not a multiple of 3");
+  if (g.position_shift > kMaxPositionShift) invalid("position shift above 24");
+  if (m.has_normals() && (g.normal_bits < 4 || g.normal_bits > 16)) invalid("normal bits outside 4..16");
+  if (!(grid.step > 0.0f) || !std::isfinite(grid.step)) invalid("grid step must be positive and finite");
+  const uint64_t vertex_end = uint64_t(g.first_vertex) + V;
+  if (vertex_end > UINT32_MAX) invalid("first vertex out of range");
+  for (uint32_t i : m.indices) {
+    if (i >= vertex_end) invalid("index " + std::to_string(i) + " out of range");
+  }
+
+  // Vertex order: meshopt's vertex-cache then vertex-fetch order (what its codecs compress best), unless the
+  // caller's order is significant. order[new] = old.
+  QuantizedNode n;
+  n.indices = m.indices;
+  n.order.resize(V);
+  std::iota(n.order.begin(), n.order.end(), 0u);
+  if (g.first_vertex == 0 && !g.preserve_order && V > 0) {
+    std::vector<uint32_t> optimized(n.indices.size());
+    meshopt_optimizeVertexCache(optimized.data(), n.indices.data(), n.indices.size(), V);
+    std::vector<uint32_t> remap(V);
+    size_t used = meshopt_optimizeVertexFetchRemap(remap.data(), optimized.data(), optimized.size(), V);
+    for (uint32_t& r : remap) {
+      if (r == ~0u) r = static_cast<uint32_t>(used++);  // unreferenced vertices keep a place at the end
+    }
+    for (size_t old = 0; old < V; ++old) n.order[remap[old]] = static_cast<uint32_t>(old);
+    for (size_t i = 0; i < n.indices.size(); ++i) n.indices[i] = remap[optimized[i]];
+  }
+
+  // Quantization: q = round((p - origin) / step); c = round(q / 2^k) for free vertices, floor(q / 2^k) for
+  // locked ones (whose k low bits the codec stores apart).
+  const uint32_t k = g.position_shift;
+  n.q.resize(3 * V), n.c.resize(3 * V), n.locked.resize(V);
+  for (size_t v = 0; v < V; ++v) {
+    const uint32_t old = n.order[v];
+    const bool locked = !g.locked.empty() && g.locked[old];
+    n.locked[v] = locked;
+    for (int a = 0; a < 3; ++a) {
+      double t = std::round((double(m.positions[old][a]) - double(grid.origin[a])) / double(grid.step));
+      if (!(std::abs(t) <= double(kMaxGridCoordinate))) invalid("position outside the range of the grid");
+      int64_t qa = static_cast<int64_t>(t);
+      int64_t ca = (k == 0 || locked) ? (qa >> k) : ((qa + (int64_t(1) << (k - 1))) >> k);
+      n.q[3 * v + a] = qa;
+      n.c[3 * v + a] = ca;
+      n.cmin[a] = v == 0 ? ca : std::min(n.cmin[a], ca);
+      n.cmax[a] = v == 0 ? ca : std::max(n.cmax[a], ca);
+    }
+  }
+  if (m.has_uvs()) {
+    glm::vec2 uv_min = V ? m.uvs[0] : glm::vec2(0.0f), uv_max = uv_min;
+    for (const glm::vec2& uv : m.uvs) {
+      if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) invalid("non-finite texture coordinate");
+      uv_min = glm::min(uv_min, uv);
+      uv_max = glm::max(uv_max, uv);
+    }
+    n.uv_min = uv_min;
+    n.uv_extent = uv_max - uv_min;
+  }
+  return n;
+}
+
+}  // namespace lodstream::package

@@ -1,0 +1,79 @@
+#include "package/vertex_attributes.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace lodstream::package {
+
+namespace {
+
+template <typename T>
+void put(uint8_t* dst, T v) {
+  std::memcpy(dst, &v, sizeof v);
+}
+template <typename T>
+T get(const uint8_t* src) {
+  T v;
+  std::memcpy(&v, src, sizeof v);
+  return v;
+}
+
+}  // namespace
+
+uint32_t attribute_flags(const NodeGeometry& g) {
+  const Mesh& m = *g.mesh;
+  return (m.has_normals() ? kHasNormals : 0) | (m.has_uvs() ? kHasUvs : 0) | (m.has_colors() ? kHasColors : 0) |
+         (g.vertex_data.empty() ? 0 : kHasVertexData);
+}
+
+AttributeLayout attribute_layout(uint32_t flags, size_t at) {
+  AttributeLayout l;
+  l.uv = at, at += (flags & kHasUvs) ? 4 : 0;
+  l.color = at, at += (flags & kHasColors) ? 4 : 0;
+  l.data = at, at += (flags & kHasVertexData) ? 4 : 0;
+  l.end = at;
+  return l;
+}
+
+void put_attributes(uint8_t* r, const AttributeLayout& l, uint32_t flags, const NodeGeometry& g,
+                    const QuantizedNode& n, uint32_t old) {
+  const Mesh& m = *g.mesh;
+  if (flags & kHasUvs) {
+    for (int a = 0; a < 2; ++a) {
+      float t = n.uv_extent[a] > 0.0f ? (m.uvs[old][a] - n.uv_min[a]) / n.uv_extent[a] : 0.0f;
+      put(r + l.uv + 2 * a, static_cast<uint16_t>(std::lround(std::clamp(t, 0.0f, 1.0f) * 65535.0f)));
+    }
+  }
+  if (flags & kHasColors) {
+    for (int a = 0; a < 4; ++a)
+      r[l.color + a] = static_cast<uint8_t>(std::lround(std::clamp(m.colors[old][a], 0.0f, 1.0f) * 255.0f));
+  }
+  if (flags & kHasVertexData) put(r + l.data, g.vertex_data[old]);
+}
+
+void get_attributes(const uint8_t* records, size_t stride, size_t V, const AttributeLayout& l, uint32_t flags,
+                    glm::vec2 uv_min, glm::vec2 uv_extent, DecodedNode& out) {
+  Mesh& m = out.mesh;
+  if (flags & kHasUvs) {
+    m.uvs.resize(V);
+    const glm::vec2 scale = uv_extent * (1.0f / 65535.0f);
+    for (size_t v = 0; v < V; ++v) {
+      const uint8_t* r = records + v * stride + l.uv;
+      m.uvs[v] = uv_min + glm::vec2(get<uint16_t>(r), get<uint16_t>(r + 2)) * scale;
+    }
+  }
+  if (flags & kHasColors) {
+    m.colors.resize(V);
+    for (size_t v = 0; v < V; ++v) {
+      const uint8_t* r = records + v * stride + l.color;
+      m.colors[v] = glm::vec4(r[0], r[1], r[2], r[3]) * (1.0f / 255.0f);
+    }
+  }
+  if (flags & kHasVertexData) {
+    out.vertex_data.resize(V);
+    for (size_t v = 0; v < V; ++v) out.vertex_data[v] = get<uint32_t>(records + v * stride + l.data);
+  }
+}
+
+}  // namespace lodstream::package
