@@ -474,7 +474,8 @@ const bool registered = register_command(
        sub.add_option("-o,--output", args->output, "the package to write (.lods)")->required();
        sub.add_option("--normal-bits", args->normal_bits, "octahedral normal bits per component (4..16)");
        sub.add_option("--codec", args->codec,
-                      "node codec: 2 = predicted positions and normals (default), 1 = meshoptimizer's codecs");
+                      "node codec: 1 = meshoptimizer's codecs (default), 2 = predicted positions and normals "
+                      "(about 30 % smaller, decodes at about half the speed)");
        sub.add_option("--max-grid-bits", args->max_grid_bits,
                       "finest grid: at most 2^-N of a mesh's diagonal (14..20, default 20), fewer when its "
                       "vertices stay apart with fewer");

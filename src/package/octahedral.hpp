@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <glm/glm.hpp>
 
 namespace lodstream::package {
@@ -16,17 +17,19 @@ inline float sign_not_zero(float v) {
   return v >= 0.0f ? 1.0f : -1.0f;
 }
 
-// n need not be unit length; a zero vector encodes as +z. Returns components in [-(2^(bits-1)-1),
+// n need not be unit length; a zero (or non-finite) vector encodes as +z. Returns components in [-(2^(bits-1)-1),
 // 2^(bits-1)-1].
 inline glm::ivec2 oct_encode(glm::vec3 n, int bits) {
-  float l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
-  glm::vec2 p = l1 > 0.0f ? glm::vec2(n.x, n.y) / l1 : glm::vec2(0.0f);
-  if (l1 > 0.0f && n.z < 0.0f) {
+  const float l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
+  const bool usable = l1 > 0.0f && l1 <= std::numeric_limits<float>::max();  // not zero, NaN or infinite
+  glm::vec2 p = usable ? glm::vec2(n.x, n.y) / l1 : glm::vec2(0.0f);
+  if (usable && n.z < 0.0f) {
     p = glm::vec2((1.0f - std::abs(p.y)) * sign_not_zero(p.x), (1.0f - std::abs(p.x)) * sign_not_zero(p.y));
   }
-  float scale = static_cast<float>((1 << (bits - 1)) - 1);
-  return {static_cast<int>(std::lround(std::clamp(p.x, -1.0f, 1.0f) * scale)),
-          static_cast<int>(std::lround(std::clamp(p.y, -1.0f, 1.0f) * scale))};
+  // Round half away from zero without a libm call (codec 2's decoder encodes a predicted normal per vertex).
+  const float scale = static_cast<float>((1 << (bits - 1)) - 1);
+  const float x = std::clamp(p.x, -1.0f, 1.0f) * scale, y = std::clamp(p.y, -1.0f, 1.0f) * scale;
+  return {static_cast<int>(x + std::copysign(0.5f, x)), static_cast<int>(y + std::copysign(0.5f, y))};
 }
 
 // Inverse of oct_encode for any integer pair (garbage in gives some unit vector, never NaN). The fold of the

@@ -20,6 +20,8 @@ constexpr uint8_t kFormat = 1;
 constexpr uint32_t kAllFlags = kHasNormals | kHasUvs | kHasColors | kHasVertexData;
 constexpr uint32_t kNone = UINT32_MAX;
 constexpr uint32_t kMaxPositionBytes = 5, kMaxNormalBytes = 3;
+// Triangles before a vertex's first triangle searched for the one across the parallelogram's edge.
+constexpr uint32_t kAcrossWindow = 8;
 // Decoded coarse coordinates stay within ±2^32 (valid ones within ±2^31), so no chain of predictions from
 // hostile residuals (< 2^40) overflows int64.
 constexpr int64_t kMaxCoarse = int64_t(1) << 32;
@@ -36,57 +38,55 @@ uint32_t bytes_for(uint64_t largest) {
   return n;
 }
 
-// Calls visit(v, o1, o2, o) for every vertex of the node once, in the walk order of the header comment, with
-// the predictors: o1 + o2 - o (parallelogram), o1 alone (o2 == kNone) or none (o1 == kNone; then predict
-// from the previously visited vertex, or cmin). Every predictor was visited before. `last` is scratch (V
-// entries). O(T + V).
+// Calls visit(v, o1, o2, o) for v = 0, 1, ..., V - 1 with v's predictors, all below v (decoded before it in
+// vertex order): o1 + o2 - o (parallelogram), o1 alone (o2 == kNone), or none (o1 == kNone: predict from
+// vertex v - 1, or cmin for v = 0); the rule is the header comment's. `first` is scratch (V entries).
+// Indices must be below first_vertex + V. O(T + V), one branch-free pass over the corners, then per vertex
+// a look at its first triangle and the kAcrossWindow triangles before it.
 template <class Visit>
-void walk(std::span<const uint32_t> indices, uint32_t first_vertex, uint32_t V, std::vector<uint32_t>& last,
-          Visit&& visit) {
-  // last[v]: kNone until v is visited, then kVisited until its first triangle is done, then the latest
-  // triangle using v (set when the triangle is done, so the lookup across an edge never finds the current one).
-  constexpr uint32_t kVisited = kNone - 1;
-  const uint32_t triangles = uint32_t(indices.size() / 3);
-  last.assign(V, kNone);
-  auto across = [&](uint32_t t, uint32_t o1, uint32_t o2) -> uint32_t {
-    if (t >= triangles) return kNone;
-    const uint32_t* u = &indices[3 * size_t(t)];
-    const uint32_t a = u[0] - first_vertex, b = u[1] - first_vertex, c = u[2] - first_vertex;
-    uint32_t o = kNone;
-    if (a == o2 && b == o1) o = c;
-    if (b == o2 && c == o1) o = a;
-    if (c == o2 && a == o1) o = b;
-    return o < V && last[o] != kNone ? o : kNone;
-  };
-  uint32_t previous = kNone;
-  for (uint32_t t = 0; t < triangles; ++t) {
-    const uint32_t l[3] = {indices[3 * size_t(t)] - first_vertex, indices[3 * size_t(t) + 1] - first_vertex,
-                           indices[3 * size_t(t) + 2] - first_vertex};
-    for (int k = 0; k < 3; ++k) {
-      const uint32_t v = l[k];
-      if (v >= V || last[v] != kNone) continue;
-      const uint32_t o1 = l[k == 2 ? 0 : k + 1], o2 = l[k == 0 ? 2 : k - 1];
-      const bool known1 = o1 < V && last[o1] != kNone, known2 = o2 < V && last[o2] != kNone;
-      if (known1 && known2) {
-        uint32_t o = across(last[o1], o1, o2);
-        if (o == kNone) o = across(last[o2], o1, o2);
-        if (o != kNone)
-          visit(v, o1, o2, o);
-        else
-          visit(v, o1, kNone, kNone);
-      } else if (known1 || known2) {
-        visit(v, known1 ? o1 : o2, kNone, kNone);
-      } else {
-        visit(v, previous, kNone, kNone);
-      }
-      last[v] = kVisited;
-      previous = v;
-    }
-    for (uint32_t v : l)
-      if (v < V) last[v] = t;
+void for_each_prediction(std::span<const uint32_t> indices, uint32_t first_vertex, uint32_t V,
+                         std::vector<uint32_t>& first, Visit&& visit) {
+  // first[v]: the first corner using v (a reverse pass storing unconditionally leaves the smallest).
+  first.assign(V, kNone);
+  const uint32_t corners = uint32_t(indices.size());
+  if (first_vertex == 0) {
+    for (uint32_t c = corners; c-- > 0;) first[indices[c]] = c;
+  } else {
+    for (uint32_t c = corners; c-- > 0;)
+      if (const uint32_t l = indices[c] - first_vertex; l < V) first[l] = c;
   }
-  for (uint32_t v = 0; v < V; ++v)
-    if (last[v] == kNone) visit(v, previous, kNone, kNone), last[v] = kVisited, previous = v;
+  const uint32_t* idx = indices.data();
+  for (uint32_t v = 0; v < V; ++v) {
+    const uint32_t corner = first[v];
+    if (corner == kNone) {
+      visit(v, v > 0 ? v - 1 : kNone, kNone, kNone);
+      continue;
+    }
+    const uint32_t t = corner / 3, k = corner - 3 * t;
+    const uint32_t o1 = idx[3 * t + (k == 2 ? 0 : k + 1)] - first_vertex,
+                   o2 = idx[3 * t + (k == 0 ? 2 : k - 1)] - first_vertex;
+    const bool known1 = o1 < v, known2 = o2 < v;  // chunk-external corners wrap to huge values: unknown
+    if (known1 && known2) {
+      // The triangle across edge o1-o2 holds o2 -> o1: among the few before t (cache order keeps it close).
+      uint32_t o = kNone;
+      for (uint32_t back = 1; back <= kAcrossWindow && back <= t && o == kNone; ++back) {
+        const uint32_t* u = idx + 3 * (t - back);
+        const uint32_t a = u[0] - first_vertex, b = u[1] - first_vertex, c = u[2] - first_vertex;
+        if (a == o2 && b == o1) o = c;
+        if (b == o2 && c == o1) o = a;
+        if (c == o2 && a == o1) o = b;
+        if (o >= v) o = kNone;
+      }
+      if (o != kNone)
+        visit(v, o1, o2, o);
+      else
+        visit(v, o1, kNone, kNone);
+    } else if (known1 || known2) {
+      visit(v, known1 ? o1 : o2, kNone, kNone);
+    } else {
+      visit(v, v > 0 ? v - 1 : kNone, kNone, kNone);
+    }
+  }
 }
 
 int64_t predict(const int64_t* c, uint32_t o1, uint32_t o2, uint32_t o, int a, int64_t cmin) {
@@ -166,12 +166,26 @@ Parsed parse(std::span<const uint8_t> bytes, const std::string& where) {
   return p;
 }
 
-// Value i of `count` values stored as `width` byte planes starting at plane `first` (plane stride count).
-inline uint64_t plane_value(const uint8_t* planes, size_t count, uint32_t width, uint32_t first, uint32_t step,
-                            size_t i) {
-  uint64_t value = 0;
-  for (uint32_t b = 0; b < width; ++b) value |= uint64_t(planes[(first + b * step) * count + i]) << (8 * b);
-  return value;
+// Unzigzags `count` values of `components` components each, stored as `width` byte planes (byte b of
+// component a at plane b * components + a), into out[components * i + a]. Cost: O(count * components * width),
+// one pass per plane.
+template <typename T>
+void read_planes(const uint8_t* planes, size_t count, uint32_t components, uint32_t width, T* out) {
+  for (uint32_t a = 0; a < components; ++a) {
+    const uint8_t* low = planes + a * count;
+    if (width == 1) {
+      for (size_t i = 0; i < count; ++i) out[components * i + a] = T(unzigzag(low[i]));
+    } else if (width == 2) {
+      const uint8_t* high = planes + (components + a) * count;
+      for (size_t i = 0; i < count; ++i) out[components * i + a] = T(unzigzag(low[i] | uint64_t(high[i]) << 8));
+    } else {
+      for (size_t i = 0; i < count; ++i) {
+        uint64_t value = 0;
+        for (uint32_t b = 0; b < width; ++b) value |= uint64_t(planes[(b * components + a) * count + i]) << (8 * b);
+        out[components * i + a] = T(unzigzag(value));
+      }
+    }
+  }
 }
 
 void put_planes(std::vector<uint8_t>& out, const std::vector<uint64_t>& values, uint32_t components,
@@ -208,18 +222,16 @@ std::vector<uint8_t> PredictiveCodec::encode(const NodeGeometry& g, const Positi
                                 index_stream.size()) != 0)
     throw Error("node codec: index codec round trip failed");
 
-  // Position residuals in walk order.
+  // Position residuals in vertex order.
   std::vector<uint64_t> residuals(3 * size_t(V));
-  std::vector<uint32_t> last;
-  size_t visited = 0;
+  std::vector<uint32_t> first;
   uint64_t largest = 0;
-  walk(seen, g.first_vertex, V, last, [&](uint32_t v, uint32_t o1, uint32_t o2, uint32_t o) {
+  for_each_prediction(seen, g.first_vertex, V, first, [&](uint32_t v, uint32_t o1, uint32_t o2, uint32_t o) {
     for (int a = 0; a < 3; ++a) {
       const uint64_t z = zigzag(n.c[3 * size_t(v) + a] - predict(n.c.data(), o1, o2, o, a, n.cmin[a]));
-      residuals[3 * visited + a] = z;
+      residuals[3 * size_t(v) + a] = z;
       largest = std::max(largest, z);
     }
-    ++visited;
   });
   const uint32_t position_bytes = bytes_for(largest);
 
@@ -300,41 +312,49 @@ DecodedNode PredictiveCodec::decode(std::span<const uint8_t> bytes, const Positi
     throw Error(where + ": index " + std::to_string(max_index) + " out of range");
   const LockedStream locked = LockedStream::parse(p.locked_stream, V, p.shift, where);
 
-  // Positions: the walk of the header comment, residuals in visit order.
-  thread_local std::vector<uint32_t> last;
-  thread_local std::vector<int64_t> c;
-  c.resize(3 * size_t(V));
-  const uint8_t* planes = p.position_planes.data();
-  const uint32_t width = p.position_bytes;
-  size_t visited = 0;
-  bool in_range = true;
-  walk(m.indices, p.first_vertex, V, last, [&](uint32_t v, uint32_t o1, uint32_t o2, uint32_t o) {
-    for (int a = 0; a < 3; ++a) {
-      const int64_t value = predict(c.data(), o1, o2, o, a, p.cmin[a]) +
-                            unzigzag(plane_value(planes, V, width, uint32_t(a), 3, visited));
-      const bool ok = value >= -kMaxCoarse && value <= kMaxCoarse;
-      in_range &= ok;
-      c[3 * size_t(v) + a] = ok ? value : 0;
+  // Positions: the prediction of the header comment, in vertex order. The arithmetic wraps (unsigned), so
+  // hostile residuals cannot overflow; the result is range-checked afterwards.
+  thread_local std::vector<uint32_t> first;
+  thread_local std::vector<int64_t> residual, c;
+  residual.resize(3 * size_t(V)), c.resize(3 * size_t(V));
+  read_planes(p.position_planes.data(), V, 3, p.position_bytes, residual.data());
+  const int64_t* r = residual.data();
+  uint64_t* cu = reinterpret_cast<uint64_t*>(c.data());
+  const uint64_t cmin[3] = {uint64_t(p.cmin[0]), uint64_t(p.cmin[1]), uint64_t(p.cmin[2])};
+  for_each_prediction(m.indices, p.first_vertex, V, first, [&](uint32_t v, uint32_t o1, uint32_t o2, uint32_t o) {
+    uint64_t* out = cu + 3 * size_t(v);
+    if (o1 == kNone) {
+      for (int a = 0; a < 3; ++a) out[a] = cmin[a] + uint64_t(r[a]);
+    } else if (o2 == kNone) {
+      const uint64_t* from = cu + 3 * size_t(o1);
+      for (int a = 0; a < 3; ++a) out[a] = from[a] + uint64_t(r[a]);
+    } else {
+      const uint64_t *x = cu + 3 * size_t(o1), *y = cu + 3 * size_t(o2), *z = cu + 3 * size_t(o);
+      for (int a = 0; a < 3; ++a) out[a] = x[a] + y[a] - z[a] + uint64_t(r[a]);
     }
-    ++visited;
+    r += 3;
   });
+  bool in_range = true;
+  for (size_t i = 0; i < 3 * size_t(V); ++i) in_range &= cu[i] + uint64_t(kMaxCoarse) <= 2 * uint64_t(kMaxCoarse);
   if (!in_range) throw Error(where + ": predicted position out of the grid's range");
   m.positions.resize(V);
   decode_positions(std::span(c).first(3 * size_t(V)), locked, grid, m.positions.data());
 
   if (p.flags & kHasNormals) {
     thread_local std::vector<glm::vec3> sum;
+    thread_local std::vector<int32_t> normal_residual;
     predicted_normals(m.indices, p.first_vertex, m.positions.data(), V, sum);
+    normal_residual.resize(2 * size_t(V));
+    read_planes(p.normal_planes.data(), V, 2, p.normal_bytes, normal_residual.data());
     m.normals.resize(V);
     const int bits = int(p.normal_bits);
     const float inv_scale = 1.0f / static_cast<float>((1 << (bits - 1)) - 1);
-    const uint8_t* normal_planes = p.normal_planes.data();
     for (uint32_t v = 0; v < V; ++v) {
       const glm::ivec2 guess = oct_encode(sum[v], bits);
-      const int64_t x = guess.x + unzigzag(plane_value(normal_planes, V, p.normal_bytes, 0, 2, v));
-      const int64_t y = guess.y + unzigzag(plane_value(normal_planes, V, p.normal_bytes, 1, 2, v));
-      m.normals[v] = oct_decode(int(std::clamp<int64_t>(x, -65536, 65536)),
-                                int(std::clamp<int64_t>(y, -65536, 65536)), inv_scale);
+      // oct_decode clamps; residuals of a valid node are below 2^17, hostile ones are clamped first.
+      const int x = guess.x + std::clamp(normal_residual[2 * size_t(v)], -(1 << 18), 1 << 18);
+      const int y = guess.y + std::clamp(normal_residual[2 * size_t(v) + 1], -(1 << 18), 1 << 18);
+      m.normals[v] = oct_decode(x, y, inv_scale);
     }
   }
 

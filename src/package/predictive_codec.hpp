@@ -13,15 +13,17 @@
 // Index stream: meshopt_encodeIndexBuffer (version 1). The decoder decodes it first; everything below walks
 //   the decoded triangles, so encoder and decoder predict from the same data.
 // Positions (parallelogram prediction, Touma & Gotsman 1998, "Triangle Mesh Compression", GI'98): the
-//   coarse coordinates c (quantized_node.hpp) are visited in the order the triangles first use the node's
-//   vertices (then unused vertices in index order). At its first triangle, with o1, o2 the other corners:
-//     both decoded, and the latest triangle using o1 or the latest using o2 holds edge o2 -> o1 with a third
-//       corner o:               pred = c[o1] + c[o2] - c[o]   (the parallelogram across edge o1-o2)
-//     else one of them decoded: pred = c[that corner]
-//     else:                     pred = c[previously visited vertex], or cmin for the first.
-//   Residual c - pred is stored zigzag-mapped, byte b of axis a of the i-th visited vertex at plane 3b + a,
-//   offset i (equal bytes together, so zstd models low and high bytes apart). One pass over the triangles,
-//   O(1) per corner, no hash maps. Chunk vertices below first_vertex are not in the node: never predictors.
+//   coarse coordinates c (quantized_node.hpp) are decoded in vertex order (meshopt's vertex-fetch order:
+//   first use by the triangles). Vertex v is predicted from its first triangle t (in decoded order), with
+//   o1, o2 its other corners, from vertices below v only:
+//     o1, o2 < v, and one of the 8 triangles before t holds edge o2 -> o1 with a third corner o < v:
+//                               pred = c[o1] + c[o2] - c[o]   (the parallelogram across edge o1-o2)
+//     else o1 or o2 < v:        pred = c[that corner]
+//     else:                     pred = c[v - 1], or cmin for v = 0 (also for vertices no triangle uses).
+//   Residual c - pred is stored zigzag-mapped, byte b of axis a of vertex v at plane 3b + a, offset v
+//   (equal bytes together, so zstd models low and high bytes apart). Chunk vertices below first_vertex are
+//   not in the node: never predictors. The decode is one branch-free pass over the corners (first corner of
+//   each vertex) and one pass over the vertices; no hash maps.
 // Normals: predicted per vertex as the area-weighted sum of the normals of the node's own triangles over the
 //   DECODED positions (cross(p1 - p0, p2 - p0), Gouraud's smooth normal), octahedral-encoded at normal_bits
 //   (octahedral.hpp); the residual oct(n) - oct(pred) per component, zigzag-mapped, byte b of component a at

@@ -4,6 +4,7 @@
 #include <set>
 #include <tuple>
 
+#include "package/meshopt_codec.hpp"
 #include "support/shapes.hpp"
 
 namespace lodstream::test {
@@ -45,7 +46,7 @@ std::vector<Mesh> split_into_chunks(const Mesh& mesh, size_t triangles,
   return chunks;
 }
 
-TestPackage write_test_package(const std::filesystem::path& file) {
+TestPackage write_test_package(const std::filesystem::path& file, uint32_t codec) {
   TestPackage t;
   Mesh sphere = uv_sphere(2.0f, 12, 24);
   Mesh cube = cube_with_seams(3);
@@ -61,7 +62,8 @@ TestPackage write_test_package(const std::filesystem::path& file) {
       {Material{"crate", {0.5f, 0.5f, 0.5f, 1.0f}, "", nullptr}, 0});  // texture blob 0
 
   WriterOptions options;
-  options.page_bytes = 2048;
+  options.page_bytes = t.page_bytes = codec == MeshoptCodec::kId ? 2048 : 4096;
+  options.codec = codec;
   options.nodes_per_index_page = 5;
   PackageWriter writer(file, options);
   const std::vector<uint8_t> png = {0x89, 'P', 'N', 'G', 1, 2, 3, 4, 5};
@@ -86,7 +88,7 @@ TestPackage write_test_package(const std::filesystem::path& file) {
       g.locked = locked[i];
       g.position_shift = shift;
       g.normal_bits = 12;
-      writer.add_node(id, default_node_codec().encode(g, rep.grid));
+      writer.add_node(id, node_codec(codec).encode(g, rep.grid));
       if (i % 3 == 2) writer.end_group();
 
       NodeRecord n;

@@ -1,8 +1,8 @@
 // A small multi-object package built in code for the package tests: two representations (a UV sphere with
 // normals and UVs, a cube with seams and colours) cut into chunks of a few dozen triangles, one node per
 // chunk, each chunk at its own position shift, with every vertex that two chunks share flagged as locked;
-// three objects (two instances of the sphere). Written with small pages so that it has several data and index
-// pages.
+// three objects (two instances of the sphere). Written with small pages (2 KB raw for codec 1, 4 KB for codec 2,
+// whose raw nodes are about twice as large) so that it has several data and index pages.
 #pragma once
 
 #include <filesystem>
@@ -20,10 +20,13 @@ struct TestPackage {
   std::vector<std::vector<uint8_t>> locked;  // per node, per vertex
   std::vector<uint32_t> shifts;              // position shift per node
   uint32_t root_nodes = 0;
+  size_t page_bytes = 0;  // the writer's raw page target
   package::WrittenPackage written;
 };
 
-TestPackage write_test_package(const std::filesystem::path& file);
+// Nodes encoded with node codec `codec` (package/node_codec.hpp).
+TestPackage write_test_package(const std::filesystem::path& file,
+                               uint32_t codec = package::default_node_codec().id());
 
 // Splits `mesh` into chunks of `triangles` consecutive triangles (compacted vertices); `locked` gets, per
 // chunk vertex, whether another chunk holds a vertex at the same position.

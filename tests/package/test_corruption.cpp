@@ -10,6 +10,8 @@
 
 #include "core/error.hpp"
 #include "package/bytes.hpp"
+#include "package/meshopt_codec.hpp"
+#include "package/predictive_codec.hpp"
 #include "package/reader.hpp"
 #include "package_fixture.hpp"
 #include "support/run.hpp"
@@ -71,11 +73,11 @@ bool same(const Content& a, const Content& b) {
   return true;
 }
 
-class Corruption : public ::testing::Test {
+class Corruption : public ::testing::TestWithParam<uint32_t> {
  protected:
   void SetUp() override {
     std::filesystem::path file = temp_dir() / "small.lods";
-    write_test_package(file);
+    write_test_package(file, GetParam());
     std::ifstream in(file, std::ios::binary);
     original = {std::istreambuf_iterator<char>(in), {}};
     PackageReader reader(std::make_shared<MemorySource>(original));
@@ -141,11 +143,14 @@ class Corruption : public ::testing::Test {
   RootIndex root;
 };
 
-TEST_F(Corruption, TheRebuildHelperItselfGivesAValidPackage) {
+INSTANTIATE_TEST_SUITE_P(Codecs, Corruption, ::testing::Values(MeshoptCodec::kId, PredictiveCodec::kId),
+                         [](const auto& info) { return "codec" + std::to_string(info.param); });
+
+TEST_P(Corruption, TheRebuildHelperItselfGivesAValidPackage) {
   EXPECT_EQ(outcome(with_root([](RootIndex&) {})), Outcome::intact);
 }
 
-TEST_F(Corruption, EveryTruncationIsAnError) {
+TEST_P(Corruption, EveryTruncationIsAnError) {
   for (size_t n = 0; n < original.size(); ++n) {
     ASSERT_EQ(outcome(std::vector<uint8_t>(original.begin(), original.begin() + std::ptrdiff_t(n))),
               Outcome::error)
@@ -153,7 +158,7 @@ TEST_F(Corruption, EveryTruncationIsAnError) {
   }
 }
 
-TEST_F(Corruption, FlippedBytesAreErrorsOrHarmlessAndVerifyCatchesAll) {
+TEST_P(Corruption, FlippedBytesAreErrorsOrHarmlessAndVerifyCatchesAll) {
   size_t errors = 0;
   for (size_t at = 0; at < original.size(); ++at) {
     for (uint8_t mask : {uint8_t(0xff), uint8_t(0x01)}) {
@@ -174,7 +179,7 @@ TEST_F(Corruption, FlippedBytesAreErrorsOrHarmlessAndVerifyCatchesAll) {
   EXPECT_GE(errors, (original.size() - 2 * kHeaderSize) * 4 / 3);
 }
 
-TEST_F(Corruption, HostileHeadersAreErrors) {
+TEST_P(Corruption, HostileHeadersAreErrors) {
   std::vector<std::function<void(Header&)>> cases = {
       [](Header& h) { h.version = 99; },
       [](Header& h) { h.file_size = uint64_t(1) << 60; },
@@ -194,7 +199,7 @@ TEST_F(Corruption, HostileHeadersAreErrors) {
   EXPECT_NE(message.find("magic"), std::string::npos) << message;
 }
 
-TEST_F(Corruption, HostileRootIndicesAreErrors) {
+TEST_P(Corruption, HostileRootIndicesAreErrors) {
   const uint64_t end = original.size();
   std::vector<std::pair<const char*, std::function<void(RootIndex&)>>> cases = {
       {"2^32-1 nodes", [](RootIndex& r) { r.node_count = UINT32_MAX; }},
@@ -243,7 +248,7 @@ TEST_F(Corruption, HostileRootIndicesAreErrors) {
   }
 }
 
-TEST_F(Corruption, HugeCountsInHandWrittenRootsAreErrors) {
+TEST_P(Corruption, HugeCountsInHandWrittenRootsAreErrors) {
   // Root index prefix: codec, node count, input triangles, metadata; then a count that would need exabytes.
   auto prefix = [&]() {
     ByteWriter w;
@@ -270,7 +275,7 @@ TEST_F(Corruption, HugeCountsInHandWrittenRootsAreErrors) {
   EXPECT_EQ(outcome(with_raw_root(long_string.bytes)), Outcome::error);
 }
 
-TEST_F(Corruption, CorruptedPagesReceivedFromElsewhereAreErrorsOrValidMeshes) {
+TEST_P(Corruption, CorruptedPagesReceivedFromElsewhereAreErrorsOrValidMeshes) {
   PackageReader reader(std::make_shared<MemorySource>(original));
   const std::vector<uint8_t> page = reader.read_page(0);
   std::vector<uint32_t> ids;

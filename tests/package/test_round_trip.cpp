@@ -11,6 +11,8 @@
 #include <tuple>
 
 #include "core/error.hpp"
+#include "package/meshopt_codec.hpp"
+#include "package/predictive_codec.hpp"
 #include "package/reader.hpp"
 #include "package_fixture.hpp"
 #include "support/run.hpp"
@@ -57,17 +59,20 @@ std::vector<std::array<uint32_t, 3>> canonical_triangles(const std::vector<uint3
   return tris;
 }
 
-class RoundTrip : public ::testing::Test {
+class RoundTrip : public ::testing::TestWithParam<uint32_t> {
  protected:
   void SetUp() override {
     file = temp_dir() / "scene.lods";
-    t = write_test_package(file);
+    t = write_test_package(file, GetParam());
   }
   std::filesystem::path file;
   TestPackage t;
 };
 
-TEST_F(RoundTrip, SceneAndTablesSurvive) {
+INSTANTIATE_TEST_SUITE_P(Codecs, RoundTrip, ::testing::Values(MeshoptCodec::kId, PredictiveCodec::kId),
+                         [](const auto& info) { return "codec" + std::to_string(info.param); });
+
+TEST_P(RoundTrip, SceneAndTablesSurvive) {
   PackageReader reader = PackageReader::open(file);
   EXPECT_EQ(reader.header().file_size, std::filesystem::file_size(file));
   EXPECT_EQ(reader.header().content_hash, t.written.content_hash);
@@ -103,7 +108,7 @@ TEST_F(RoundTrip, SceneAndTablesSurvive) {
   EXPECT_EQ(t.written.pages, reader.root().pages.size());
 }
 
-TEST_F(RoundTrip, RecordsLoadOnDemand) {
+TEST_P(RoundTrip, RecordsLoadOnDemand) {
   PackageReader reader = PackageReader::open(file);
   ASSERT_EQ(reader.node_count(), t.records.size());
   EXPECT_TRUE(reader.has_node(0));
@@ -133,18 +138,18 @@ TEST_F(RoundTrip, RecordsLoadOnDemand) {
   EXPECT_THROW(reader.node(reader.node_count()), Error);
 }
 
-TEST_F(RoundTrip, GroupsStayInOnePageAndPagesStayNearTheTarget) {
+TEST_P(RoundTrip, GroupsStayInOnePageAndPagesStayNearTheTarget) {
   PackageReader reader = PackageReader::open(file);
-  // The fixture closes a group after every third node of a representation; each group fits in a 2 KB page.
+  // The fixture closes a group after every third node of a representation; each group fits in a page.
   for (uint32_t id = 0; id + 2 < reader.node_count(); ++id) {
     if (id % 3 == 0 && t.records[id].representation == t.records[id + 2].representation && id + 2 < 9) {
       EXPECT_EQ(reader.node(id).page, reader.node(id + 2).page) << id;
     }
   }
-  for (const Range& p : reader.root().pages) EXPECT_LE(p.raw_size, 2048u);
+  for (const Range& p : reader.root().pages) EXPECT_LE(p.raw_size, t.page_bytes);
 }
 
-TEST_F(RoundTrip, GeometrySurvivesWithinQuantizationError) {
+TEST_P(RoundTrip, GeometrySurvivesWithinQuantizationError) {
   PackageReader reader = PackageReader::open(file);
   for (uint32_t id = 0; id < reader.node_count(); ++id) {
     const Mesh& original = t.meshes[id];
@@ -184,7 +189,7 @@ TEST_F(RoundTrip, GeometrySurvivesWithinQuantizationError) {
   }
 }
 
-TEST_F(RoundTrip, LockedVerticesDecodeBitIdenticalAcrossNodes) {
+TEST_P(RoundTrip, LockedVerticesDecodeBitIdenticalAcrossNodes) {
   PackageReader reader = PackageReader::open(file);
   using Key = std::tuple<uint32_t, float, float, float>;  // representation, original position
   std::map<Key, std::vector<glm::vec3>> decoded_at;
@@ -216,14 +221,14 @@ TEST_F(RoundTrip, LockedVerticesDecodeBitIdenticalAcrossNodes) {
   EXPECT_GT(across_shifts, 20u);  // shared between nodes at different precisions
 }
 
-TEST_F(RoundTrip, VerifyContentsDecodesEverything) {
+TEST_P(RoundTrip, VerifyContentsDecodesEverything) {
   PackageReader reader = PackageReader::open(file);
   EXPECT_NO_THROW(reader.verify_contents());
 }
 
-TEST_F(RoundTrip, WritingTwiceGivesTheSameBytes) {
+TEST_P(RoundTrip, WritingTwiceGivesTheSameBytes) {
   std::filesystem::path again = temp_dir() / "again.lods";
-  TestPackage t2 = write_test_package(again);
+  TestPackage t2 = write_test_package(again, GetParam());
   EXPECT_EQ(t2.written.content_hash, t.written.content_hash);
   EXPECT_EQ(file_bytes(again), file_bytes(file));
 }
