@@ -4,10 +4,11 @@
 //   bench_package [--mesh=FILE] [--normal-bits=N] [--zstd-level=L] [google benchmark flags]
 //
 // Every figure is measured for codec 1 (meshoptimizer's codecs) and codec 2 (predicted positions and normals)
-// side by side in one run (benchmark argument = codec id). Before the timings it prints the size table: bytes per triangle of the whole package and where they go
-// (positions, normals, UVs, connectivity, index), each measured after zstd by encoding with and without the
-// attribute. Timings report triangles per second on one core: encode (codec), write (codec + zstd + file),
-// decode (checksum + zstd + codec, from pages in memory) and decode of the codec alone.
+// side by side in one run (benchmark argument = codec id). Before the timings it prints the size table: bytes
+// per triangle of the whole package and where they go (positions, normals, UVs, connectivity, index), each
+// measured after zstd by encoding with and without the attribute. Timings report triangles per second on one
+// core: encode (codec), write (codec + zstd + file), decode (checksum + zstd + codec, from pages in memory)
+// and decode of the codec alone.
 #include <benchmark/benchmark.h>
 #include <meshoptimizer.h>
 

@@ -5,12 +5,26 @@
 #pragma once
 
 #include <cstdint>
+#include <cstring>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace lodstream::package {
+
+// Unaligned little-endian (the byte order of every supported target) store and load of a trivially copyable
+// value in a byte record (vertex records of the node codecs).
+template <typename T>
+void store_raw(uint8_t* dst, T v) {
+  std::memcpy(dst, &v, sizeof v);
+}
+template <typename T>
+T load_raw(const uint8_t* src) {
+  T v;
+  std::memcpy(&v, src, sizeof v);
+  return v;
+}
 
 class ByteWriter {
  public:

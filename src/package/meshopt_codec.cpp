@@ -11,6 +11,7 @@
 #include "core/error.hpp"
 #include "package/bytes.hpp"
 #include "package/coarse_positions.hpp"
+#include "package/node_header.hpp"
 #include "package/octahedral.hpp"
 #include "package/vertex_attributes.hpp"
 
@@ -38,10 +39,7 @@ Layout layout_for(uint32_t flags, uint32_t normal_bits) {
   return l;
 }
 
-struct Parsed {
-  uint32_t flags = 0, shift = 0, normal_bits = 0, vertices = 0, triangles = 0, first_vertex = 0;
-  int64_t cmin[3] = {0, 0, 0};
-  glm::vec2 uv_min{0.0f}, uv_extent{0.0f};
+struct Parsed : NodeHeader {
   size_t header_size = 0;
   std::span<const uint8_t> vertex_stream, locked_stream, index_stream;
 };
@@ -49,31 +47,7 @@ struct Parsed {
 Parsed parse(std::span<const uint8_t> bytes, const std::string& where) {
   ByteReader r(bytes, where);
   Parsed p;
-  if (r.u8() != kFormat) r.fail("unknown node format");
-  p.flags = r.u8();
-  if (p.flags & ~kAllFlags) r.fail("unknown node flags");
-  p.shift = r.u8();
-  if (p.shift > kMaxPositionShift) r.fail("position shift " + std::to_string(p.shift) + " too large");
-  p.normal_bits = r.u8();
-  if ((p.flags & kHasNormals) && (p.normal_bits < 4 || p.normal_bits > 16)) r.fail("invalid normal bits");
-  uint64_t v = r.varint();
-  if (v > kMaxNodeVertices) r.fail("vertex count " + std::to_string(v) + " exceeds 65536");
-  p.vertices = static_cast<uint32_t>(v);
-  // meshopt's index stream spends at least one byte per triangle, so a count above the node's size is a lie.
-  uint64_t t = r.varint();
-  if (t > bytes.size()) r.fail("triangle count " + std::to_string(t) + " impossible for a node of this size");
-  p.triangles = static_cast<uint32_t>(t);
-  uint64_t first = r.varint();
-  if (first > UINT32_MAX - p.vertices) r.fail("first vertex out of range");
-  p.first_vertex = static_cast<uint32_t>(first);
-  for (int64_t& c : p.cmin) {
-    c = r.svarint();
-    if (c < -kMaxGridCoordinate * 2 || c > kMaxGridCoordinate * 2) r.fail("grid coordinate out of range");
-  }
-  if (p.flags & kHasUvs) {
-    p.uv_min = {r.finite_f32("uv"), r.finite_f32("uv")};
-    p.uv_extent = {r.finite_f32("uv"), r.finite_f32("uv")};
-  }
+  static_cast<NodeHeader&>(p) = NodeHeader::read(r, kFormat, kAllFlags, bytes.size());
   uint64_t vertex_size = r.varint(), locked_size = r.varint(), index_size = r.varint();
   p.header_size = r.position();
   if (vertex_size > r.remaining() || locked_size > r.remaining() - vertex_size ||
@@ -84,17 +58,6 @@ Parsed parse(std::span<const uint8_t> bytes, const std::string& where) {
   p.locked_stream = r.bytes(locked_size, "locked stream");
   p.index_stream = r.bytes(index_size, "index stream");
   return p;
-}
-
-template <typename T>
-void put(uint8_t* dst, T v) {
-  std::memcpy(dst, &v, sizeof v);
-}
-template <typename T>
-T get(const uint8_t* src) {
-  T v;
-  std::memcpy(&v, src, sizeof v);
-  return v;
 }
 
 }  // namespace
@@ -121,9 +84,9 @@ std::vector<uint8_t> MeshoptCodec::encode(const NodeGeometry& g, const PositionG
     for (int a = 0; a < 3; ++a) {
       uint64_t s = static_cast<uint64_t>(n.c[3 * v + a] - n.cmin[a]);
       if (flags & kWidePositions) {
-        put(r + 4 * a, static_cast<uint32_t>(s));
+        store_raw(r + 4 * a, static_cast<uint32_t>(s));
       } else {
-        put(r + 2 * a, static_cast<uint16_t>(s));
+        store_raw(r + 2 * a, static_cast<uint16_t>(s));
       }
     }
     if (flags & kHasNormals) {
@@ -132,8 +95,8 @@ std::vector<uint8_t> MeshoptCodec::encode(const NodeGeometry& g, const PositionG
         r[L.normal] = static_cast<uint8_t>(static_cast<int8_t>(o.x));
         r[L.normal + 1] = static_cast<uint8_t>(static_cast<int8_t>(o.y));
       } else {
-        put(r + L.normal, static_cast<int16_t>(o.x));
-        put(r + L.normal + 2, static_cast<int16_t>(o.y));
+        store_raw(r + L.normal, static_cast<int16_t>(o.x));
+        store_raw(r + L.normal + 2, static_cast<int16_t>(o.y));
       }
     }
     put_attributes(r, L.attributes, flags, g, n, old);
@@ -149,17 +112,12 @@ std::vector<uint8_t> MeshoptCodec::encode(const NodeGeometry& g, const PositionG
                                                 n.indices.size()));
 
   ByteWriter w;
-  w.u8(kFormat);
-  w.u8(static_cast<uint8_t>(flags));
-  w.u8(static_cast<uint8_t>(k));
-  w.u8(static_cast<uint8_t>((flags & kHasNormals) ? g.normal_bits : 0));
-  w.varint(V);
-  w.varint(n.indices.size() / 3);
-  w.varint(g.first_vertex);
-  for (int64_t cm : n.cmin) w.svarint(cm);
-  if (flags & kHasUvs) {
-    w.f32(n.uv_min.x), w.f32(n.uv_min.y), w.f32(n.uv_extent.x), w.f32(n.uv_extent.y);
-  }
+  NodeHeader h;
+  h.format = kFormat, h.flags = flags, h.shift = k, h.normal_bits = g.normal_bits;
+  h.vertices = uint32_t(V), h.triangles = uint32_t(n.indices.size() / 3), h.first_vertex = g.first_vertex;
+  std::copy(std::begin(n.cmin), std::end(n.cmin), h.cmin);
+  h.uv_min = n.uv_min, h.uv_extent = n.uv_extent;
+  h.write(w);
   w.varint(vertex_stream.size());
   w.varint(locked_stream.size());
   w.varint(index_stream.size());
@@ -201,7 +159,8 @@ DecodedNode MeshoptCodec::decode(std::span<const uint8_t> bytes, const PositionG
   for (size_t v = 0; v < V; ++v) {
     const uint8_t* r = records.data() + v * L.stride;
     for (int a = 0; a < 3; ++a)
-      c[3 * v + a] = p.cmin[a] + (wide ? int64_t(get<uint32_t>(r + 4 * a)) : int64_t(get<uint16_t>(r + 2 * a)));
+      c[3 * v + a] = p.cmin[a] +
+                     (wide ? int64_t(load_raw<uint32_t>(r + 4 * a)) : int64_t(load_raw<uint16_t>(r + 2 * a)));
   }
   m.positions.resize(V);
   decode_positions(c, locked, grid, m.positions.data());
@@ -214,7 +173,7 @@ DecodedNode MeshoptCodec::decode(std::span<const uint8_t> bytes, const PositionG
       if (L.normal_size == 2) {
         x = static_cast<int8_t>(r[0]), y = static_cast<int8_t>(r[1]);
       } else {
-        x = get<int16_t>(r), y = get<int16_t>(r + 2);
+        x = load_raw<int16_t>(r), y = load_raw<int16_t>(r + 2);
       }
       m.normals[v] = oct_decode(x, y, inv_scale);
     }

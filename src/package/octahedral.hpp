@@ -8,8 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <glm/glm.hpp>
+#include <limits>
 
 namespace lodstream::package {
 
@@ -17,8 +17,8 @@ inline float sign_not_zero(float v) {
   return v >= 0.0f ? 1.0f : -1.0f;
 }
 
-// n need not be unit length; a zero (or non-finite) vector encodes as +z. Returns components in [-(2^(bits-1)-1),
-// 2^(bits-1)-1].
+// n need not be unit length; a zero (or non-finite) vector encodes as +z. Returns components in
+// [-(2^(bits-1)-1), 2^(bits-1)-1].
 inline glm::ivec2 oct_encode(glm::vec3 n, int bits) {
   const float l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
   const bool usable = l1 > 0.0f && l1 <= std::numeric_limits<float>::max();  // not zero, NaN or infinite

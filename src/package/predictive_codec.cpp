@@ -8,6 +8,7 @@
 #include "core/error.hpp"
 #include "package/bytes.hpp"
 #include "package/coarse_positions.hpp"
+#include "package/node_header.hpp"
 #include "package/octahedral.hpp"
 #include "package/quantized_node.hpp"
 #include "package/vertex_attributes.hpp"
@@ -109,11 +110,8 @@ void predicted_normals(std::span<const uint32_t> indices, uint32_t first_vertex,
   }
 }
 
-struct Parsed {
-  uint32_t flags = 0, shift = 0, normal_bits = 0, vertices = 0, triangles = 0, first_vertex = 0;
+struct Parsed : NodeHeader {
   uint32_t position_bytes = 0, normal_bytes = 0;
-  int64_t cmin[3] = {0, 0, 0};
-  glm::vec2 uv_min{0.0f}, uv_extent{0.0f};
   size_t header_size = 0;
   std::span<const uint8_t> position_planes, normal_planes, attribute_stream, locked_stream, index_stream;
 };
@@ -121,36 +119,12 @@ struct Parsed {
 Parsed parse(std::span<const uint8_t> bytes, const std::string& where) {
   ByteReader r(bytes, where);
   Parsed p;
-  if (r.u8() != kFormat) r.fail("unknown node format");
-  p.flags = r.u8();
-  if (p.flags & ~kAllFlags) r.fail("unknown node flags");
-  p.shift = r.u8();
-  if (p.shift > kMaxPositionShift) r.fail("position shift " + std::to_string(p.shift) + " too large");
-  p.normal_bits = r.u8();
-  if ((p.flags & kHasNormals) && (p.normal_bits < 4 || p.normal_bits > 16)) r.fail("invalid normal bits");
+  static_cast<NodeHeader&>(p) = NodeHeader::read(r, kFormat, kAllFlags, bytes.size());
   const uint8_t widths = r.u8();
   p.position_bytes = widths & 15, p.normal_bytes = widths >> 4;
   if (p.position_bytes < 1 || p.position_bytes > kMaxPositionBytes || p.normal_bytes > kMaxNormalBytes ||
       (p.normal_bytes == 0) != !(p.flags & kHasNormals))
     r.fail("invalid residual widths");
-  uint64_t v = r.varint();
-  if (v > kMaxNodeVertices) r.fail("vertex count " + std::to_string(v) + " exceeds 65536");
-  p.vertices = static_cast<uint32_t>(v);
-  // meshopt's index stream spends at least one byte per triangle, so a count above the node's size is a lie.
-  uint64_t t = r.varint();
-  if (t > bytes.size()) r.fail("triangle count " + std::to_string(t) + " impossible for a node of this size");
-  p.triangles = static_cast<uint32_t>(t);
-  uint64_t first = r.varint();
-  if (first > UINT32_MAX - p.vertices) r.fail("first vertex out of range");
-  p.first_vertex = static_cast<uint32_t>(first);
-  for (int64_t& c : p.cmin) {
-    c = r.svarint();
-    if (c < -kMaxGridCoordinate * 2 || c > kMaxGridCoordinate * 2) r.fail("grid coordinate out of range");
-  }
-  if (p.flags & kHasUvs) {
-    p.uv_min = {r.finite_f32("uv"), r.finite_f32("uv")};
-    p.uv_extent = {r.finite_f32("uv"), r.finite_f32("uv")};
-  }
   const uint64_t attribute_size = r.varint(), locked_size = r.varint(), index_size = r.varint();
   p.header_size = r.position();
   const uint64_t planes = uint64_t(p.vertices) * (3 * p.position_bytes + 2 * p.normal_bytes);
@@ -167,8 +141,8 @@ Parsed parse(std::span<const uint8_t> bytes, const std::string& where) {
 }
 
 // Unzigzags `count` values of `components` components each, stored as `width` byte planes (byte b of
-// component a at plane b * components + a), into out[components * i + a]. Cost: O(count * components * width),
-// one pass per plane.
+// component a at plane b * components + a), into out[components * i + a]. Cost: O(count * components *
+// width), one pass per plane.
 template <typename T>
 void read_planes(const uint8_t* planes, size_t count, uint32_t components, uint32_t width, T* out) {
   for (uint32_t a = 0; a < components; ++a) {
@@ -177,11 +151,13 @@ void read_planes(const uint8_t* planes, size_t count, uint32_t components, uint3
       for (size_t i = 0; i < count; ++i) out[components * i + a] = T(unzigzag(low[i]));
     } else if (width == 2) {
       const uint8_t* high = planes + (components + a) * count;
-      for (size_t i = 0; i < count; ++i) out[components * i + a] = T(unzigzag(low[i] | uint64_t(high[i]) << 8));
+      for (size_t i = 0; i < count; ++i)
+        out[components * i + a] = T(unzigzag(low[i] | uint64_t(high[i]) << 8));
     } else {
       for (size_t i = 0; i < count; ++i) {
         uint64_t value = 0;
-        for (uint32_t b = 0; b < width; ++b) value |= uint64_t(planes[(b * components + a) * count + i]) << (8 * b);
+        for (uint32_t b = 0; b < width; ++b)
+          value |= uint64_t(planes[(b * components + a) * count + i]) << (8 * b);
         out[components * i + a] = T(unzigzag(value));
       }
     }
@@ -262,7 +238,8 @@ std::vector<uint8_t> PredictiveCodec::encode(const NodeGeometry& g, const Positi
   if (layout.end > 0) {
     const size_t stride = (layout.end + 3) & ~size_t(3);
     std::vector<uint8_t> records(V * stride, 0);
-    for (uint32_t v = 0; v < V; ++v) put_attributes(records.data() + v * stride, layout, flags, g, n, n.order[v]);
+    for (uint32_t v = 0; v < V; ++v)
+      put_attributes(records.data() + v * stride, layout, flags, g, n, n.order[v]);
     attribute_stream.resize(meshopt_encodeVertexBufferBound(V, stride));
     attribute_stream.resize(meshopt_encodeVertexBuffer(attribute_stream.data(), attribute_stream.size(),
                                                        records.data(), V, stride));
@@ -270,18 +247,13 @@ std::vector<uint8_t> PredictiveCodec::encode(const NodeGeometry& g, const Positi
   const std::vector<uint8_t> locked_stream = encode_locked_stream(n, k);
 
   ByteWriter w;
-  w.u8(kFormat);
-  w.u8(static_cast<uint8_t>(flags));
-  w.u8(static_cast<uint8_t>(k));
-  w.u8(static_cast<uint8_t>((flags & kHasNormals) ? g.normal_bits : 0));
+  NodeHeader h;
+  h.format = kFormat, h.flags = flags, h.shift = k, h.normal_bits = g.normal_bits;
+  h.vertices = V, h.triangles = uint32_t(n.indices.size() / 3), h.first_vertex = g.first_vertex;
+  std::copy(std::begin(n.cmin), std::end(n.cmin), h.cmin);
+  h.uv_min = n.uv_min, h.uv_extent = n.uv_extent;
+  h.write(w);
   w.u8(static_cast<uint8_t>(position_bytes | normal_bytes << 4));
-  w.varint(V);
-  w.varint(n.indices.size() / 3);
-  w.varint(g.first_vertex);
-  for (int64_t cm : n.cmin) w.svarint(cm);
-  if (flags & kHasUvs) {
-    w.f32(n.uv_min.x), w.f32(n.uv_min.y), w.f32(n.uv_extent.x), w.f32(n.uv_extent.y);
-  }
   w.varint(attribute_stream.size());
   w.varint(locked_stream.size());
   w.varint(index_stream.size());
@@ -321,21 +293,23 @@ DecodedNode PredictiveCodec::decode(std::span<const uint8_t> bytes, const Positi
   const int64_t* r = residual.data();
   uint64_t* cu = reinterpret_cast<uint64_t*>(c.data());
   const uint64_t cmin[3] = {uint64_t(p.cmin[0]), uint64_t(p.cmin[1]), uint64_t(p.cmin[2])};
-  for_each_prediction(m.indices, p.first_vertex, V, first, [&](uint32_t v, uint32_t o1, uint32_t o2, uint32_t o) {
-    uint64_t* out = cu + 3 * size_t(v);
-    if (o1 == kNone) {
-      for (int a = 0; a < 3; ++a) out[a] = cmin[a] + uint64_t(r[a]);
-    } else if (o2 == kNone) {
-      const uint64_t* from = cu + 3 * size_t(o1);
-      for (int a = 0; a < 3; ++a) out[a] = from[a] + uint64_t(r[a]);
-    } else {
-      const uint64_t *x = cu + 3 * size_t(o1), *y = cu + 3 * size_t(o2), *z = cu + 3 * size_t(o);
-      for (int a = 0; a < 3; ++a) out[a] = x[a] + y[a] - z[a] + uint64_t(r[a]);
-    }
-    r += 3;
-  });
+  for_each_prediction(
+      m.indices, p.first_vertex, V, first, [&](uint32_t v, uint32_t o1, uint32_t o2, uint32_t o) {
+        uint64_t* out = cu + 3 * size_t(v);
+        if (o1 == kNone) {
+          for (int a = 0; a < 3; ++a) out[a] = cmin[a] + uint64_t(r[a]);
+        } else if (o2 == kNone) {
+          const uint64_t* from = cu + 3 * size_t(o1);
+          for (int a = 0; a < 3; ++a) out[a] = from[a] + uint64_t(r[a]);
+        } else {
+          const uint64_t *x = cu + 3 * size_t(o1), *y = cu + 3 * size_t(o2), *z = cu + 3 * size_t(o);
+          for (int a = 0; a < 3; ++a) out[a] = x[a] + y[a] - z[a] + uint64_t(r[a]);
+        }
+        r += 3;
+      });
   bool in_range = true;
-  for (size_t i = 0; i < 3 * size_t(V); ++i) in_range &= cu[i] + uint64_t(kMaxCoarse) <= 2 * uint64_t(kMaxCoarse);
+  for (size_t i = 0; i < 3 * size_t(V); ++i)
+    in_range &= cu[i] + uint64_t(kMaxCoarse) <= 2 * uint64_t(kMaxCoarse);
   if (!in_range) throw Error(where + ": predicted position out of the grid's range");
   m.positions.resize(V);
   decode_positions(std::span(c).first(3 * size_t(V)), locked, grid, m.positions.data());

@@ -5,11 +5,10 @@
 // grid values and locked vertices bit-identically on the finest grid.
 //
 // Bytes of a node:
-//   u8 format (1), u8 flags (1 normals, 2 uvs, 4 colors, 8 vertex_data), u8 position_shift k, u8 normal_bits,
+//   the common header (node_header.hpp) with format 1 and flags 1 normals, 2 uvs, 4 colors, 8 vertex_data;
 //   u8 widths (low nibble: bytes per position residual wp, 1..5; high nibble: bytes per normal residual wn,
-//   0..3); varint vertex count V (≤ 65536), varint triangle count T, varint first_vertex; svarint cmin[3];
-//   [uvs: f32 uv_min[2], f32 uv_extent[2]]; varint sizes of the attribute, locked and index streams; then the
-//   position planes (3 wp V bytes), the normal planes (2 wn V bytes), the attribute, locked and index streams.
+//   0..3); varint sizes of the attribute, locked and index streams; then the position planes (3 wp V bytes),
+//   the normal planes (2 wn V bytes), the attribute, locked and index streams.
 // Index stream: meshopt_encodeIndexBuffer (version 1). The decoder decodes it first; everything below walks
 //   the decoded triangles, so encoder and decoder predict from the same data.
 // Positions (parallelogram prediction, Touma & Gotsman 1998, "Triangle Mesh Compression", GI'98): the

@@ -1,6 +1,6 @@
 // What every node codec does first: validate a NodeGeometry, choose the stored vertex order and quantize the
-// positions onto the representation's grid (the rule of node_codec.hpp), then the UV box. Shared by the codecs
-// so that a vertex that two codecs store decodes to the same grid value.
+// positions onto the representation's grid (the rule of node_codec.hpp), then the UV box. Shared by the
+// codecs so that a vertex that two codecs store decodes to the same grid value.
 //
 // How precision is spent. q = round((p - origin) / step) on the representation's grid (finest step, error per
 // axis ≤ step/2). A free vertex stores c = round(q / 2^k) and decodes to c * 2^k (error per axis ≤ step/2 +

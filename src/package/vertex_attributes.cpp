@@ -4,27 +4,14 @@
 #include <cmath>
 #include <cstring>
 
+#include "package/bytes.hpp"
+
 namespace lodstream::package {
-
-namespace {
-
-template <typename T>
-void put(uint8_t* dst, T v) {
-  std::memcpy(dst, &v, sizeof v);
-}
-template <typename T>
-T get(const uint8_t* src) {
-  T v;
-  std::memcpy(&v, src, sizeof v);
-  return v;
-}
-
-}  // namespace
 
 uint32_t attribute_flags(const NodeGeometry& g) {
   const Mesh& m = *g.mesh;
-  return (m.has_normals() ? kHasNormals : 0) | (m.has_uvs() ? kHasUvs : 0) | (m.has_colors() ? kHasColors : 0) |
-         (g.vertex_data.empty() ? 0 : kHasVertexData);
+  return (m.has_normals() ? kHasNormals : 0) | (m.has_uvs() ? kHasUvs : 0) |
+         (m.has_colors() ? kHasColors : 0) | (g.vertex_data.empty() ? 0 : kHasVertexData);
 }
 
 AttributeLayout attribute_layout(uint32_t flags, size_t at) {
@@ -42,14 +29,14 @@ void put_attributes(uint8_t* r, const AttributeLayout& l, uint32_t flags, const 
   if (flags & kHasUvs) {
     for (int a = 0; a < 2; ++a) {
       float t = n.uv_extent[a] > 0.0f ? (m.uvs[old][a] - n.uv_min[a]) / n.uv_extent[a] : 0.0f;
-      put(r + l.uv + 2 * a, static_cast<uint16_t>(std::lround(std::clamp(t, 0.0f, 1.0f) * 65535.0f)));
+      store_raw(r + l.uv + 2 * a, static_cast<uint16_t>(std::lround(std::clamp(t, 0.0f, 1.0f) * 65535.0f)));
     }
   }
   if (flags & kHasColors) {
     for (int a = 0; a < 4; ++a)
       r[l.color + a] = static_cast<uint8_t>(std::lround(std::clamp(m.colors[old][a], 0.0f, 1.0f) * 255.0f));
   }
-  if (flags & kHasVertexData) put(r + l.data, g.vertex_data[old]);
+  if (flags & kHasVertexData) store_raw(r + l.data, g.vertex_data[old]);
 }
 
 void get_attributes(const uint8_t* records, size_t stride, size_t V, const AttributeLayout& l, uint32_t flags,
@@ -60,7 +47,7 @@ void get_attributes(const uint8_t* records, size_t stride, size_t V, const Attri
     const glm::vec2 scale = uv_extent * (1.0f / 65535.0f);
     for (size_t v = 0; v < V; ++v) {
       const uint8_t* r = records + v * stride + l.uv;
-      m.uvs[v] = uv_min + glm::vec2(get<uint16_t>(r), get<uint16_t>(r + 2)) * scale;
+      m.uvs[v] = uv_min + glm::vec2(load_raw<uint16_t>(r), load_raw<uint16_t>(r + 2)) * scale;
     }
   }
   if (flags & kHasColors) {
@@ -72,7 +59,7 @@ void get_attributes(const uint8_t* records, size_t stride, size_t V, const Attri
   }
   if (flags & kHasVertexData) {
     out.vertex_data.resize(V);
-    for (size_t v = 0; v < V; ++v) out.vertex_data[v] = get<uint32_t>(records + v * stride + l.data);
+    for (size_t v = 0; v < V; ++v) out.vertex_data[v] = load_raw<uint32_t>(records + v * stride + l.data);
   }
 }
 

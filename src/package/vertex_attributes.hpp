@@ -23,8 +23,8 @@ struct AttributeLayout {
 AttributeLayout attribute_layout(uint32_t flags, size_t at);
 
 // Writes caller vertex `old`'s attributes into `record`. Cost: O(1).
-void put_attributes(uint8_t* record, const AttributeLayout& layout, uint32_t flags, const NodeGeometry& geometry,
-                    const QuantizedNode& node, uint32_t old);
+void put_attributes(uint8_t* record, const AttributeLayout& layout, uint32_t flags,
+                    const NodeGeometry& geometry, const QuantizedNode& node, uint32_t old);
 // Reads the attributes of V records (`stride` bytes apart) into out.mesh.uvs / colors and out.vertex_data.
 // Cost: O(V).
 void get_attributes(const uint8_t* records, size_t stride, size_t vertices, const AttributeLayout& layout,

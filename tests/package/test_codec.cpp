@@ -11,8 +11,8 @@
 #include "core/error.hpp"
 #include "package/format.hpp"
 #include "package/meshopt_codec.hpp"
-#include "package/predictive_codec.hpp"
 #include "package/octahedral.hpp"
+#include "package/predictive_codec.hpp"
 #include "support/shapes.hpp"
 
 namespace lodstream::test {

@@ -1,0 +1,52 @@
+#include "package/node_header.hpp"
+
+#include <string>
+
+#include "package/quantized_node.hpp"
+#include "package/vertex_attributes.hpp"
+
+namespace lodstream::package {
+
+void NodeHeader::write(ByteWriter& w) const {
+  w.u8(format);
+  w.u8(static_cast<uint8_t>(flags));
+  w.u8(static_cast<uint8_t>(shift));
+  w.u8(static_cast<uint8_t>((flags & kHasNormals) ? normal_bits : 0));
+  w.varint(vertices);
+  w.varint(triangles);
+  w.varint(first_vertex);
+  for (int64_t c : cmin) w.svarint(c);
+  if (flags & kHasUvs) w.f32(uv_min.x), w.f32(uv_min.y), w.f32(uv_extent.x), w.f32(uv_extent.y);
+}
+
+NodeHeader NodeHeader::read(ByteReader& r, uint8_t format, uint32_t known_flags, size_t node_size) {
+  NodeHeader h;
+  h.format = r.u8();
+  if (h.format != format) r.fail("unknown node format");
+  h.flags = r.u8();
+  if (h.flags & ~known_flags) r.fail("unknown node flags");
+  h.shift = r.u8();
+  if (h.shift > kMaxPositionShift) r.fail("position shift " + std::to_string(h.shift) + " too large");
+  h.normal_bits = r.u8();
+  if ((h.flags & kHasNormals) && (h.normal_bits < 4 || h.normal_bits > 16)) r.fail("invalid normal bits");
+  const uint64_t v = r.varint();
+  if (v > kMaxNodeVertices) r.fail("vertex count " + std::to_string(v) + " exceeds 65536");
+  h.vertices = static_cast<uint32_t>(v);
+  const uint64_t t = r.varint();
+  if (t > node_size) r.fail("triangle count " + std::to_string(t) + " impossible for a node of this size");
+  h.triangles = static_cast<uint32_t>(t);
+  const uint64_t first = r.varint();
+  if (first > UINT32_MAX - h.vertices) r.fail("first vertex out of range");
+  h.first_vertex = static_cast<uint32_t>(first);
+  for (int64_t& c : h.cmin) {
+    c = r.svarint();
+    if (c < -kMaxGridCoordinate * 2 || c > kMaxGridCoordinate * 2) r.fail("grid coordinate out of range");
+  }
+  if (h.flags & kHasUvs) {
+    h.uv_min = {r.finite_f32("uv"), r.finite_f32("uv")};
+    h.uv_extent = {r.finite_f32("uv"), r.finite_f32("uv")};
+  }
+  return h;
+}
+
+}  // namespace lodstream::package
