@@ -112,12 +112,7 @@ std::vector<uint8_t> MeshoptCodec::encode(const NodeGeometry& g, const PositionG
                                                 n.indices.size()));
 
   ByteWriter w;
-  NodeHeader h;
-  h.format = kFormat, h.flags = flags, h.shift = k, h.normal_bits = g.normal_bits;
-  h.vertices = uint32_t(V), h.triangles = uint32_t(n.indices.size() / 3), h.first_vertex = g.first_vertex;
-  std::copy(std::begin(n.cmin), std::end(n.cmin), h.cmin);
-  h.uv_min = n.uv_min, h.uv_extent = n.uv_extent;
-  h.write(w);
+  NodeHeader::of(kFormat, flags, g, n).write(w);
   w.varint(vertex_stream.size());
   w.varint(locked_stream.size());
   w.varint(index_stream.size());

@@ -1,11 +1,22 @@
 #include "package/node_header.hpp"
 
+#include <algorithm>
+#include <iterator>
 #include <string>
 
-#include "package/quantized_node.hpp"
 #include "package/vertex_attributes.hpp"
 
 namespace lodstream::package {
+
+NodeHeader NodeHeader::of(uint8_t format, uint32_t flags, const NodeGeometry& g, const QuantizedNode& n) {
+  NodeHeader h;
+  h.format = format, h.flags = flags, h.shift = g.position_shift, h.normal_bits = g.normal_bits;
+  h.vertices = uint32_t(n.order.size()), h.triangles = uint32_t(n.indices.size() / 3);
+  h.first_vertex = g.first_vertex;
+  std::copy(std::begin(n.cmin), std::end(n.cmin), h.cmin);
+  h.uv_min = n.uv_min, h.uv_extent = n.uv_extent;
+  return h;
+}
 
 void NodeHeader::write(ByteWriter& w) const {
   w.u8(format);

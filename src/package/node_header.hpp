@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "package/bytes.hpp"
+#include "package/quantized_node.hpp"
 
 namespace lodstream::package {
 
@@ -18,6 +19,9 @@ struct NodeHeader {
   int64_t cmin[3] = {0, 0, 0};
   glm::vec2 uv_min{0.0f}, uv_extent{0.0f};
 
+  // The header of a quantized node (quantized_node.hpp) of `geometry`.
+  static NodeHeader of(uint8_t format, uint32_t flags, const NodeGeometry& geometry,
+                       const QuantizedNode& node);
   void write(ByteWriter& w) const;
   // Reads and validates: the format must be `format`, flags within `known_flags`, shift ≤ 24, normal bits in
   // 4..16 with normals, V ≤ 65536, T ≤ node_size (every codec spends at least a byte per triangle),

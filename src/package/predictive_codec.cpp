@@ -41,20 +41,29 @@ uint32_t bytes_for(uint64_t largest) {
 
 // Calls visit(v, o1, o2, o) for v = 0, 1, ..., V - 1 with v's predictors, all below v (decoded before it in
 // vertex order): o1 + o2 - o (parallelogram), o1 alone (o2 == kNone), or none (o1 == kNone: predict from
-// vertex v - 1, or cmin for v = 0); the rule is the header comment's. `first` is scratch (V entries).
-// Indices must be below first_vertex + V. O(T + V), one branch-free pass over the corners, then per vertex
-// a look at its first triangle and the kAcrossWindow triangles before it.
+// vertex v - 1, or cmin for v = 0); the rule is the header comment's. `first` is scratch (V + 1 entries).
+// Returns the largest index, which the caller must check against first_vertex + V (a larger one is ignored
+// here: never a predictor). O(T + V), one branch-free pass over the corners, then per vertex a look at its
+// first triangle and the kAcrossWindow triangles before it.
 template <class Visit>
-void for_each_prediction(std::span<const uint32_t> indices, uint32_t first_vertex, uint32_t V,
-                         std::vector<uint32_t>& first, Visit&& visit) {
-  // first[v]: the first corner using v (a reverse pass storing unconditionally leaves the smallest).
-  first.assign(V, kNone);
+uint32_t for_each_prediction(std::span<const uint32_t> indices, uint32_t first_vertex, uint32_t V,
+                             std::vector<uint32_t>& first, Visit&& visit) {
+  // first[v]: the first corner using v (a reverse pass storing unconditionally leaves the smallest; indices
+  // past the node land in the spare entry V).
+  first.assign(size_t(V) + 1, kNone);
   const uint32_t corners = uint32_t(indices.size());
+  uint32_t largest = 0;
   if (first_vertex == 0) {
-    for (uint32_t c = corners; c-- > 0;) first[indices[c]] = c;
+    for (uint32_t c = corners; c-- > 0;) {
+      const uint32_t i = indices[c];
+      largest = std::max(largest, i);
+      first[std::min(i, V)] = c;
+    }
   } else {
-    for (uint32_t c = corners; c-- > 0;)
+    for (uint32_t c = corners; c-- > 0;) {
+      largest = std::max(largest, indices[c]);
       if (const uint32_t l = indices[c] - first_vertex; l < V) first[l] = c;
+    }
   }
   const uint32_t* idx = indices.data();
   for (uint32_t v = 0; v < V; ++v) {
@@ -88,6 +97,7 @@ void for_each_prediction(std::span<const uint32_t> indices, uint32_t first_verte
       visit(v, v > 0 ? v - 1 : kNone, kNone, kNone);
     }
   }
+  return largest;
 }
 
 int64_t predict(const int64_t* c, uint32_t o1, uint32_t o2, uint32_t o, int a, int64_t cmin) {
@@ -247,12 +257,7 @@ std::vector<uint8_t> PredictiveCodec::encode(const NodeGeometry& g, const Positi
   const std::vector<uint8_t> locked_stream = encode_locked_stream(n, k);
 
   ByteWriter w;
-  NodeHeader h;
-  h.format = kFormat, h.flags = flags, h.shift = k, h.normal_bits = g.normal_bits;
-  h.vertices = V, h.triangles = uint32_t(n.indices.size() / 3), h.first_vertex = g.first_vertex;
-  std::copy(std::begin(n.cmin), std::end(n.cmin), h.cmin);
-  h.uv_min = n.uv_min, h.uv_extent = n.uv_extent;
-  h.write(w);
+  NodeHeader::of(kFormat, flags, g, n).write(w);
   w.u8(static_cast<uint8_t>(position_bytes | normal_bytes << 4));
   w.varint(attribute_stream.size());
   w.varint(locked_stream.size());
@@ -277,15 +282,10 @@ DecodedNode PredictiveCodec::decode(std::span<const uint8_t> bytes, const Positi
   if (meshopt_decodeIndexBuffer(m.indices.data(), m.indices.size(), sizeof(uint32_t), p.index_stream.data(),
                                 p.index_stream.size()) != 0)
     throw Error(where + ": corrupted index stream");
-  const uint32_t vertex_end = p.first_vertex + p.vertices;
-  uint32_t max_index = 0;
-  for (uint32_t i : m.indices) max_index = std::max(max_index, i);
-  if (T > 0 && max_index >= vertex_end)
-    throw Error(where + ": index " + std::to_string(max_index) + " out of range");
   const LockedStream locked = LockedStream::parse(p.locked_stream, V, p.shift, where);
 
   // Positions: the prediction of the header comment, in vertex order. The arithmetic wraps (unsigned), so
-  // hostile residuals cannot overflow; the result is range-checked afterwards.
+  // hostile residuals cannot overflow; the results and the indices are range-checked afterwards.
   thread_local std::vector<uint32_t> first;
   thread_local std::vector<int64_t> residual, c;
   residual.resize(3 * size_t(V)), c.resize(3 * size_t(V));
@@ -293,7 +293,8 @@ DecodedNode PredictiveCodec::decode(std::span<const uint8_t> bytes, const Positi
   const int64_t* r = residual.data();
   uint64_t* cu = reinterpret_cast<uint64_t*>(c.data());
   const uint64_t cmin[3] = {uint64_t(p.cmin[0]), uint64_t(p.cmin[1]), uint64_t(p.cmin[2])};
-  for_each_prediction(
+  bool out_of_range = false;
+  const uint32_t max_index = for_each_prediction(
       m.indices, p.first_vertex, V, first, [&](uint32_t v, uint32_t o1, uint32_t o2, uint32_t o) {
         uint64_t* out = cu + 3 * size_t(v);
         if (o1 == kNone) {
@@ -305,12 +306,12 @@ DecodedNode PredictiveCodec::decode(std::span<const uint8_t> bytes, const Positi
           const uint64_t *x = cu + 3 * size_t(o1), *y = cu + 3 * size_t(o2), *z = cu + 3 * size_t(o);
           for (int a = 0; a < 3; ++a) out[a] = x[a] + y[a] - z[a] + uint64_t(r[a]);
         }
+        for (int a = 0; a < 3; ++a) out_of_range |= out[a] + uint64_t(kMaxCoarse) > 2 * uint64_t(kMaxCoarse);
         r += 3;
       });
-  bool in_range = true;
-  for (size_t i = 0; i < 3 * size_t(V); ++i)
-    in_range &= cu[i] + uint64_t(kMaxCoarse) <= 2 * uint64_t(kMaxCoarse);
-  if (!in_range) throw Error(where + ": predicted position out of the grid's range");
+  if (T > 0 && max_index >= p.first_vertex + p.vertices)
+    throw Error(where + ": index " + std::to_string(max_index) + " out of range");
+  if (out_of_range) throw Error(where + ": predicted position out of the grid's range");
   m.positions.resize(V);
   decode_positions(std::span(c).first(3 * size_t(V)), locked, grid, m.positions.data());
 
