@@ -14,13 +14,9 @@
 //   locked vertex, packed LSB first.
 // Index stream: meshopt_encodeIndexBuffer (format version 1) of the triangles.
 //
-// How precision is spent. q = round((p - origin) / step) on the representation's grid (finest step, error per
-// axis ≤ step/2). A free vertex stores c = round(q / 2^k) and decodes to c * 2^k (error per axis ≤ step/2 +
-// 2^k step/2); a locked vertex stores c = floor(q / 2^k) plus its k low bits and decodes to q exactly. Each
-// unused low bit of a free vertex saves about one bit per coordinate before zstd; the bits of locked vertices
-// (shared with nodes at other shifts) are never dropped, so their decoded positions agree bit for bit
-// everywhere. Normals: octahedral at normal_bits per component (max angular error about 2^(2 - normal_bits)
-// radians); UVs: 16 bits over the node's own UV box; colours: 8 bits.
+// Quantization and how precision is spent: quantized_node.hpp; the locked stream and the decode formula:
+// coarse_positions.hpp. Normals: octahedral at normal_bits per component (max angular error about
+// 2^(2 - normal_bits) radians); UVs: 16 bits over the node's own UV box; colours: 8 bits.
 #pragma once
 
 #include "package/node_codec.hpp"

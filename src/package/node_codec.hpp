@@ -8,7 +8,8 @@
 // of 2^k grid steps), EXCEPT vertices flagged `locked`, which always decode to the exact finest-grid value.
 // Because the grid is shared by every node of a representation and the decode is one deterministic formula, a
 // vertex that two nodes store as locked (or with the same shift) decodes bit-identically in both: that keeps
-// cuts crack-free. See MeshoptCodec for how the remaining precision is spent.
+// cuts crack-free. See quantized_node.hpp for how the remaining precision is spent. The codecs: MeshoptCodec
+// (id 1, the default) and PredictiveCodec (id 2).
 #pragma once
 
 #include <cstdint>

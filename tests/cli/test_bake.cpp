@@ -4,6 +4,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include "support/run.hpp"
 
@@ -13,8 +15,11 @@ using lodstream::test::temp_dir;
 
 namespace {
 
-nlohmann::json bake_and_verify(const std::string& model, const std::filesystem::path& out) {
-  auto bake = run_lodstream({"bake", data_file(model).string(), "-o", out.string(), "--json"});
+nlohmann::json bake_and_verify(const std::string& model, const std::filesystem::path& out,
+                               std::vector<std::string> options = {}) {
+  std::vector<std::string> args = {"bake", data_file(model).string(), "-o", out.string(), "--json"};
+  args.insert(args.end(), options.begin(), options.end());
+  auto bake = run_lodstream(args);
   EXPECT_EQ(bake.status, 0) << bake.err;
   if (bake.status != 0) return {};
   auto j = bake.json();
@@ -44,6 +49,20 @@ TEST(CliBake, ElephantBuildsAVerifiedHierarchy) {
   EXPECT_EQ(j["objects"].get<size_t>(), 1u);
   EXPECT_GE(j["levels"].get<int>(), 3);
   EXPECT_GT(j["nodes"].get<int>(), 44);  // more than the full-resolution clusters alone
+}
+
+TEST(CliBake, BothNodeCodecsVerifyAndCodecTwoIsSmaller) {
+  // The same hierarchy through codec 1 (meshoptimizer's codecs) and codec 2 (predicted positions and
+  // normals): both packages pass inspect --verify (crack-free cuts need codec 2's locked vertices exact too).
+  const auto dir = temp_dir();
+  auto one = bake_and_verify("bunny.obj", dir / "bunny1.lods", {"--codec", "1"});
+  auto two = bake_and_verify("bunny.obj", dir / "bunny2.lods", {"--codec", "2"});
+  EXPECT_EQ(one["nodes"], two["nodes"]);
+  EXPECT_LT(two["bytes"].get<double>(), 0.9 * one["bytes"].get<double>());
+  auto bad = run_lodstream(
+      {"bake", data_file("elephant.off").string(), "-o", (dir / "x.lods").string(), "--codec", "3"});
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find("lodstream: error: --codec"), std::string::npos) << bad.err;
 }
 
 TEST(CliBake, MotorBikeKeepsEveryObject) {
