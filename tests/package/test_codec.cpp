@@ -103,6 +103,33 @@ TEST_P(NodeCodecTest, ProgressiveChunkKeepsOrderExternalIndicesAndVertexData) {
   }
 }
 
+TEST_P(NodeCodecTest, PreserveOrderKeepsVerticesAndTriangles) {
+  // preserve_order on a standalone node (first_vertex 0): vertex i decodes as input vertex i and triangle t
+  // as input triangle t (possibly rotated), though the input order is far from the codecs' preferred one.
+  Mesh m = sphere(1.0f, 7, 9);
+  std::reverse(m.positions.begin(), m.positions.end());
+  std::reverse(m.normals.begin(), m.normals.end());
+  const uint32_t last = uint32_t(m.vertex_count()) - 1;
+  for (uint32_t& i : m.indices) i = last - i;
+  NodeGeometry g;
+  g.mesh = &m;
+  g.preserve_order = true;
+  const PositionGrid pg = PositionGrid::for_bounds(m.bounds());
+  const NodeCodec& codec = node_codec(GetParam());
+  const DecodedNode d = codec.decode(codec.encode(g, pg), pg, "ordered");
+  ASSERT_EQ(d.mesh.vertex_count(), m.vertex_count());
+  for (size_t v = 0; v < m.vertex_count(); ++v)
+    EXPECT_LE(glm::length(d.mesh.positions[v] - m.positions[v]), pg.step) << v;
+  ASSERT_EQ(d.mesh.indices.size(), m.indices.size());
+  for (size_t t = 0; t < m.triangle_count(); ++t) {
+    std::array<uint32_t, 3> a{m.indices[3 * t], m.indices[3 * t + 1], m.indices[3 * t + 2]};
+    std::array<uint32_t, 3> b{d.mesh.indices[3 * t], d.mesh.indices[3 * t + 1], d.mesh.indices[3 * t + 2]};
+    std::rotate(a.begin(), std::min_element(a.begin(), a.end()), a.end());
+    std::rotate(b.begin(), std::min_element(b.begin(), b.end()), b.end());
+    EXPECT_EQ(a, b) << t;
+  }
+}
+
 TEST_P(NodeCodecTest, WidePositionRangeStaysExact) {
   // 2^20 steps across: more than 16 bits per coordinate.
   Mesh m = sphere(1.0f, 8, 16);
