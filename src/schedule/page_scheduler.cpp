@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <tuple>
+#include <unordered_set>
 
 #include "core/error.hpp"
 #include "schedule/screen_area.hpp"
@@ -105,7 +106,7 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
     drawn_area[d.object] +=
         projected_area(to_world(records.record(d.node)->sphere, o.transform, max_scale(o.transform)), v.view);
   }
-  std::vector<uint64_t> seen;
+  std::unordered_set<uint64_t> seen;  // exchanges of this view (a linear search was quadratic in the cut)
   for (const MissingNode& m : cut.missing) {
     if (!m.record_known) {
       double& priority = unknown[m.node];
@@ -119,8 +120,7 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
     const bool root = r.parents.empty();
     const uint64_t key = uint64_t(m.object) << 32 |
                          (root ? package::kNone : *std::min_element(r.parents.begin(), r.parents.end()));
-    if (std::find(seen.begin(), seen.end(), key) != seen.end()) continue;
-    seen.push_back(key);
+    if (!seen.insert(key).second) continue;
     Exchange e;
     e.object = m.object;
     if (root) {
@@ -220,9 +220,12 @@ std::vector<PageRef> PageScheduler::next(const package::PackageScene& scene, con
   std::stable_sort(ranked.begin(), ranked.end(), [](const Ranked& a, const Ranked& b) {
     return std::tie(a.ratio, a.secondary) > std::tie(b.ratio, b.secondary);
   });
+  size_t first = 0;  // ranked[0, first) are all done
   while (!plan.full()) {
+    while (first < ranked.size() && ranked[first].e->done) ++first;
     Exchange* best = nullptr;
-    for (const Ranked& r : ranked) {
+    for (size_t i = first; i < ranked.size(); ++i) {
+      const Ranked& r = ranked[i];
       if (r.e->done || !plan.eligible(*r.e)) continue;
       if (plan.cost(*r.e) == 0) {
         r.e->done = true;
