@@ -197,8 +197,8 @@ std::vector<PageRef> PageScheduler::next(const package::PackageScene& scene, con
   std::map<uint64_t, Exchange> exchanges;
   std::map<uint32_t, double> unknown;
   for (const WeightedView& v : views)
-    collect(scene, records, select_cut(scene, planned, v.view, {options.tau}), v, options.tau, exchanges,
-            unknown);
+    collect(scene, records, select_cut(scene, planned, v.view, {options.tau, options.triangle_budget}), v,
+            options.tau, exchanges, unknown);
 
   // Records first: nothing below an unknown record can be ranked.
   std::vector<std::pair<double, uint32_t>> by_priority;
@@ -246,7 +246,7 @@ std::vector<PageRef> PageScheduler::next_sse(const package::PackageScene& scene,
                                              const View& view, const ScheduleOptions& options) const {
   Plan plan{*this, records, data_held_, index_held_, {}, 0, options};
   const Planned planned(records, data_held_);
-  const Cut cut = select_cut(scene, planned, view, {options.tau});
+  const Cut cut = select_cut(scene, planned, view, {options.tau, options.triangle_budget});
   for (const MissingNode& m : cut.missing) {
     plan.add_record(m.node);
     if (m.record_known) plan.add(PageKind::data, records.record(m.node)->page);
