@@ -1,5 +1,7 @@
 #include "hierarchy/progressive_steps.hpp"
 
+#include <meshoptimizer.h>
+
 #include <algorithm>
 
 #include "hierarchy/bounding_sphere.hpp"
@@ -52,7 +54,11 @@ ProgressiveSteps build_progressive_steps(const Mesh& mesh, const StepOptions& op
     part(m.normals, s.mesh.normals);
     part(m.uvs, s.mesh.uvs);
     part(m.colors, s.mesh.colors);
-    s.mesh.indices.assign(m.indices.begin() + 3 * first_triangle, m.indices.begin() + 3 * t_end);
+    // Inside a step the triangle order is free (a prefix ends at a step's end): meshopt's vertex-cache order,
+    // which its index codec compresses best.
+    s.mesh.indices.resize(3 * (t_end - first_triangle));
+    meshopt_optimizeVertexCache(s.mesh.indices.data(), m.indices.data() + 3 * first_triangle,
+                                s.mesh.indices.size(), V);
     for (uint32_t c : s.mesh.indices)
       for (uint32_t x = c; x >= end && !carried[x]; x = pm.parent[x]) {
         carried[x] = 1;

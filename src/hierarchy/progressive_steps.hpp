@@ -26,7 +26,8 @@ namespace lodstream::hierarchy {
 
 struct ProgressiveStep {
   // Vertices [first_vertex, first_vertex + vertex_count) of the order (indices count from 0 of the whole
-  // mesh); triangles [first_triangle, first_triangle + triangle_count) with full-resolution corners.
+  // mesh); triangles [first_triangle, first_triangle + triangle_count) of the order with full-resolution
+  // corners, in vertex-cache order inside the step.
   Mesh mesh;
   uint32_t first_vertex = 0, first_triangle = 0;
   // The two-sided error bound (model units) of the prefix that ends with this step; 0 for the last one.

@@ -148,9 +148,10 @@ const Mesh& CutGeometry::prefix(uint32_t last_step) {
       id = r.parents[0];
     }
     std::reverse(steps.begin(), steps.end());
-    Mesh mesh = package::assemble_prefix(
+    Decoded assembled;
+    assembled.node.mesh = package::assemble_prefix(
         steps, reader_->source().name() + ": progressive prefix ending at node " + std::to_string(last_step));
-    it = prefixes_.emplace(last_step, Decoded{{std::move(mesh)}, frame_}).first;
+    it = prefixes_.emplace(last_step, std::move(assembled)).first;
   }
   it->second.last_drawn = frame_;
   return it->second.node.mesh;
