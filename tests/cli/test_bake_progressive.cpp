@@ -73,3 +73,14 @@ TEST(BakeProgressive, ASmallMeshIsOneProgressiveMeshWhoseEveryPrefixVerifies) {
   EXPECT_EQ(r.err.rfind("lodstream: error: --pm-max-triangles", 0), 0u) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
 }
+
+TEST(BakeProgressive, AnHlodOverProgressiveMeshesVerifies) {
+  // HLOD leaves merge a progressive mesh's base (step 0) and bound its error and sphere (check_hlod).
+  const std::string file = (test::temp_dir() / "hlod.lods").string();
+  auto r = test::run_lodstream({"bake", test::data_file("motorBike.obj").string(), "-o", file, "--hlod",
+                                "--pm-max-triangles", "2048", "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_GT(r.json()["progressive_meshes"].get<int>(), 0);
+  EXPECT_GT(r.json()["hlod"]["nodes"].get<int>(), 0);
+  expect_verifies(file);
+}
