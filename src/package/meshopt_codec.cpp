@@ -17,7 +17,8 @@ namespace lodstream::package {
 namespace {
 
 constexpr uint8_t kFormat = 1;
-constexpr uint32_t kNormals = 1, kUvs = 2, kColors = 4, kVertexData = 8, kWidePositions = 16, kAllFlags = 31;
+constexpr uint32_t kNormals = 1, kUvs = 2, kColors = 4, kVertexData = 8, kWidePositions = 16,
+                   kProgressive = 32, kAllFlags = 63;
 constexpr size_t kMaxVertices = 65536;
 constexpr uint32_t kMaxShift = 24;
 constexpr int64_t kMaxGridCoordinate = int64_t(1) << 30;
@@ -42,11 +43,12 @@ Layout layout_for(uint32_t flags, uint32_t normal_bits) {
 }
 
 struct Parsed {
-  uint32_t flags = 0, shift = 0, normal_bits = 0, vertices = 0, triangles = 0, first_vertex = 0;
+  uint32_t flags = 0, shift = 0, normal_bits = 0, vertices = 0, triangles = 0, first_vertex = 0,
+           index_end = 0;
   int64_t cmin[3] = {0, 0, 0};
   glm::vec2 uv_min{0.0f}, uv_extent{0.0f};
   size_t header_size = 0;
-  std::span<const uint8_t> vertex_stream, locked_stream, index_stream;
+  std::span<const uint8_t> vertex_stream, locked_stream, index_stream, extra;
 };
 
 Parsed parse(std::span<const uint8_t> bytes, const std::string& where) {
@@ -69,6 +71,14 @@ Parsed parse(std::span<const uint8_t> bytes, const std::string& where) {
   uint64_t first = r.varint();
   if (first > UINT32_MAX - p.vertices) r.fail("first vertex out of range");
   p.first_vertex = static_cast<uint32_t>(first);
+  p.index_end = p.first_vertex + p.vertices;
+  uint64_t extra_size = 0;
+  if (p.flags & kProgressive) {
+    const uint64_t end = r.varint();
+    if (end < p.index_end || end > UINT32_MAX) r.fail("index end out of range");
+    p.index_end = static_cast<uint32_t>(end);
+    extra_size = r.varint();
+  }
   for (int64_t& c : p.cmin) {
     c = r.svarint();
     if (c < -kMaxGridCoordinate * 2 || c > kMaxGridCoordinate * 2) r.fail("grid coordinate out of range");
@@ -79,13 +89,15 @@ Parsed parse(std::span<const uint8_t> bytes, const std::string& where) {
   }
   uint64_t vertex_size = r.varint(), locked_size = r.varint(), index_size = r.varint();
   p.header_size = r.position();
-  if (vertex_size > r.remaining() || locked_size > r.remaining() - vertex_size ||
-      index_size != r.remaining() - vertex_size - locked_size) {
+  if (extra_size > r.remaining() || vertex_size > r.remaining() - extra_size ||
+      locked_size > r.remaining() - extra_size - vertex_size ||
+      index_size != r.remaining() - extra_size - vertex_size - locked_size) {
     r.fail("stream sizes do not add up to the node size");
   }
   p.vertex_stream = r.bytes(vertex_size, "vertex stream");
   p.locked_stream = r.bytes(locked_size, "locked stream");
   p.index_stream = r.bytes(index_size, "index stream");
+  p.extra = r.bytes(extra_size, "extra bytes");
   if (p.shift == 0 && locked_size != 0) throw Error(where + ": locked stream without a position shift");
   return p;
 }
@@ -141,8 +153,10 @@ std::vector<uint8_t> MeshoptCodec::encode(const NodeGeometry& g, const PositionG
   if (!(grid.step > 0.0f) || !std::isfinite(grid.step)) invalid("grid step must be positive and finite");
   const uint64_t vertex_end = uint64_t(g.first_vertex) + V;
   if (vertex_end > UINT32_MAX) invalid("first vertex out of range");
+  if (g.index_end != 0 && g.index_end < vertex_end) invalid("index end below the node's last vertex");
+  const uint64_t index_end = g.index_end == 0 ? vertex_end : g.index_end;
   for (uint32_t i : m.indices) {
-    if (i >= vertex_end) invalid("index " + std::to_string(i) + " out of range");
+    if (i >= index_end) invalid("index " + std::to_string(i) + " out of range");
   }
 
   // Vertex order: meshopt's vertex-cache then vertex-fetch order (what its codecs compress best), unless the
@@ -182,7 +196,8 @@ std::vector<uint8_t> MeshoptCodec::encode(const NodeGeometry& g, const PositionG
     }
   }
   uint32_t flags = (m.has_normals() ? kNormals : 0) | (m.has_uvs() ? kUvs : 0) |
-                   (m.has_colors() ? kColors : 0) | (g.vertex_data.empty() ? 0 : kVertexData);
+                   (m.has_colors() ? kColors : 0) | (g.vertex_data.empty() ? 0 : kVertexData) |
+                   (index_end != vertex_end || !g.extra.empty() ? kProgressive : 0);
   for (int a = 0; a < 3; ++a) {
     if (cmax[a] - cmin[a] > 65535) flags |= kWidePositions;
   }
@@ -252,7 +267,7 @@ std::vector<uint8_t> MeshoptCodec::encode(const NodeGeometry& g, const PositionG
       }
     }
   }
-  std::vector<uint8_t> index_stream(meshopt_encodeIndexBufferBound(indices.size(), vertex_end));
+  std::vector<uint8_t> index_stream(meshopt_encodeIndexBufferBound(indices.size(), index_end));
   index_stream.resize(
       meshopt_encodeIndexBuffer(index_stream.data(), index_stream.size(), indices.data(), indices.size()));
 
@@ -264,6 +279,10 @@ std::vector<uint8_t> MeshoptCodec::encode(const NodeGeometry& g, const PositionG
   w.varint(V);
   w.varint(indices.size() / 3);
   w.varint(g.first_vertex);
+  if (flags & kProgressive) {
+    w.varint(index_end);
+    w.varint(g.extra.size());
+  }
   for (int64_t cm : cmin) w.svarint(cm);
   if (flags & kUvs) {
     w.f32(uv_min.x), w.f32(uv_min.y), w.f32(uv_extent.x), w.f32(uv_extent.y);
@@ -274,6 +293,7 @@ std::vector<uint8_t> MeshoptCodec::encode(const NodeGeometry& g, const PositionG
   w.raw(vertex_stream);
   w.raw(locked_stream);
   w.raw(index_stream);
+  w.raw(g.extra);
   return std::move(w.bytes);
 }
 
@@ -290,16 +310,17 @@ DecodedNode MeshoptCodec::decode(std::span<const uint8_t> bytes, const PositionG
   }
   DecodedNode out;
   out.first_vertex = p.first_vertex;
+  out.index_end = p.index_end;
+  out.extra.assign(p.extra.begin(), p.extra.end());
   Mesh& m = out.mesh;
   m.indices.resize(3 * T);
   if (meshopt_decodeIndexBuffer(m.indices.data(), m.indices.size(), sizeof(uint32_t), p.index_stream.data(),
                                 p.index_stream.size()) != 0) {
     throw Error(where + ": corrupted index stream");
   }
-  const uint32_t vertex_end = p.first_vertex + p.vertices;
   uint32_t max_index = 0;
   for (uint32_t i : m.indices) max_index = std::max(max_index, i);
-  if (T > 0 && max_index >= vertex_end)
+  if (T > 0 && max_index >= p.index_end)
     throw Error(where + ": index " + std::to_string(max_index) + " out of range");
 
   // Locked stream: a bit per vertex, then 3k residual bits per locked vertex.
@@ -390,7 +411,7 @@ NodeSizeBreakdown MeshoptCodec::breakdown(std::span<const uint8_t> bytes, const 
   b.header = p.header_size;
   b.vertices = p.vertex_stream.size();
   b.locked = p.locked_stream.size();
-  b.indices = p.index_stream.size();
+  b.indices = p.index_stream.size() + p.extra.size();  // extra: a progressive step's chains (connectivity)
   return b;
 }
 

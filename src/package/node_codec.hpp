@@ -68,6 +68,13 @@ struct NodeGeometry {
   bool preserve_order = false;
   // Optional 32-bit value per vertex, stored losslessly and opaque to the codec (e.g. a collapse parent).
   std::span<const uint32_t> vertex_data;
+  // Indices may refer to any vertex below index_end (0 = first_vertex + vertex count): a progressive-mesh
+  // step stores its triangles' full-resolution corners, which may lie in later steps. At least first_vertex +
+  // vertex count when nonzero.
+  uint32_t index_end = 0;
+  // Optional bytes stored losslessly after the geometry, opaque to the codec (e.g. a progressive step's
+  // vertex-substitution chains, package/progressive_prefix.hpp).
+  std::span<const uint8_t> extra;
 };
 
 // A decoded node: `mesh.indices` number vertices as the representation does (chunk vertex i is first_vertex +
@@ -76,7 +83,9 @@ struct NodeGeometry {
 struct DecodedNode {
   Mesh mesh;
   uint32_t first_vertex = 0;
+  uint32_t index_end = 0;  // every index is below it (first_vertex + vertex count unless encoded larger)
   std::vector<uint32_t> vertex_data;
+  std::vector<uint8_t> extra;
 };
 
 // Bytes of each part of one encoded node (before zstd), for size reports.

@@ -102,6 +102,7 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
   std::vector<double> drawn_area(scene.objects.size(), 0.0);
   for (const DrawnNode& d : cut.drawn) {
     if (d.object == package::kNone) continue;  // an HLOD proxy: its exchanges weigh its own sphere
+    if (d.refined) continue;                   // a progressive prefix weighs its object's sphere once
     const package::ObjectRecord& o = scene.objects[d.object];
     drawn_area[d.object] +=
         projected_area(to_world(records.record(d.node)->sphere, o.transform, max_scale(o.transform)), v.view);
