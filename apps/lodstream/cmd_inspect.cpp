@@ -6,7 +6,8 @@
 // has exactly the boundary edges of the full-resolution (level-0) surface; and for an HLOD (check_hlod):
 // proxy object sets nest (an inner proxy's objects are the disjoint union of its children's, the root's cover
 // every object it lists once per leaf) and a leaf proxy bounds its objects' roots (error at least theirs in
-// world units, sphere containing theirs and the object's bounds). Every embedded texture (blob) must
+// world units, sphere containing theirs and the object's bounds); for a progressive mesh (check_progressive),
+// its steps form one chain and every prefix assembles into a valid mesh. Every embedded texture (blob) must
 // decode as an image. Exits 1 naming the first violation.
 #include <tbb/parallel_for.h>
 
@@ -21,6 +22,7 @@
 #include "core/image.hpp"
 #include "hierarchy/bounding_sphere.hpp"
 #include "hierarchy/cut.hpp"
+#include "package/progressive_prefix.hpp"
 #include "package/reader.hpp"
 #include "schedule/cut.hpp"
 
@@ -114,6 +116,50 @@ std::string check_hlod(const PackageScene& scene, const std::vector<NodeRecord>&
   return "";
 }
 
+// The first violation of the progressive-mesh invariants, or "": each progressive representation is one chain
+// of progressive steps from its root (step k's child is step k+1, whose only parent is k; errors
+// non-increasing along it, which check_records' pairs imply), covering all of its nodes; and every prefix
+// (steps 0..j) assembles (package/progressive_prefix.hpp: steps contiguous, every corner resolves below the
+// prefix's vertex count, no degenerate triangle) with its vertices inside the steps' sphere.
+std::string check_progressive(PackageReader& reader, const std::vector<NodeRecord>& nodes) {
+  const PackageScene& scene = reader.scene();
+  std::vector<size_t> members(scene.representations.size(), 0);
+  for (const NodeRecord& n : nodes) ++members[n.representation];
+  for (uint32_t r = 0; r < scene.representations.size(); ++r) {
+    const Representation& rep = scene.representations[r];
+    if (rep.kind != RepresentationKind::progressive_mesh) continue;
+    const std::string where = "progressive representation " + std::to_string(r) + ": ";
+    if (rep.roots.size() != 1) return where + "must have one root (step 0)";
+    std::vector<DecodedNode> steps;
+    for (uint32_t id = rep.roots[0], previous = kNone;;) {
+      const NodeRecord& n = nodes[id];
+      const std::string at = where + "node " + std::to_string(id) + ": ";
+      if (n.kind != NodeKind::progressive_step || n.representation != r)
+        return at + "is not a progressive step of it";
+      if (n.parents != (previous == kNone ? std::vector<uint32_t>{} : std::vector<uint32_t>{previous}))
+        return at + "its parent is not the step before it";
+      if (n.children.size() > 1) return at + "has more than one next step";
+      if (steps.size() >= members[r]) return at + "the chain of steps loops";
+      try {
+        steps.push_back(reader.load_node(id));
+        std::vector<const DecodedNode*> prefix;
+        for (const DecodedNode& s : steps) prefix.push_back(&s);
+        const Mesh m = assemble_prefix(prefix, reader.source().name());
+        for (const glm::vec3& v : m.positions)
+          if (glm::length(v - n.sphere.center) > n.sphere.radius * 1.00001f + 2.0f * rep.grid.step)
+            return at + "a vertex of its prefix lies outside the sphere";
+      } catch (const Error& e) {
+        return at + e.what();
+      }
+      if (n.children.empty()) break;
+      previous = id, id = n.children[0];
+    }
+    if (steps.size() != members[r])
+      return where + "its chain of steps leaves out " + std::to_string(members[r] - steps.size()) + " nodes";
+  }
+  return "";
+}
+
 struct Summary {
   nlohmann::json json;
   std::string text;
@@ -184,7 +230,9 @@ int run_inspect(const InspectArgs& args) {
               violation = "node " + std::to_string(id) + ": a decoded vertex lies outside its sphere";
               break;
             }
-          welded[id] = welders[nodes[id].representation].weld(m);
+          // (A progressive step's corners may lie in later steps: its prefixes are checked below.)
+          if (nodes[id].kind != NodeKind::progressive_step)
+            welded[id] = welders[nodes[id].representation].weld(m);
         }
     }
     // Every embedded texture decodes as an image.
@@ -195,6 +243,7 @@ int run_inspect(const InspectArgs& args) {
         violation = e.what();
       }
     }
+    if (violation.empty()) violation = check_progressive(reader, nodes);
     // Crack-free cuts per cluster DAG.
     std::mt19937 rng(12345);
     std::uniform_real_distribution<double> u(0.0, 1.0);

@@ -9,7 +9,9 @@ std::vector<std::vector<uint32_t>> finest_nodes(const package::PackageScene& sce
   std::vector<std::vector<uint32_t>> finest(scene.representations.size());
   for (uint32_t id = 0; id < node_count; ++id) {
     const package::NodeRecord* n = records.record(id);
-    if (n && n->children.empty() && n->kind != package::NodeKind::hlod_proxy)  // HLOD leaves: not geometry
+    // HLOD leaves: not geometry; a progressive mesh's finest prefix is all of its steps.
+    if (n && (n->children.empty() || n->kind == package::NodeKind::progressive_step) &&
+        n->kind != package::NodeKind::hlod_proxy)
       finest[n->representation].push_back(id);
   }
   return finest;
@@ -38,7 +40,8 @@ schedule::Cut finest_cut(const package::PackageScene& scene, const schedule::Nod
       const package::NodeRecord& n = *records.record(id);
       const double e = schedule::screen_error(
           double(n.error) * scale, schedule::to_world(n.sphere, objects[o].transform, scale), view);
-      cut.drawn.push_back({o, id, e, n.triangles});
+      const bool refined = n.kind == package::NodeKind::progressive_step && !n.children.empty();
+      cut.drawn.push_back({o, id, e, n.triangles, refined});
       cut.triangles += n.triangles;
     }
   }

@@ -13,8 +13,8 @@
 namespace lodstream::cli {
 
 // Per representation of `scene`: the ids of its nodes with no children (HLOD proxies excluded: the finest
-// level is the objects' own geometry), among records 0..node_count-1 of
-// `records` (every record must be known). Cost: one pass over the records.
+// level is the objects' own geometry), and every step of a progressive mesh (its finest prefix), among
+// records 0..node_count-1 of `records` (every record must be known). Cost: one pass over the records.
 std::vector<std::vector<uint32_t>> finest_nodes(const package::PackageScene& scene,
                                                 const schedule::NodeSource& records, uint32_t node_count);
 

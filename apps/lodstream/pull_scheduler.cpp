@@ -20,14 +20,14 @@ bool moved(const schedule::ViewSample& a, const schedule::ViewSample& b) {
 }  // namespace
 
 PullScheduler::PullScheduler(package::PackageReader reader, PullFetcher::SourceFactory make_source,
-                             PullOptions fetch, PageInbox& frames, PullOrder order, double tau,
+                             PullOptions fetch, PageInbox& frames, PullOrder order, schedule::CutOptions cut,
                              std::span<const schedule::PageRef> held)
     : reader_(std::move(reader)),
       records_(reader_, no_pages_),
       scheduler_(reader_.root()),
       frames_(frames),
       order_(order),
-      tau_(tau),
+      cut_(cut),
       fetcher_(std::move(make_source), fetched_, fetch) {
   for (const schedule::PageRef& p : held) scheduler_.set_held(p.kind, p.id);
   thread_ = std::thread([this] { run(); });
@@ -117,7 +117,10 @@ void PullScheduler::run() {
       index.swap(index_pages_);
       ahead_empty = ahead_.empty();
     }
-    for (uint32_t page : evicted) scheduler_.set_held(PageKind::data, page, false);
+    const double now_s = sample ? sample->time_s : 0.0;
+    for (uint32_t page : evicted) backoff_.released(page, now_s);
+    const std::vector<uint32_t> due = backoff_.due(now_s);
+    for (uint32_t page : due) scheduler_.set_held(PageKind::data, page, false);
     try {
       for (const ArrivedPage& a : index) reader_.add_index_page(a.page.id, a.bytes);
     } catch (const Error& e) {
@@ -130,13 +133,13 @@ void PullScheduler::run() {
     const bool view_due =
         !planned || (moved(*sample, *planned) && sample->time_s - planned->time_s >= kReplanInterval);
     const bool more = ahead_empty && room_left;
-    if (!(view_due || more || !index.empty() || !evicted.empty())) continue;
+    if (!(view_due || more || !index.empty() || !due.empty())) continue;
 
     // A plan for kPlanAhead windows, made while the fetcher's threads go on requesting the last plan's pages
     // (held, so not chosen again). Its pages go first; what is left of the last plan follows, up to
     // kPlanAhead windows in all, and the rest is not held any more (the next plan may choose it again).
     planned = sample;
-    const schedule::ScheduleOptions options{tau_, kPlanAhead * window, SIZE_MAX};
+    const schedule::ScheduleOptions options{cut_.tau, kPlanAhead * window, SIZE_MAX, cut_.triangle_budget};
     const auto predicted = schedule::predicted_views(*sample, 0.0);
     const std::vector<schedule::PageRef> pages =
         order_ == PullOrder::sse ? scheduler_.next_sse(reader_.scene(), records_, predicted[0].view, options)

@@ -6,7 +6,8 @@
 // Ownership, so that nothing is shared without a lock: this object's thread alone owns a copy of the client's
 // PackageReader (the node records the scheduler sees: index pages are installed into it here) and the
 // PageScheduler with its held set (pages arrived, requested or planned; pages the frame thread's cache
-// evicted are reported through evicted() and become schedulable again). The frame thread owns the
+// evicted are reported through evicted() and become schedulable again after a hold-off that doubles with each
+// eviction of the page: schedule/release_backoff.hpp). The frame thread owns the
 // ClientPackage it installs arrived pages into. The fetcher's threads relay arrived pages as soon as they are
 // read (the inbox's listener): into the frame thread's inbox, and for index pages a copy into this object's
 // slot; then they request the next planned pages while the window has room. The threads share only that
@@ -16,9 +17,9 @@
 // Plans (one PageScheduler::next or next_sse call each) look kPlanAhead windows ahead: the window's room is
 // requested at once, the rest in the plan's order as arrivals free the window, on the fetcher's threads, so
 // that the link stays busy while this thread plans. It plans only when the window has room or nothing is
-// left to request, and then when an index page arrived (new records), a page was evicted, the view moved and
-// the last plan is at least kReplanInterval older in the samples' own time, or the last plan's pages are all
-// requested and it chose anything (there may be more to fetch). It sleeps otherwise, woken by
+// left to request, and then when an index page arrived (new records), an evicted page's hold-off ended, the
+// view moved and the last plan is at least kReplanInterval older in the samples' own time, or the last plan's
+// pages are all requested and it chose anything (there may be more to fetch). It sleeps otherwise, woken by
 // publish(), evicted() and every arrival: no polling. A plan costs one select_cut per predicted view;
 // bounding their rate keeps clients that share a few cores from spending them on plans.
 #pragma once
@@ -40,6 +41,7 @@
 #include "runtime/package_nodes.hpp"
 #include "schedule/motion.hpp"
 #include "schedule/page_scheduler.hpp"
+#include "schedule/release_backoff.hpp"
 
 namespace lodstream::cli {
 
@@ -59,7 +61,8 @@ class PullScheduler {
   // failure go to `frames` (which must outlive this object). Nothing is fetched before the first publish();
   // `held` pages (restored from a disk cache) are never fetched.
   PullScheduler(package::PackageReader reader, PullFetcher::SourceFactory make_source, PullOptions fetch,
-                PageInbox& frames, PullOrder order, double tau, std::span<const schedule::PageRef> held = {});
+                PageInbox& frames, PullOrder order, schedule::CutOptions cut,
+                std::span<const schedule::PageRef> held = {});
   // Stops this thread, then the fetcher (after the reads under way).
   ~PullScheduler();
   PullScheduler(const PullScheduler&) = delete;
@@ -89,7 +92,7 @@ class PullScheduler {
   schedule::PageScheduler scheduler_;
   PageInbox& frames_;
   const PullOrder order_;
-  const double tau_;
+  const schedule::CutOptions cut_;
 
   // The slot shared with the frame thread and the fetcher's threads.
   mutable std::mutex mutex_;
@@ -97,6 +100,7 @@ class PullScheduler {
   bool woken_ = false, stop_ = false;
   std::optional<schedule::ViewSample> latest_;
   std::vector<uint32_t> evicted_;
+  schedule::ReleaseBackoff backoff_;      // scheduler thread: when an evicted page may be fetched again
   std::vector<ArrivedPage> index_pages_;  // arrived, for reader_
   std::deque<schedule::PageRef> ahead_;   // planned (held), not requested yet, in plan order
   std::string error_;                     // the transport's failure, once

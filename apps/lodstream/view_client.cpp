@@ -9,6 +9,7 @@
 #include "net/push_client.hpp"
 #include "net/url.hpp"
 #include "pull_scheduler.hpp"
+#include "schedule/cache_budget.hpp"
 #include "view_motion.hpp"
 
 namespace lodstream::cli {
@@ -46,7 +47,9 @@ ViewClient::ViewClient(const std::string& source, const ViewClientOptions& optio
                                        : std::filesystem::path()),
       client_(package::PackageReader(open_source(source, mode_ != Mode::file)), cache_bytes(options)) {
   cut_options_.tau = options.pixel_error;
-  if (options.budget) cut_options_.triangle_budget = options.budget;
+  cut_options_.triangle_budget =
+      std::min<uint64_t>(options.budget ? options.budget : UINT64_MAX,
+                         schedule::affordable_triangles(client_.reader().root(), cache_bytes(options)));
   if (!options.cache_dir.empty()) {
     disk_.emplace(options.cache_dir, client_.reader().header().content_hash);
     for (const std::string& w : disk_->restore(client_, cache_bytes(options)).warnings)
@@ -90,7 +93,7 @@ ViewClient::ViewClient(const std::string& source, const ViewClientOptions& optio
     for (uint32_t id : client_.held(kind)) held.push_back({kind, id});
   puller_ = std::make_unique<PullScheduler>(client_.reader(), std::move(make_source), fetch, arrived_,
                                             options.order == "sse" ? PullOrder::sse : PullOrder::benefit,
-                                            options.pixel_error, held);
+                                            cut_options_, held);
 }
 
 ViewClient::~ViewClient() = default;
@@ -117,8 +120,9 @@ void ViewClient::request_baseline(std::span<const schedule::WeightedView> predic
   const size_t requests = client_.in_flight(), max_requests = size_t(window_);
   if (window_ ? requests >= max_requests : in_flight >= window) return;
   const schedule::ScheduleOptions s =
-      window_ ? schedule::ScheduleOptions{tau_, UINT64_MAX, max_requests - requests}
-              : schedule::ScheduleOptions{tau_, window - in_flight, SIZE_MAX};
+      window_
+          ? schedule::ScheduleOptions{tau_, UINT64_MAX, max_requests - requests, cut_options_.triangle_budget}
+          : schedule::ScheduleOptions{tau_, window - in_flight, SIZE_MAX, cut_options_.triangle_budget};
   const auto pages =
       sse_ ? client_.scheduler().next_sse(client_.scene(), client_.nodes(), predicted[0].view, s)
            : client_.scheduler().next(client_.scene(), client_.nodes(), predicted, s);
@@ -148,6 +152,7 @@ runtime::Frame ViewClient::frame(const schedule::ViewSample& now) {
   runtime::Frame f = client_.frame(predicted[0].view, ahead, cut_options_);
   const std::vector<uint32_t> evicted = client_.take_evicted();
   if (puller_) puller_->evicted(evicted);
+  if (pusher_) pusher_->released(evicted);
   return f;
 }
 

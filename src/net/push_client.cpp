@@ -34,11 +34,13 @@ struct PushClient::Impl {
   // Owned by the strand:
   std::optional<wire::ViewUpdate> view;
   std::optional<wire::Ack> ack;
+  std::set<uint32_t> release;  // data pages evicted and not yet said (over the current connection)
   bool open = false, closing = false, done = false;
   bool welcomed_now = false;      // the current connection was welcomed
   uint64_t connection = 0;        // the current connection's number; a writer of an older one stops
   uint64_t received = 0;          // page bytes over the current connection
-  std::set<uint32_t> arrived[2];  // pages received over any connection, by kind
+  std::set<uint32_t> arrived[2];  // pages received over any connection and not evicted since, by kind
+  std::set<uint32_t> evicted;     // data pages evicted since the start and not received again
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
 
   double now() const {
@@ -50,18 +52,21 @@ struct PushClient::Impl {
     co_await ws.async_write(asio::buffer(frame), use_awaitable);
   }
 
-  // The Hello of a (re)connection: the pages held when the client started plus every page received since.
+  // The Hello of a (re)connection: the pages held when the client started plus every page received since,
+  // minus the data pages evicted since (`evicted`).
   wire::Hello current_hello() const {
     wire::Hello h = hello;
-    auto held = [&](const std::vector<wire::PageRun>& runs, const std::set<uint32_t>& more) {
+    auto held = [&](const std::vector<wire::PageRun>& runs, const std::set<uint32_t>& more,
+                    const std::set<uint32_t>& gone) {
       std::set<uint32_t> pages = more;
       for (const wire::PageRun& run : runs)
-        for (uint64_t p = run.first; p < uint64_t(run.first) + run.count; ++p) pages.insert(uint32_t(p));
+        for (uint64_t p = run.first; p < uint64_t(run.first) + run.count; ++p)
+          if (!gone.count(uint32_t(p))) pages.insert(uint32_t(p));
       const std::vector<uint32_t> sorted(pages.begin(), pages.end());
       return wire::page_runs(sorted);
     };
-    h.held = held(hello.held, arrived[size_t(schedule::PageKind::data)]);
-    h.held_index = held(hello.held_index, arrived[size_t(schedule::PageKind::index)]);
+    h.held = held(hello.held, arrived[size_t(schedule::PageKind::data)], evicted);
+    h.held_index = held(hello.held_index, arrived[size_t(schedule::PageKind::index)], {});
     return h;
   }
 
@@ -74,6 +79,12 @@ struct PushClient::Impl {
           co_await send(*ws, m);
         } else if (view) {
           const wire::Message m = *std::exchange(view, std::nullopt);
+          co_await send(*ws, m);
+        } else if (!release.empty()) {
+          const std::vector<uint32_t> pages(release.begin(), release.end());
+          release.clear();
+          // Named, not a temporary in the co_await (GCC 12 destroys such temporaries twice).
+          const wire::Message m = wire::Released{wire::page_runs(pages)};
           co_await send(*ws, m);
         } else if (closing) {
           open = false;
@@ -95,6 +106,7 @@ struct PushClient::Impl {
     auto ws = std::make_shared<WebSocket>(strand);
     const uint64_t number = ++connection;
     ack.reset();
+    release.clear();  // the new Hello leaves them out
     received = 0;
     welcomed_now = false;
     std::string lost;
@@ -121,6 +133,8 @@ struct PushClient::Impl {
           received += page->bytes.size();
           ack = wire::Ack{page->sequence, received, now(), page->server_time_s};
           arrived[size_t(page->kind)].insert(page->page_id);
+          if (page->kind == schedule::PageKind::data)
+            evicted.erase(page->page_id), release.erase(page->page_id);
           inbox->put({{page->kind, page->page_id, uint32_t(page->bytes.size())}, std::move(page->bytes)});
           ++owner->pages_;
           wake.cancel();
@@ -128,7 +142,7 @@ struct PushClient::Impl {
           if (welcome->package_hash != hello.cached_hash) {  // what the client held is of another package
             hello.cached_hash = welcome->package_hash;
             hello.held.clear(), hello.held_index.clear();
-            arrived[0].clear(), arrived[1].clear();
+            arrived[0].clear(), arrived[1].clear(), evicted.clear(), release.clear();
           }
           if (owner->welcomed_) ++owner->reconnects_;
           owner->welcomed_ = true;
@@ -205,6 +219,18 @@ PushClient::~PushClient() {
 void PushClient::send_view(const wire::ViewUpdate& view) {
   asio::post(impl_->strand, [m = impl_.get(), view] {
     m->view = view;
+    m->wake.cancel();
+  });
+}
+
+void PushClient::released(std::span<const uint32_t> pages) {
+  if (pages.empty()) return;
+  asio::post(impl_->strand, [m = impl_.get(), pages = std::vector<uint32_t>(pages.begin(), pages.end())] {
+    for (uint32_t p : pages) {
+      m->arrived[size_t(schedule::PageKind::data)].erase(p);
+      m->evicted.insert(p);
+      if (m->open) m->release.insert(p);
+    }
     m->wake.cancel();
   });
 }

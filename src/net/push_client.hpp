@@ -4,13 +4,15 @@
 // server time echoed), and sends the latest view the frame loop gave it (send_view: the newest replaces one
 // not yet sent). A connection lost after a Welcome (the server restarted) is opened again with back-off,
 // its Hello listing the pages held at the start plus every page received since, so that the server sends
-// none of them again (issue 5); meanwhile the frame loop keeps drawing what it holds. A Bye from the server,
+// none of them again (issue 5); meanwhile the frame loop keeps drawing what it holds. Pages the client's
+// cache evicts are said to the server (released()), which may then send them again. A Bye from the server,
 // a malformed message, or a first connection that fails is reported through the inbox.
 #pragma once
 
 #include <atomic>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <thread>
 
@@ -35,6 +37,9 @@ class PushClient {
   PushClient& operator=(const PushClient&) = delete;
 
   void send_view(const wire::ViewUpdate& view);
+  // Data pages the client's cache evicted: said to the server (a Released message) so that it may send them
+  // again, and left out of a reconnection's Hello.
+  void released(std::span<const uint32_t> pages);
   bool welcomed() const { return welcomed_; }
   uint64_t pages_received() const { return pages_; }
   // Connections opened again (and welcomed) after one was lost.

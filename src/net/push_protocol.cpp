@@ -1,5 +1,7 @@
 #include "net/push_protocol.hpp"
 
+#include "schedule/cache_budget.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -15,6 +17,7 @@ PushProtocol::PushProtocol(std::shared_ptr<const PushPackage> package, PushProto
     : package_(std::move(package)),
       options_(options),
       scheduler_(package_->reader->root()),
+      released_(package_->reader->root().pages.size(), false),
       remaining_(package_->reader->root().pages.size() + package_->reader->root().index_pages.size()) {}
 
 std::optional<wire::Message> PushProtocol::on_message(const wire::Message& message, double now_s) {
@@ -31,15 +34,13 @@ std::optional<wire::Message> PushProtocol::on_message(const wire::Message& messa
       auto hold = [&](const std::vector<wire::PageRun>& runs, PageKind kind, size_t count) {
         for (const auto& run : runs)
           for (uint64_t p = run.first; p < uint64_t(run.first) + run.count && p < count; ++p)
-            if (!scheduler_.held(kind, uint32_t(p))) {
-              held_bytes_ += scheduler_.page(kind, uint32_t(p)).bytes;
-              mark_sent(scheduler_.page(kind, uint32_t(p)));
-            }
+            if (!scheduler_.held(kind, uint32_t(p))) mark_sent(scheduler_.page(kind, uint32_t(p)));
       };
       hold(hello->held, PageKind::data, reader.root().pages.size());
       hold(hello->held_index, PageKind::index, reader.root().index_pages.size());
     }
     cache_budget_ = hello->cache_budget_bytes;
+    triangle_budget_ = schedule::affordable_triangles(reader.root(), cache_budget_);
     welcomed_ = true;
     return wire::Welcome{hash, reader.source().size(), uint32_t(reader.root().pages.size())};
   }
@@ -72,6 +73,20 @@ std::optional<wire::Message> PushProtocol::on_message(const wire::Message& messa
         s.time_s - *planned_view_s_ >= options_.replan_interval_s)
       planned_.clear();  // re-planned from the new prediction at the next send
     ++counters_.views;
+  } else if (auto* released = std::get_if<wire::Released>(&message)) {
+    const size_t count = package_->reader->root().pages.size();
+    for (const wire::PageRun& run : released->pages) {
+      if (uint64_t(run.first) + run.count > count)
+        throw wire::WireError("wire: released message: pages " + std::to_string(run.first) + ".." +
+                              std::to_string(uint64_t(run.first) + run.count - 1) + " but the package has " +
+                              std::to_string(count));
+      for (uint32_t p = run.first; p < run.first + run.count; ++p)
+        if (scheduler_.held(PageKind::data, p) && !released_[p]) {
+          held_bytes_ -= reader().root().pages[p].raw_size;
+          released_[p] = true;
+          backoff_.released(p, now_s);
+        }
+    }
   } else if (std::holds_alternative<wire::Bye>(message)) {
     ended_ = true;
   } else {
@@ -87,29 +102,35 @@ uint64_t PushProtocol::window_bytes() const {
 
 void PushProtocol::plan(double now_s, uint64_t bytes) {
   const package::PackageReader& reader = *package_->reader;
+  for (uint32_t p : backoff_.due(now_s))  // released pages the views may have again
+    if (released_[p] && scheduler_.held(PageKind::data, p)) {
+      scheduler_.set_held(PageKind::data, p, false);
+      ++remaining_;
+    }
   std::vector<PageRef> pages;
   if (view_) {
     // The present is (now - arrival) past the sample; a page sent now arrives half a round trip later.
     const double lead = (now_s - view_received_s_) + 0.5 * link_.rtt_s();
     const auto views = schedule::predicted_views(*view_, lead, options_.horizons);
-    pages = scheduler_.next(reader.scene(), package_->records, views, {options_.tau, bytes, SIZE_MAX});
+    pages = scheduler_.next(reader.scene(), package_->records, views,
+                            {options_.tau, bytes, SIZE_MAX, triangle_budget_});
     planned_view_s_ = view_->time_s;
   }
   if (pages.empty() && options_.fill_when_idle) {
-    // The rest in file order, index pages first, while the client's cache has room.
-    uint64_t room = cache_budget_ > held_bytes_ + counters_.bytes_sent
-                        ? cache_budget_ - held_bytes_ - counters_.bytes_sent
-                        : 0;
+    // The rest in file order, index pages first, while the client's cache has room for the data pages
+    // (decompressed, as it holds them; index pages are not in its cache), never a page it released.
+    uint64_t room = cache_budget_ > held_bytes_ ? cache_budget_ - held_bytes_ : 0;
     uint64_t planned = 0;
     for (PageKind kind : {PageKind::index, PageKind::data}) {
       const size_t count =
           kind == PageKind::data ? reader.root().pages.size() : reader.root().index_pages.size();
       for (uint32_t id = 0; id < count && planned < bytes; ++id) {
         const PageRef p = scheduler_.page(kind, id);
-        if (scheduler_.held(kind, id) || p.bytes > room) continue;
+        const uint64_t cached = kind == PageKind::data ? reader.root().pages[id].raw_size : 0;
+        if (scheduler_.held(kind, id) || cached > room || (kind == PageKind::data && released_[id])) continue;
         pages.push_back(p);
         planned += p.bytes;
-        room -= p.bytes;
+        room -= cached;
       }
     }
   }
@@ -122,7 +143,8 @@ std::optional<PageToSend> PushProtocol::next_page(double now_s) {
   if (in_flight >= window) return std::nullopt;
   while (!planned_.empty() && scheduler_.held(planned_.front().kind, planned_.front().id))
     planned_.pop_front();
-  if (planned_.empty()) plan(now_s, uint64_t(options_.plan_windows * double(window)));
+  if (planned_.empty() || backoff_.due_by(now_s))
+    plan(now_s, uint64_t(options_.plan_windows * double(window)));
   if (planned_.empty()) return std::nullopt;
   const PageRef page = planned_.front();
   planned_.pop_front();
@@ -138,6 +160,10 @@ std::optional<PageToSend> PushProtocol::next_page(double now_s) {
 
 void PushProtocol::mark_sent(const PageRef& page) {
   scheduler_.set_held(page.kind, page.id);
+  if (page.kind == PageKind::data) {
+    held_bytes_ += reader().root().pages[page.id].raw_size;
+    released_[page.id] = false;
+  }
   --remaining_;
 }
 

@@ -8,7 +8,8 @@
 // (schedule/page_scheduler.hpp): benefit per byte over the views predicted from the latest ViewUpdate
 // (schedule/motion.hpp, horizons measured from the present plus half a round trip, the time a page sent now
 // takes to arrive), index pages before the data pages that need their records; never a page the client holds
-// (Hello's held runs, when its hash is this package's) or was sent. At most `window_bdp` estimated
+// (Hello's held runs, when its hash is this package's) or was sent and not released since (a Released
+// message: the client's cache evicted it). At most `window_bdp` estimated
 // bandwidth-delay products (schedule::LinkEstimator, fed by the acknowledgements) are in flight, at least
 // `min_window_bytes`; so what waits, waits here, where a new view re-orders it: the plan is dropped on a
 // ViewUpdate at least `replan_interval_s` (client time) after the view it was made from, and re-made from the
@@ -17,7 +18,9 @@
 // per view update kept the server's core busy and the link a fifth used). When the scheduler has nothing to
 // send (no view yet, or every predicted view's ideal cut sent) and `fill_when_idle` is set, the rest of the
 // package follows in file order (index pages first), up to the client's cache budget: seed 003's "coffee
-// break".
+// break". The planned cuts keep to the triangles the client's cache budget affords
+// (schedule/cache_budget.hpp). Pages the client released are sent again only when the scheduler picks them
+// for a view, after a hold-off that doubles with each release of the page (schedule/release_backoff.hpp).
 //
 // Time is the caller's (seconds on any monotonic clock). Cost: a plan is one PageScheduler::next (one cut per
 // predicted view) for a window's worth of pages.
@@ -36,6 +39,7 @@
 #include "schedule/motion.hpp"
 #include "schedule/package_records.hpp"
 #include "schedule/page_scheduler.hpp"
+#include "schedule/release_backoff.hpp"
 
 namespace lodstream {
 
@@ -103,14 +107,21 @@ class PushProtocol {
  private:
   void plan(double now_s, uint64_t bytes);
   void mark_sent(const schedule::PageRef& page);
+  const package::PackageReader& reader() const { return *package_->reader; }
 
   std::shared_ptr<const PushPackage> package_;
   PushProtocolOptions options_;
   schedule::PageScheduler scheduler_;
   schedule::LinkEstimator link_;
   bool welcomed_ = false, ended_ = false;
-  uint64_t cache_budget_ = 0, held_bytes_ = 0;
-  size_t remaining_ = 0;  // pages neither held nor sent
+  uint64_t cache_budget_ = 0;
+  uint64_t triangle_budget_ = UINT64_MAX;  // of the planned cuts: what the client's cache affords
+  // Decompressed bytes of the data pages the client holds as far as the server knows (held, sent, not
+  // released): what its cache budget is spent on.
+  uint64_t held_bytes_ = 0;
+  std::vector<bool> released_;        // data pages the client let go: never sent again by the idle fill
+  schedule::ReleaseBackoff backoff_;  // when a released page may be planned again
+  size_t remaining_ = 0;              // pages neither held nor sent
   std::optional<schedule::ViewSample> view_;
   double view_received_s_ = 0.0;
   std::optional<double> planned_view_s_;  // client time of the view sample the current plan was made from

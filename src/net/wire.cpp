@@ -7,7 +7,15 @@ namespace lodstream::wire {
 
 namespace {
 
-enum class Type : uint16_t { kHello = 1, kView = 2, kAck = 3, kWelcome = 4, kPage = 5, kBye = 6 };
+enum class Type : uint16_t {
+  kHello = 1,
+  kView = 2,
+  kAck = 3,
+  kWelcome = 4,
+  kPage = 5,
+  kBye = 6,
+  kReleased = 7
+};
 
 class Writer {
  public:
@@ -81,16 +89,17 @@ void put_runs(Writer& w, const std::vector<PageRun>& runs) {
   for (const auto& run : runs) w.put(run.first), w.put(run.count);
 }
 
-std::vector<PageRun> get_runs(Reader& r) {
-  uint32_t count = r.get<uint32_t>("held run count");
-  if (count > r.remaining() / 8) r.fail("held run count", "is larger than the message");
+// Page runs; `field` names them in errors ("held runs", "released runs").
+std::vector<PageRun> get_runs(Reader& r, const char* field) {
+  uint32_t count = r.get<uint32_t>(field);
+  if (count > r.remaining() / 8) r.fail(field, "count is larger than the message");
   std::vector<PageRun> runs(count);
   uint64_t end = 0;
   for (auto& run : runs) {
-    run.first = r.get<uint32_t>("held run");
-    run.count = r.get<uint32_t>("held run");
+    run.first = r.get<uint32_t>(field);
+    run.count = r.get<uint32_t>(field);
     if (run.count == 0 || run.first < end || uint64_t(run.first) + run.count > UINT32_MAX)
-      r.fail("held runs", "must be non-empty, sorted and non-overlapping");
+      r.fail(field, "must be non-empty, sorted and non-overlapping");
     end = uint64_t(run.first) + run.count;
   }
   return runs;
@@ -122,6 +131,9 @@ void encode_payload(Writer& w, const Page& m) {
 }
 void encode_payload(Writer& w, const Bye& m) {
   w.put_string(m.reason);
+}
+void encode_payload(Writer& w, const Released& m) {
+  put_runs(w, m.pages);
 }
 
 constexpr Type type_of(const Message& m) {
@@ -155,7 +167,7 @@ std::vector<PageRun> page_runs(std::span<const uint32_t> sorted_pages) {
 }
 
 const char* type_name(const Message& message) {
-  static const char* names[] = {"hello", "view", "ack", "welcome", "page", "bye"};
+  static const char* names[] = {"hello", "view", "ack", "welcome", "page", "bye", "released"};
   return names[message.index()];
 }
 
@@ -192,8 +204,8 @@ Message decode(std::span<const uint8_t> frame) {
       m.package = r.string("package", kMaxNameBytes);
       if (m.package.empty()) r.fail("package", "is empty");
       m.cached_hash = hash(r, "cached hash");
-      m.held = get_runs(r);
-      m.held_index = get_runs(r);
+      m.held = get_runs(r, "held runs");
+      m.held_index = get_runs(r, "held index runs");
       m.cache_budget_bytes = r.get<uint64_t>("cache budget");
       m.triangles_per_frame = r.get<uint32_t>("triangles per frame");
       viewport(r, m.viewport_width, m.viewport_height);
@@ -249,6 +261,13 @@ Message decode(std::span<const uint8_t> frame) {
     case Type::kBye: {
       Reader r(body, "bye");
       Bye m{r.string("reason", 1024)};
+      r.done();
+      return m;
+    }
+    case Type::kReleased: {
+      Reader r(body, "released");
+      Released m{get_runs(r, "released runs")};
+      if (m.pages.empty()) r.fail("released runs", "are empty");
       r.done();
       return m;
     }

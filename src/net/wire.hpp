@@ -20,7 +20,8 @@
 namespace lodstream::wire {
 
 // 2: pages carry their kind (data or index page), hello lists held index pages too.
-constexpr uint16_t kProtocolVersion = 2;
+// 3: the client says which data pages its cache let go (Released).
+constexpr uint16_t kProtocolVersion = 3;
 constexpr size_t kHeaderBytes = 8;
 constexpr size_t kMaxMessageBytes = 16u << 20;  // larger frames are refused before they are read
 constexpr size_t kMaxNameBytes = 256;
@@ -96,7 +97,14 @@ struct Bye {
   std::string reason;
 };
 
-using Message = std::variant<Hello, ViewUpdate, Ack, Welcome, Page, Bye>;
+// Client → server: data pages the client's cache evicted. It no longer holds them, so the server may send
+// them again when a view needs them (without this, a client whose cache is smaller than what its path
+// needs would never get an evicted page back).
+struct Released {
+  std::vector<PageRun> pages;
+};
+
+using Message = std::variant<Hello, ViewUpdate, Ack, Welcome, Page, Bye, Released>;
 
 std::vector<uint8_t> encode(const Message& message);
 

@@ -20,7 +20,9 @@ namespace lodstream::package {
 namespace {
 
 constexpr uint8_t kFormat = 1;
-constexpr uint32_t kWidePositions = 16, kAllFlags = 31;  // with vertex_attributes.hpp's attribute flags
+constexpr uint32_t kWidePositions = 16;  // with vertex_attributes.hpp's attribute flags and kProgressive
+constexpr uint32_t kAllFlags =
+    kHasNormals | kHasUvs | kHasColors | kHasVertexData | kWidePositions | kProgressive;
 
 // Byte offsets of each attribute inside the interleaved vertex record.
 struct Layout {
@@ -41,22 +43,25 @@ Layout layout_for(uint32_t flags, uint32_t normal_bits) {
 
 struct Parsed : NodeHeader {
   size_t header_size = 0;
-  std::span<const uint8_t> vertex_stream, locked_stream, index_stream;
+  std::span<const uint8_t> vertex_stream, locked_stream, index_stream, extra;
 };
 
 Parsed parse(std::span<const uint8_t> bytes, const std::string& where) {
   ByteReader r(bytes, where);
   Parsed p;
   static_cast<NodeHeader&>(p) = NodeHeader::read(r, kFormat, kAllFlags, bytes.size());
+  const uint64_t extra_size = p.extra_size;
   uint64_t vertex_size = r.varint(), locked_size = r.varint(), index_size = r.varint();
   p.header_size = r.position();
-  if (vertex_size > r.remaining() || locked_size > r.remaining() - vertex_size ||
-      index_size != r.remaining() - vertex_size - locked_size) {
+  if (extra_size > r.remaining() || vertex_size > r.remaining() - extra_size ||
+      locked_size > r.remaining() - extra_size - vertex_size ||
+      index_size != r.remaining() - extra_size - vertex_size - locked_size) {
     r.fail("stream sizes do not add up to the node size");
   }
   p.vertex_stream = r.bytes(vertex_size, "vertex stream");
   p.locked_stream = r.bytes(locked_size, "locked stream");
   p.index_stream = r.bytes(index_size, "index stream");
+  p.extra = r.bytes(extra_size, "extra bytes");
   return p;
 }
 
@@ -106,8 +111,7 @@ std::vector<uint8_t> MeshoptCodec::encode(const NodeGeometry& g, const PositionG
   vertex_stream.resize(
       meshopt_encodeVertexBuffer(vertex_stream.data(), vertex_stream.size(), records.data(), V, L.stride));
   const std::vector<uint8_t> locked_stream = encode_locked_stream(n, k);
-  const uint64_t vertex_end = uint64_t(g.first_vertex) + V;
-  std::vector<uint8_t> index_stream(meshopt_encodeIndexBufferBound(n.indices.size(), vertex_end));
+  std::vector<uint8_t> index_stream(meshopt_encodeIndexBufferBound(n.indices.size(), n.index_end));
   index_stream.resize(meshopt_encodeIndexBuffer(index_stream.data(), index_stream.size(), n.indices.data(),
                                                 n.indices.size()));
 
@@ -119,6 +123,7 @@ std::vector<uint8_t> MeshoptCodec::encode(const NodeGeometry& g, const PositionG
   w.raw(vertex_stream);
   w.raw(locked_stream);
   w.raw(index_stream);
+  w.raw(g.extra);
   return std::move(w.bytes);
 }
 
@@ -135,16 +140,17 @@ DecodedNode MeshoptCodec::decode(std::span<const uint8_t> bytes, const PositionG
   }
   DecodedNode out;
   out.first_vertex = p.first_vertex;
+  out.index_end = p.index_end;
+  out.extra.assign(p.extra.begin(), p.extra.end());
   Mesh& m = out.mesh;
   m.indices.resize(3 * T);
   if (meshopt_decodeIndexBuffer(m.indices.data(), m.indices.size(), sizeof(uint32_t), p.index_stream.data(),
                                 p.index_stream.size()) != 0) {
     throw Error(where + ": corrupted index stream");
   }
-  const uint32_t vertex_end = p.first_vertex + p.vertices;
   uint32_t max_index = 0;
   for (uint32_t i : m.indices) max_index = std::max(max_index, i);
-  if (T > 0 && max_index >= vertex_end)
+  if (T > 0 && max_index >= p.index_end)
     throw Error(where + ": index " + std::to_string(max_index) + " out of range");
 
   // Positions: q = (cmin + stored) * 2^k (+ the k low bits of a locked vertex), coarse_positions.hpp.
@@ -183,7 +189,7 @@ NodeSizeBreakdown MeshoptCodec::breakdown(std::span<const uint8_t> bytes, const 
   b.header = p.header_size;
   b.vertices = p.vertex_stream.size();
   b.locked = p.locked_stream.size();
-  b.indices = p.index_stream.size();
+  b.indices = p.index_stream.size() + p.extra.size();  // extra: a progressive step's chains (connectivity)
   return b;
 }
 

@@ -2,10 +2,11 @@
 // later, per page, by the writer.
 //
 // Bytes of a node:
-//   u8 format (1), u8 flags (1 normals, 2 uvs, 4 colors, 8 vertex_data, 16 wide positions), u8 position_shift
-//   k, u8 normal_bits; varint vertex count V (≤ 65536), varint triangle count T, varint first_vertex; svarint
-//   cmin[3]; [uvs: f32 uv_min[2], f32 uv_extent[2]]; varint size of the vertex, locked and index streams; the
-//   streams.
+//   u8 format (1), u8 flags (1 normals, 2 uvs, 4 colors, 8 vertex_data, 16 wide positions, 32 progressive),
+//   u8 position_shift k, u8 normal_bits; varint vertex count V (≤ 65536), varint triangle count T, varint
+//   first_vertex; [progressive: varint index_end, varint extra size]; svarint cmin[3]; [uvs: f32 uv_min[2],
+//   f32 uv_extent[2]]; varint size of the vertex, locked and index streams; the streams; [the extra bytes].
+//   (Flag 32 came with progressive meshes; packages without it read as before, so the id stays 1.)
 // Vertex stream: meshopt_encodeVertexBuffer over ONE interleaved record per vertex (meshopt codes each byte
 //   column on its own, so interleaving costs nothing and saves a per-stream tail): position c - cmin as u16x3
 //   (u32x3 when the node spans more than 65536 coarse steps), octahedral normal s8x2 (bits ≤ 8) or s16x2, UV

@@ -37,7 +37,8 @@ struct PositionGrid {
   // step (0.017) of its 279-unit diagonal, and also holds near-duplicate vertices 1e-5 apart (float noise,
   // which no grid separates): it gets max_bits, and the 92 near-duplicates that still collide there are
   // welded by snap(). Only the finest level pays for the extra bits: coarser nodes drop low bits in
-  // proportion to their error (the bake's position_shift). Cost: O(V) per bit count tried.
+  // proportion to their error (the bake's position_shift). Requires max_bits <= 20. Cost: O(V log V) per bit
+  // count tried.
   static PositionGrid separating(const Mesh& mesh, int min_bits = 14, int max_bits = 20);
   // Moves every position to the grid point the codec decodes it to and drops the triangles this makes
   // degenerate (two corners on one grid point). A hierarchy built on the snapped mesh has a finest level
@@ -68,6 +69,13 @@ struct NodeGeometry {
   bool preserve_order = false;
   // Optional 32-bit value per vertex, stored losslessly and opaque to the codec (e.g. a collapse parent).
   std::span<const uint32_t> vertex_data;
+  // Indices may refer to any vertex below index_end (0 = first_vertex + vertex count): a progressive-mesh
+  // step stores its triangles' full-resolution corners, which may lie in later steps. At least first_vertex +
+  // vertex count when nonzero.
+  uint32_t index_end = 0;
+  // Optional bytes stored losslessly after the geometry, opaque to the codec (e.g. a progressive step's
+  // vertex-substitution chains, package/progressive_prefix.hpp).
+  std::span<const uint8_t> extra;
 };
 
 // A decoded node: `mesh.indices` number vertices as the representation does (chunk vertex i is first_vertex +
@@ -76,7 +84,9 @@ struct NodeGeometry {
 struct DecodedNode {
   Mesh mesh;
   uint32_t first_vertex = 0;
+  uint32_t index_end = 0;  // every index is below it (first_vertex + vertex count unless encoded larger)
   std::vector<uint32_t> vertex_data;
+  std::vector<uint8_t> extra;
 };
 
 // Bytes of each part of one encoded node (before zstd), for size reports.

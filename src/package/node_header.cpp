@@ -13,6 +13,8 @@ NodeHeader NodeHeader::of(uint8_t format, uint32_t flags, const NodeGeometry& g,
   h.format = format, h.flags = flags, h.shift = g.position_shift, h.normal_bits = g.normal_bits;
   h.vertices = uint32_t(n.order.size()), h.triangles = uint32_t(n.indices.size() / 3);
   h.first_vertex = g.first_vertex;
+  h.index_end = n.index_end, h.extra_size = g.extra.size();
+  if (h.index_end != h.first_vertex + h.vertices || h.extra_size != 0) h.flags |= kProgressive;
   std::copy(std::begin(n.cmin), std::end(n.cmin), h.cmin);
   h.uv_min = n.uv_min, h.uv_extent = n.uv_extent;
   return h;
@@ -26,6 +28,7 @@ void NodeHeader::write(ByteWriter& w) const {
   w.varint(vertices);
   w.varint(triangles);
   w.varint(first_vertex);
+  if (flags & kProgressive) w.varint(index_end), w.varint(extra_size);
   for (int64_t c : cmin) w.svarint(c);
   if (flags & kHasUvs) w.f32(uv_min.x), w.f32(uv_min.y), w.f32(uv_extent.x), w.f32(uv_extent.y);
 }
@@ -49,6 +52,13 @@ NodeHeader NodeHeader::read(ByteReader& r, uint8_t format, uint32_t known_flags,
   const uint64_t first = r.varint();
   if (first > UINT32_MAX - h.vertices) r.fail("first vertex out of range");
   h.first_vertex = static_cast<uint32_t>(first);
+  h.index_end = h.first_vertex + h.vertices;
+  if (h.flags & kProgressive) {
+    const uint64_t end = r.varint();
+    if (end < h.index_end || end > UINT32_MAX) r.fail("index end out of range");
+    h.index_end = static_cast<uint32_t>(end);
+    h.extra_size = r.varint();
+  }
   for (int64_t& c : h.cmin) {
     c = r.svarint();
     if (c < -kMaxGridCoordinate * 2 || c > kMaxGridCoordinate * 2) r.fail("grid coordinate out of range");

@@ -18,7 +18,7 @@ namespace lodstream::package {
 namespace {
 
 constexpr uint8_t kFormat = 1;
-constexpr uint32_t kAllFlags = kHasNormals | kHasUvs | kHasColors | kHasVertexData;
+constexpr uint32_t kAllFlags = kHasNormals | kHasUvs | kHasColors | kHasVertexData | kProgressive;
 constexpr uint32_t kNone = UINT32_MAX;
 constexpr uint32_t kMaxPositionBytes = 5, kMaxNormalBytes = 3;
 // Triangles before a vertex's first triangle searched for the one across the parallelogram's edge.
@@ -42,9 +42,10 @@ uint32_t bytes_for(uint64_t largest) {
 // Calls visit(v, o1, o2, o) for v = 0, 1, ..., V - 1 with v's predictors, all below v (decoded before it in
 // vertex order): o1 + o2 - o (parallelogram), o1 alone (o2 == kNone), or none (o1 == kNone: predict from
 // vertex v - 1, or cmin for v = 0); the rule is the header comment's. `first` is scratch (V + 1 entries).
-// Returns the largest index, which the caller must check against first_vertex + V (a larger one is ignored
-// here: never a predictor). O(T + V), one branch-free pass over the corners, then per vertex a look at its
-// first triangle and the kAcrossWindow triangles before it.
+// Returns the largest index, which the caller must check against the node's index_end (one at or past
+// first_vertex + V, a progressive step's corner in a later step, is never a predictor). O(T + V), one
+// branch-free pass over the corners, then per vertex a look at its first triangle and the kAcrossWindow
+// triangles before it.
 template <class Visit>
 uint32_t for_each_prediction(std::span<const uint32_t> indices, uint32_t first_vertex, uint32_t V,
                              std::vector<uint32_t>& first, Visit&& visit) {
@@ -123,7 +124,8 @@ void predicted_normals(std::span<const uint32_t> indices, uint32_t first_vertex,
 struct Parsed : NodeHeader {
   uint32_t position_bytes = 0, normal_bytes = 0;
   size_t header_size = 0;
-  std::span<const uint8_t> position_planes, normal_planes, attribute_stream, locked_stream, index_stream;
+  std::span<const uint8_t> position_planes, normal_planes, attribute_stream, locked_stream, index_stream,
+      extra;
 };
 
 Parsed parse(std::span<const uint8_t> bytes, const std::string& where) {
@@ -138,15 +140,17 @@ Parsed parse(std::span<const uint8_t> bytes, const std::string& where) {
   const uint64_t attribute_size = r.varint(), locked_size = r.varint(), index_size = r.varint();
   p.header_size = r.position();
   const uint64_t planes = uint64_t(p.vertices) * (3 * p.position_bytes + 2 * p.normal_bytes);
-  if (planes > r.remaining() || attribute_size > r.remaining() - planes ||
-      locked_size > r.remaining() - planes - attribute_size ||
-      index_size != r.remaining() - planes - attribute_size - locked_size)
+  const uint64_t fixed = planes + p.extra_size;  // both overflow-free: V ≤ 65536, extra_size < the node size
+  if (p.extra_size > r.remaining() || fixed > r.remaining() || attribute_size > r.remaining() - fixed ||
+      locked_size > r.remaining() - fixed - attribute_size ||
+      index_size != r.remaining() - fixed - attribute_size - locked_size)
     r.fail("stream sizes do not add up to the node size");
   p.position_planes = r.bytes(size_t(3) * p.position_bytes * p.vertices, "position residuals");
   p.normal_planes = r.bytes(size_t(2) * p.normal_bytes * p.vertices, "normal residuals");
   p.attribute_stream = r.bytes(attribute_size, "attribute stream");
   p.locked_stream = r.bytes(locked_size, "locked stream");
   p.index_stream = r.bytes(index_size, "index stream");
+  p.extra = r.bytes(p.extra_size, "extra bytes");
   return p;
 }
 
@@ -199,8 +203,7 @@ std::vector<uint8_t> PredictiveCodec::encode(const NodeGeometry& g, const Positi
   const uint32_t flags = attribute_flags(g);
 
   // The triangles as the decoder will see them (the index codec may rotate them).
-  const uint64_t vertex_end = uint64_t(g.first_vertex) + V;
-  std::vector<uint8_t> index_stream(meshopt_encodeIndexBufferBound(n.indices.size(), vertex_end));
+  std::vector<uint8_t> index_stream(meshopt_encodeIndexBufferBound(n.indices.size(), n.index_end));
   index_stream.resize(meshopt_encodeIndexBuffer(index_stream.data(), index_stream.size(), n.indices.data(),
                                                 n.indices.size()));
   std::vector<uint32_t> seen(n.indices.size());
@@ -267,6 +270,7 @@ std::vector<uint8_t> PredictiveCodec::encode(const NodeGeometry& g, const Positi
   w.raw(attribute_stream);
   w.raw(locked_stream);
   w.raw(index_stream);
+  w.raw(g.extra);
   return std::move(w.bytes);
 }
 
@@ -277,6 +281,8 @@ DecodedNode PredictiveCodec::decode(std::span<const uint8_t> bytes, const Positi
   const size_t T = p.triangles;
   DecodedNode out;
   out.first_vertex = p.first_vertex;
+  out.index_end = p.index_end;
+  out.extra.assign(p.extra.begin(), p.extra.end());
   Mesh& m = out.mesh;
   m.indices.resize(3 * T);
   if (meshopt_decodeIndexBuffer(m.indices.data(), m.indices.size(), sizeof(uint32_t), p.index_stream.data(),
@@ -309,7 +315,7 @@ DecodedNode PredictiveCodec::decode(std::span<const uint8_t> bytes, const Positi
         for (int a = 0; a < 3; ++a) out_of_range |= out[a] + uint64_t(kMaxCoarse) > 2 * uint64_t(kMaxCoarse);
         r += 3;
       });
-  if (T > 0 && max_index >= p.first_vertex + p.vertices)
+  if (T > 0 && max_index >= p.index_end)
     throw Error(where + ": index " + std::to_string(max_index) + " out of range");
   if (out_of_range) throw Error(where + ": predicted position out of the grid's range");
   m.positions.resize(V);
@@ -353,7 +359,7 @@ NodeSizeBreakdown PredictiveCodec::breakdown(std::span<const uint8_t> bytes, con
   b.header = p.header_size;
   b.vertices = p.position_planes.size() + p.normal_planes.size() + p.attribute_stream.size();
   b.locked = p.locked_stream.size();
-  b.indices = p.index_stream.size();
+  b.indices = p.index_stream.size() + p.extra.size();  // extra: a progressive step's chains (connectivity)
   return b;
 }
 

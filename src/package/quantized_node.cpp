@@ -27,13 +27,16 @@ QuantizedNode quantize_node(const NodeGeometry& g, const PositionGrid& grid) {
   if (!(grid.step > 0.0f) || !std::isfinite(grid.step)) invalid("grid step must be positive and finite");
   const uint64_t vertex_end = uint64_t(g.first_vertex) + V;
   if (vertex_end > UINT32_MAX) invalid("first vertex out of range");
+  if (g.index_end != 0 && g.index_end < vertex_end) invalid("index end below the node's last vertex");
+  const uint64_t index_end = g.index_end == 0 ? vertex_end : g.index_end;
   for (uint32_t i : m.indices) {
-    if (i >= vertex_end) invalid("index " + std::to_string(i) + " out of range");
+    if (i >= index_end) invalid("index " + std::to_string(i) + " out of range");
   }
 
   // Vertex order: meshopt's vertex-cache then vertex-fetch order (what its codecs compress best), unless the
   // caller's order is significant. order[new] = old.
   QuantizedNode n;
+  n.index_end = static_cast<uint32_t>(index_end);
   n.indices = m.indices;
   n.order.resize(V);
   std::iota(n.order.begin(), n.order.end(), 0u);

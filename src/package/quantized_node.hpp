@@ -22,6 +22,7 @@ constexpr int64_t kMaxGridCoordinate = int64_t(1) << 30;
 struct QuantizedNode {
   std::vector<uint32_t> order;    // order[new] = the caller's vertex
   std::vector<uint32_t> indices;  // the triangles in the new numbering
+  uint32_t index_end = 0;         // every index is below it (NodeGeometry::index_end, or first_vertex + V)
   std::vector<int64_t> q, c;      // per new vertex, x y z: finest-grid and stored (coarse) coordinates
   std::vector<uint8_t> locked;    // per new vertex: 1 = locked
   int64_t cmin[3] = {0, 0, 0}, cmax[3] = {0, 0, 0};

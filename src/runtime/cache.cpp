@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <tuple>
 
 namespace lodstream::runtime {
 
@@ -66,13 +65,17 @@ void PageCache::clear(const package::ContentHash& package) {
 
 void PageCache::evict() {
   if (bytes_ <= budget_) return;
-  // Candidates in eviction order: least useful first, then least recently used.
+  // Candidates in eviction order: least useful first, then least recently used; among unrated pages the
+  // newest first (pages arrive in the scheduler's order, most useful first, so in a burst that overflows the
+  // budget before any frame rated them, the last arrivals are the least useful; dropping the first ones
+  // dropped the roots and left nothing to draw).
   std::vector<std::map<Key, Entry>::iterator> order;
   for (auto it = entries_.begin(); it != entries_.end(); ++it)
     if (!it->second.pinned) order.push_back(it);
   std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) {
-    return std::tie(a->second.usefulness, a->second.last_use) <
-           std::tie(b->second.usefulness, b->second.last_use);
+    const Entry &x = a->second, &y = b->second;
+    if (x.usefulness != y.usefulness) return x.usefulness < y.usefulness;
+    return std::isinf(x.usefulness) ? x.last_use > y.last_use : x.last_use < y.last_use;
   });
   for (auto it : order) {
     if (bytes_ <= budget_) break;

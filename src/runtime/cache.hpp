@@ -8,7 +8,8 @@
 // frame, the pages the current cut draws (pinned: never evicted) and a usefulness per page (page_usefulness
 // below); when over budget, the page with the lowest usefulness goes first, least recently used first among
 // equals. A page inserted since the last set_usefulness counts as most useful (it was fetched because a cut
-// asked for it) until set_usefulness rates it; a rated page absent from the usefulness map counts 0. Only
+// asked for it) until set_usefulness rates it, the newest of them going first (arrivals come in the
+// scheduler's order); a rated page absent from the usefulness map counts 0. Only
 // pinned pages (and, transiently, unrated ones) can keep the cache over budget.
 #pragma once
 

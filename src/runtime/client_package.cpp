@@ -11,7 +11,11 @@ uint64_t key(PageKind kind, uint32_t id) {
 }  // namespace
 
 ClientPackage::ClientPackage(package::PackageReader reader, uint64_t cache_bytes)
-    : reader_(std::move(reader)), cache_(cache_bytes), nodes_(reader_, cache_), scheduler_(reader_.root()) {}
+    : reader_(std::move(reader)),
+      cache_(cache_bytes),
+      nodes_(reader_, cache_),
+      scheduler_(reader_.root()),
+      cached_(reader_.root().pages.size(), false) {}
 
 void ClientPackage::install(PageKind kind, uint32_t id, std::span<const uint8_t> stored) {
   add(kind, id, stored);
@@ -24,10 +28,12 @@ void ClientPackage::restore(PageKind kind, uint32_t id, std::span<const uint8_t>
 }
 
 void ClientPackage::add(PageKind kind, uint32_t id, std::span<const uint8_t> stored) {
-  if (kind == PageKind::index)
+  if (kind == PageKind::index) {
     reader_.add_index_page(id, stored);
-  else
+  } else {
     cache_.insert(reader_.header().content_hash, id, reader_.unpack_page(id, stored));
+    cached_[id] = true;
+  }
   scheduler_.set_held(kind, id);
   in_flight_.erase(key(kind, id));
 }
@@ -58,12 +64,16 @@ Frame ClientPackage::frame(const View& view, std::span<const View> predicted,
   views.insert(views.end(), predicted.begin(), predicted.end());
   const PageUsefulness u = page_usefulness(reader_.scene(), nodes_, f.cut, views, cached_nodes);
   cache_.set_usefulness(hash, u.pinned, u.usefulness);
-  if (cache_.evicted_pages() > 0)
-    for (uint32_t page : cached_pages)
-      if (!cache_.contains(hash, page)) {
+  // Pages evicted here or by an insert since the last frame (an arrival that overflowed the budget).
+  if (cache_.evicted_pages() != evictions_seen_) {
+    evictions_seen_ = cache_.evicted_pages();
+    for (uint32_t page = 0; page < cached_.size(); ++page)
+      if (cached_[page] && !cache_.contains(hash, page)) {
+        cached_[page] = false;
         scheduler_.set_held(PageKind::data, page, false);
         evicted_.push_back(page);
       }
+  }
   return f;
 }
 

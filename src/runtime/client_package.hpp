@@ -57,8 +57,9 @@ class ClientPackage {
   // The stored bytes restored from an earlier session.
   uint64_t bytes_restored() const { return bytes_restored_; }
   size_t in_flight() const { return in_flight_.size(); }
-  // The data pages the cache evicted since the last call (in frame()), for a scheduler kept elsewhere (a pull
-  // scheduler on its own thread) to schedule again.
+  // The data pages the cache evicted since the last call (found in frame(), whether the eviction came from
+  // frame()'s rating or from an arrival that overflowed the budget), for a scheduler kept elsewhere (a pull
+  // scheduler on its own thread, a push server) to schedule again.
   std::vector<uint32_t> take_evicted() { return std::exchange(evicted_, {}); }
   // Pages held (arrived, not merely requested), by kind, sorted (what a Hello tells a push server).
   std::vector<uint32_t> held(schedule::PageKind kind) const;
@@ -71,6 +72,8 @@ class ClientPackage {
   std::unordered_set<uint64_t> in_flight_;  // kind << 32 | id
   void add(schedule::PageKind kind, uint32_t id, std::span<const uint8_t> stored);
 
+  std::vector<bool> cached_;     // data pages put in the cache and not seen evicted yet
+  uint64_t evictions_seen_ = 0;  // cache_.evicted_pages() when cached_ was last checked
   uint64_t bytes_received_ = 0, bytes_restored_ = 0;
   std::vector<uint32_t> evicted_;  // since the last take_evicted()
 };

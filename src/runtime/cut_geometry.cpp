@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <map>
+#include <tuple>
 
 #include "core/error.hpp"
+#include "package/progressive_prefix.hpp"
 
 namespace lodstream::runtime {
 
@@ -113,9 +115,9 @@ size_t CutGeometry::update(const schedule::Cut& cut, const PageSource& pages) {
     const std::vector<uint8_t> bytes = pages(page);
     for (uint32_t id : ids) {
       if (decoded_.count(id)) continue;  // an instanced node listed once per object
-      Mesh mesh = reader_->decode_node(id, bytes).mesh;
-      if (mesh.material >= materials_.size()) mesh.material = 0;
-      decoded_.emplace(id, Decoded{std::move(mesh), frame_});
+      package::DecodedNode node = reader_->decode_node(id, bytes);
+      if (node.mesh.material >= materials_.size()) node.mesh.material = 0;
+      decoded_.emplace(id, Decoded{std::move(node), frame_});
       ++decoded;
     }
   }
@@ -123,7 +125,10 @@ size_t CutGeometry::update(const schedule::Cut& cut, const PageSource& pages) {
   triangles_ = 0;
   const auto& objects = reader_->scene().objects;
   for (const schedule::DrawnNode& d : cut.drawn) {
-    const Mesh& mesh = decoded_.at(d.node).mesh;
+    if (d.refined) continue;  // drawn as part of its object's prefix, below
+    const Mesh& mesh = reader_->node(d.node).kind == package::NodeKind::progressive_step
+                           ? prefix(d.node)
+                           : decoded_.at(d.node).node.mesh;
     const glm::mat4 transform = d.object == package::kNone ? glm::mat4(1.0f) : objects[d.object].transform;
     items_.push_back({d.object, d.node, transform, &mesh});  // HLOD proxies are world space
     triangles_ += mesh.triangle_count();
@@ -132,21 +137,43 @@ size_t CutGeometry::update(const schedule::Cut& cut, const PageSource& pages) {
   return decoded;
 }
 
-void CutGeometry::evict() {
-  std::vector<std::pair<uint64_t, uint32_t>> idle;  // (last drawn, node) of nodes not drawn now
-  uint64_t idle_triangles = 0;
-  for (const auto& [id, d] : decoded_) {
-    if (d.last_drawn == frame_) continue;
-    idle.push_back({d.last_drawn, id});
-    idle_triangles += d.mesh.triangle_count();
+const Mesh& CutGeometry::prefix(uint32_t last_step) {
+  auto it = prefixes_.find(last_step);
+  if (it == prefixes_.end()) {
+    std::vector<const package::DecodedNode*> steps;  // last first, then reversed
+    for (uint32_t id = last_step;;) {
+      steps.push_back(&decoded_.at(id).node);  // every step of a drawn prefix is drawn (cut.hpp)
+      const package::NodeRecord& r = reader_->node(id);
+      if (r.parents.empty()) break;
+      id = r.parents[0];
+    }
+    std::reverse(steps.begin(), steps.end());
+    Decoded assembled;
+    assembled.node.mesh = package::assemble_prefix(
+        steps, reader_->source().name() + ": progressive prefix ending at node " + std::to_string(last_step));
+    it = prefixes_.emplace(last_step, std::move(assembled)).first;
   }
+  it->second.last_drawn = frame_;
+  return it->second.node.mesh;
+}
+
+void CutGeometry::evict() {
+  std::vector<std::tuple<uint64_t, bool, uint32_t>> idle;  // (last drawn, prefix?, node) not drawn now
+  uint64_t idle_triangles = 0;
+  for (auto* map : {&decoded_, &prefixes_})
+    for (const auto& [id, d] : *map) {
+      if (d.last_drawn == frame_) continue;
+      idle.push_back({d.last_drawn, map == &prefixes_, id});
+      idle_triangles += d.node.mesh.triangle_count();
+    }
   if (idle_triangles <= budget_) return;
   std::sort(idle.begin(), idle.end());
-  for (const auto& [last, id] : idle) {
+  for (const auto& [last, is_prefix, id] : idle) {
     if (idle_triangles <= budget_) break;
-    auto it = decoded_.find(id);
-    idle_triangles -= it->second.mesh.triangle_count();
-    decoded_.erase(it);
+    auto& map = is_prefix ? prefixes_ : decoded_;
+    auto it = map.find(id);
+    idle_triangles -= it->second.node.mesh.triangle_count();
+    map.erase(it);
   }
 }
 

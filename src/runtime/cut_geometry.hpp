@@ -1,4 +1,5 @@
-// Cut geometry: the meshes of a cut's drawn nodes, decoded from their data pages, placed by their objects'
+// Cut geometry: the meshes of a cut's drawn nodes (a progressive mesh's drawn steps assembled into one mesh,
+// the item of its last step), decoded from their data pages, placed by their objects'
 // transforms and given the package's materials, as what a renderer draws (a core::Scene, or a list of items
 // for a caller that keeps its own GPU copy per node). Decoded meshes are cached per node, so a frame decodes
 // only the nodes that are new to it: each new node's page is unpacked once per update, then the node decoded.
@@ -101,15 +102,18 @@ class CutGeometry {
   Scene scene() const;
   // Triangles drawn by the current cut (instances counted each time).
   uint64_t triangles() const { return triangles_; }
-  // Decoded meshes held (drawn or kept for later).
+  // Decoded meshes held (drawn or kept for later; assembled progressive prefixes not counted).
   size_t cached_nodes() const { return decoded_.size(); }
 
  private:
   struct Decoded {
-    Mesh mesh;
-    uint64_t last_drawn = 0;  // update() count of the last cut that drew it
+    package::DecodedNode node;  // a prefix's assembled mesh: node.mesh alone
+    uint64_t last_drawn = 0;    // update() count of the last cut that drew it
   };
   void evict();
+  // The mesh of the progressive prefix that ends with step `last_step` (its steps decoded), assembled once
+  // (package/progressive_prefix.hpp) and cached. Throws lodstream::Error on corrupted steps.
+  const Mesh& prefix(uint32_t last_step);
   // Starts (background) or finishes the reading of the embedded textures that `cut` draws.
   void load_textures(const schedule::Cut& cut);
   // Installs the image `read` returns into material `material`, or records the warning it throws.
@@ -124,6 +128,7 @@ class CutGeometry {
   uint64_t materials_version_ = 0;
   uint64_t budget_, frame_ = 0, triangles_ = 0;
   std::unordered_map<uint32_t, Decoded> decoded_;
+  std::unordered_map<uint32_t, Decoded> prefixes_;  // by last step
   std::vector<CutItem> items_;
 };
 

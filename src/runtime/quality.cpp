@@ -20,6 +20,7 @@ FrameQuality frame_quality(const package::PackageScene& scene, const NodeSource&
     error[object] = std::max(error[object], d.error_px);
   };
   for (const DrawnNode& d : cut.drawn) {
+    if (d.refined) continue;  // a progressive step below the last drawn one (cut.hpp)
     const package::NodeRecord& r = *nodes.record(d.node);
     if (d.object == package::kNone) {  // an HLOD proxy: each object it stands for is drawn at its error
       for (uint32_t o : r.objects)

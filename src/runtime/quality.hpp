@@ -7,7 +7,8 @@
 //     area-weighted mean over its drawn nodes of min(1, tau / e_px(node)) (weights: each node's sphere's
 //     clipped screen area), 0 when nothing of it is drawn. It is 1 exactly when everything visible is drawn
 //     at tau or better. An object covered by a drawn HLOD proxy (cut.hpp) is drawn at the proxy's error:
-//     its alpha_i is min(1, tau / e_px(proxy)) and its pixel error the proxy's.
+//     its alpha_i is min(1, tau / e_px(proxy)) and its pixel error the proxy's. A progressive mesh is drawn
+//     at its last drawn step's error (the steps below it, `refined`, are not counted).
 // Pure computation; cost O(drawn nodes) plus a 256-strip integration per sphere.
 #pragma once
 

@@ -91,6 +91,10 @@ class Traversal {
         if (!refine_proxy(c, p)) break;
         continue;
       }
+      if (p.kind == package::NodeKind::progressive_step) {
+        if (!refine_step(c, p)) break;
+        continue;
+      }
       // G and P of the exchange, checked to be one.
       std::vector<const package::NodeRecord*> g(p.children.size());
       bool known = true;
@@ -178,6 +182,30 @@ class Traversal {
                             m.object == package::kNone ? package::kNone : c.node});
       draw(m.object, m.node);
     }
+    return true;
+  }
+
+  // The step after drawn progressive step `p` (cut.hpp, progressive meshes), drawn in addition to it.
+  // Returns false when the budget stops the refinement.
+  bool refine_step(const Candidate& c, const package::NodeRecord& p) {
+    const uint32_t next = p.children[0];
+    const package::NodeRecord* r = nodes_.record(next);
+    if (!r) {
+      if (ideal_) missing_.push_back({c.object, next, 0.0, c.error_px, false});
+      return true;
+    }
+    if (p.children.size() != 1 || r->kind != package::NodeKind::progressive_step ||
+        r->parents != std::vector<uint32_t>{c.node})
+      throw Error("node " + std::to_string(c.node) + ": its next step is not one progressive step after it");
+    const bool available = nodes_.available(next);
+    if (!available && !ideal_) return true;  // the prefix ends at p
+    if (triangles_ + r->triangles > options_.triangle_budget) {
+      budget_limited_ = true;
+      tau_ = c.error_px;
+      return false;
+    }
+    if (ideal_ && !available) missing_.push_back({c.object, next, project(c.object, *r), c.error_px, true});
+    draw(c.object, next);
     return true;
   }
 
@@ -285,7 +313,10 @@ Cut select_cut(const package::PackageScene& scene, const NodeSource& nodes, cons
 
   for (uint64_t k : available.drawn_) {
     const uint32_t o = uint32_t(k >> 32), id = uint32_t(k);
-    cut.drawn.push_back({o, id, available.project(o, *nodes.record(id)), nodes.record(id)->triangles});
+    const package::NodeRecord& r = *nodes.record(id);
+    const bool refined = r.kind == package::NodeKind::progressive_step && !r.children.empty() &&
+                         available.drawn_.count(key(o, r.children[0]));
+    cut.drawn.push_back({o, id, available.project(o, r), r.triangles, refined});
   }
   std::sort(cut.drawn.begin(), cut.drawn.end(), [](const DrawnNode& a, const DrawnNode& b) {
     return std::tie(a.object, a.node) < std::tie(b.object, b.node);

@@ -36,7 +36,18 @@
 // outside the frustum is neither drawn nor refined (its objects, inside its sphere, are culled). Proxy errors
 // bound their objects' roots' errors and their spheres contain theirs, so the cut rule extends across HLOD ->
 // objects. Until every HLOD root is available, nothing of a covered object is drawn (like an object whose
-// roots are not all available). Not handled yet: imposters, progressive-mesh prefixes.
+// roots are not all available).
+//
+// Progressive meshes (hierarchy/progressive_steps.hpp; a representation of kind progressive_mesh, its root
+// step 0, each step's child the next step): steps 0..j are drawn TOGETHER (their union is the prefix mesh),
+// so refining step k draws step k+1 and keeps k drawn (an exchange with P = {k}, G = {k+1} that removes
+// nothing). The same rule and order apply: step k is refined while its own error (the prefix ending with it)
+// projects to > tau, so j is the first step whose own error projects to <= tau (or the last available one);
+// in the ideal cut the missing steps j+1.. carry parent_error_px = the previous prefix's projected error, so
+// a scheduler ranks them like group exchanges. Budget: a step adds its own triangles. All steps share the
+// object's sphere, so the errors along the chain are monotonic in pixels too. Drawn steps below the last are
+// marked `refined`: their triangles are drawn, the object's error is the last one's.
+// Not handled yet: imposters.
 #pragma once
 
 #include <cstdint>
@@ -68,6 +79,9 @@ struct DrawnNode {
   uint32_t object = 0, node = 0;
   double error_px = 0.0;  // its own error, projected
   uint32_t triangles = 0;
+  // A progressive step whose next step is drawn too: part of the drawn prefix, but the object is drawn at the
+  // last step's error (quality and benefit weigh only that one).
+  bool refined = false;
 };
 
 // A node the ideal cut (every node available, same tau and budget) needs that is not available: what to

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <tuple>
+#include <unordered_set>
 
 #include "core/error.hpp"
 #include "schedule/screen_area.hpp"
@@ -101,11 +102,12 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
   std::vector<double> drawn_area(scene.objects.size(), 0.0);
   for (const DrawnNode& d : cut.drawn) {
     if (d.object == package::kNone) continue;  // an HLOD proxy: its exchanges weigh its own sphere
+    if (d.refined) continue;                   // a progressive prefix weighs its object's sphere once
     const package::ObjectRecord& o = scene.objects[d.object];
     drawn_area[d.object] +=
         projected_area(to_world(records.record(d.node)->sphere, o.transform, max_scale(o.transform)), v.view);
   }
-  std::vector<uint64_t> seen;
+  std::unordered_set<uint64_t> seen;  // exchanges of this view (a linear search was quadratic in the cut)
   for (const MissingNode& m : cut.missing) {
     if (!m.record_known) {
       double& priority = unknown[m.node];
@@ -119,8 +121,7 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
     const bool root = r.parents.empty();
     const uint64_t key = uint64_t(m.object) << 32 |
                          (root ? package::kNone : *std::min_element(r.parents.begin(), r.parents.end()));
-    if (std::find(seen.begin(), seen.end(), key) != seen.end()) continue;
-    seen.push_back(key);
+    if (!seen.insert(key).second) continue;
     Exchange e;
     e.object = m.object;
     if (root) {
@@ -197,8 +198,8 @@ std::vector<PageRef> PageScheduler::next(const package::PackageScene& scene, con
   std::map<uint64_t, Exchange> exchanges;
   std::map<uint32_t, double> unknown;
   for (const WeightedView& v : views)
-    collect(scene, records, select_cut(scene, planned, v.view, {options.tau}), v, options.tau, exchanges,
-            unknown);
+    collect(scene, records, select_cut(scene, planned, v.view, {options.tau, options.triangle_budget}), v,
+            options.tau, exchanges, unknown);
 
   // Records first: nothing below an unknown record can be ranked.
   std::vector<std::pair<double, uint32_t>> by_priority;
@@ -220,9 +221,12 @@ std::vector<PageRef> PageScheduler::next(const package::PackageScene& scene, con
   std::stable_sort(ranked.begin(), ranked.end(), [](const Ranked& a, const Ranked& b) {
     return std::tie(a.ratio, a.secondary) > std::tie(b.ratio, b.secondary);
   });
+  size_t first = 0;  // ranked[0, first) are all done
   while (!plan.full()) {
+    while (first < ranked.size() && ranked[first].e->done) ++first;
     Exchange* best = nullptr;
-    for (const Ranked& r : ranked) {
+    for (size_t i = first; i < ranked.size(); ++i) {
+      const Ranked& r = ranked[i];
       if (r.e->done || !plan.eligible(*r.e)) continue;
       if (plan.cost(*r.e) == 0) {
         r.e->done = true;
@@ -243,7 +247,7 @@ std::vector<PageRef> PageScheduler::next_sse(const package::PackageScene& scene,
                                              const View& view, const ScheduleOptions& options) const {
   Plan plan{*this, records, data_held_, index_held_, {}, 0, options};
   const Planned planned(records, data_held_);
-  const Cut cut = select_cut(scene, planned, view, {options.tau});
+  const Cut cut = select_cut(scene, planned, view, {options.tau, options.triangle_budget});
   for (const MissingNode& m : cut.missing) {
     plan.add_record(m.node);
     if (m.record_known) plan.add(PageKind::data, records.record(m.node)->page);

@@ -54,6 +54,9 @@ struct ScheduleOptions {
   double tau = 1.0;                 // target pixel error
   uint64_t max_bytes = UINT64_MAX;  // stop once the pages chosen add up to this much (at least one page)
   size_t max_pages = SIZE_MAX;
+  // The planned cuts' triangle budget (CutOptions::triangle_budget), e.g. what the client's cache affords
+  // (cache_budget.hpp).
+  uint64_t triangle_budget = UINT64_MAX;
 };
 
 class PageScheduler {

@@ -70,10 +70,14 @@ ProgressiveMesh build_progressive(const Mesh& mesh, Options options) {
 
   pm.parent.assign(V, kNone);
   pm.error.assign(V, 0.0f);
+  pm.boundary.assign(V, 1);
   for (const Collapse& c : r.collapses) {
     pm.parent[new_index[c.removed]] = new_index[c.kept];
     pm.error[new_index[c.removed]] = c.error_bound;
   }
+  // u_s sits at V - 1 - s: a seam collapse's second record is the vertex just below its first.
+  for (size_t s = 1; s < r.collapses.size(); ++s)
+    if (r.collapses[s].step == r.collapses[s - 1].step) pm.boundary[V - s] = 0;
 
   Mesh& out = pm.mesh;
   out.material = mesh.material;
@@ -108,6 +112,21 @@ size_t vertex_count_for(const ProgressiveMesh& pm, size_t max_triangles) {
   uint64_t k =
       death_key(pm.parent, idx[3 * max_triangles], idx[3 * max_triangles + 1], idx[3 * max_triangles + 2]);
   return std::max(pm.base_vertices, k == kNever ? pm.base_vertices : size_t(k - 1));
+}
+
+size_t triangle_count_for(const ProgressiveMesh& pm, size_t vertex_count) {
+  const size_t nv = std::clamp(vertex_count, pm.base_vertices, pm.mesh.vertex_count());
+  const auto& idx = pm.mesh.indices;
+  // Triangles are sorted by death key; those alive with nv vertices have a key <= nv.
+  size_t lo = 0, hi = pm.mesh.triangle_count();
+  while (lo < hi) {
+    const size_t mid = (lo + hi) / 2;
+    if (death_key(pm.parent, idx[3 * mid], idx[3 * mid + 1], idx[3 * mid + 2]) <= nv)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo;
 }
 
 Mesh extract(const ProgressiveMesh& pm, size_t vertex_count) {

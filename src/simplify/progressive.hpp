@@ -27,6 +27,9 @@ struct ProgressiveMesh {
   // Build output, not part of the streamed form: per vertex i >= base_vertices, the mesh's two-sided error
   // bound (model units) once it has i vertices (non-decreasing as i falls); 0 for base vertices.
   std::vector<float> error;
+  // Build output: per vertex i >= base_vertices, whether i vertices is a whole-collapse boundary (false where
+  // vertices i - 1 and i are the two wedges of one seam collapse: the seam is apart there); true below.
+  std::vector<uint8_t> boundary;
 };
 
 // Simplifies `mesh` by half-edge collapses as far as they go (Options::target_triangles and max_error
@@ -37,6 +40,10 @@ ProgressiveMesh build_progressive(const Mesh& mesh, Options options);
 // Vertex count of the finest prefix with at most `max_triangles` triangles; base_vertices when even the
 // base mesh has more. Cost: one chain walk.
 size_t vertex_count_for(const ProgressiveMesh& pm, size_t max_triangles);
+
+// Triangles alive with `vertex_count` vertices (clamped to [base_vertices, V]): the length of the triangle
+// prefix that extract() returns. Cost: O(log T) chain walks.
+size_t triangle_count_for(const ProgressiveMesh& pm, size_t vertex_count);
 
 // The mesh with `vertex_count` vertices (clamped to [base_vertices, V]): the vertex prefix and the triangle
 // prefix with every corner resolved to a vertex below `vertex_count`. Cost: O(triangles + chain hops).

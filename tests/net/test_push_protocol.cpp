@@ -43,6 +43,20 @@ schedule::View view_of(const wire::ViewUpdate& v) {
   return schedule::view_of(s);
 }
 
+// Takes what `p` sends from `t` on, acknowledging every 50 ms of virtual time, until a round sends nothing;
+// the pages in the order sent.
+std::vector<schedule::PageRef> drain(PushProtocol& p, double& t) {
+  std::vector<schedule::PageRef> pages;
+  for (int round = 0; round < 100; ++round) {
+    uint32_t last = 0;
+    while (auto page = p.next_page(t)) last = page->sequence, pages.push_back(page->page);
+    t += 0.05;
+    if (!last) break;
+    p.on_message(wire::Ack{last, 0, t, 0}, t);
+  }
+  return pages;
+}
+
 }  // namespace
 
 TEST(PushProtocol, AHelloForThisPackageComesFirst) {
@@ -122,23 +136,11 @@ TEST(PushProtocol, WithoutTheIdleFillANewViewRestartsSending) {
   EXPECT_FALSE(p.next_page(0.0));  // no view: nothing to send
   p.on_message(view({2, 0, 3}, {0, 0, -1}), 0.0);
   double t = 0.0;
-  auto drain = [&] {
-    size_t n = 0;
-    for (int round = 0; round < 100; ++round) {
-      uint32_t last = 0;
-      while (auto page = p.next_page(t)) last = page->sequence, ++n;
-      t += 0.05;
-      if (!last) break;
-      p.on_message(wire::Ack{last, 0, t, 0}, t);
-    }
-    return n;
-  };
-  const size_t first = drain();
-  EXPECT_GT(first, 0u);
+  EXPECT_GT(drain(p, t).size(), 0u);
   EXPECT_FALSE(p.everything_sent());
   EXPECT_FALSE(p.next_page(t));
   p.on_message(view({14, 0, 3}, {0, 0, -1}), t);  // the other end of the DAG
-  EXPECT_GT(drain(), 0u);
+  EXPECT_GT(drain(p, t).size(), 0u);
 }
 
 TEST(PushProtocol, AClientThatAcknowledgesNothingTimesOut) {
@@ -151,4 +153,57 @@ TEST(PushProtocol, AClientThatAcknowledgesNothingTimesOut) {
   EXPECT_DOUBLE_EQ(p.ack_deadline(), 6.0);
   EXPECT_NO_THROW(p.check_timeout(5.9));
   EXPECT_THROW(p.check_timeout(6.1), wire::WireError);
+}
+
+// A data page the client's cache let go (a Released message) is sent again when the view needs it, and only
+// it; releasing a page the package does not have is a protocol error.
+TEST(PushProtocol, AReleasedPageIsSentAgainWhenTheViewNeedsIt) {
+  Fixture f;
+  PushProtocolOptions options;
+  options.fill_when_idle = false;
+  PushProtocol p(f.package, options);
+  p.on_message(hello(), 0.0);
+  p.on_message(view({2, 0, 3}, {0, 0, -1}), 0.0);
+  double t = 0.0;
+  auto data = [&] {
+    std::vector<uint32_t> ids;
+    for (const schedule::PageRef& page : drain(p, t))
+      if (page.kind == PageKind::data) ids.push_back(page.id);
+    return ids;
+  };
+  const std::vector<uint32_t> first = data();
+  ASSERT_GE(first.size(), 2u);
+  const uint32_t released = first[first.size() / 2];
+  p.on_message(wire::Released{{{released, 1}}}, t);
+  EXPECT_TRUE(data().empty());  // held off (release_backoff.hpp)
+  t += 0.3;
+  EXPECT_EQ(data(), std::vector<uint32_t>{released});
+  const auto pages = uint32_t(f.dag.reader.root().pages.size());
+  EXPECT_THROW(p.on_message(wire::Released{{{pages - 1, 2}}}, t), wire::WireError);
+}
+
+// A client whose cache is smaller than the view's cut needs is sent a coarser cut that its cache affords,
+// not pages it would have to evict.
+TEST(PushProtocol, ASmallCacheIsSentTheCutItAffords) {
+  Fixture f;
+  PushProtocolOptions options;
+  options.fill_when_idle = false;
+  auto sent_for = [&](uint64_t budget) {
+    PushProtocol p(f.package, options);
+    wire::Hello h = hello();
+    h.cache_budget_bytes = budget;
+    p.on_message(h, 0.0);
+    p.on_message(view({2, 0, 1}, {0, 0, -1}), 0.0);
+    double t = 0.0;
+    uint64_t raw = 0;
+    for (const schedule::PageRef& page : drain(p, t))
+      if (page.kind == PageKind::data) raw += f.dag.reader.root().pages[page.id].raw_size;
+    return raw;
+  };
+  uint64_t package_raw = 0;
+  for (const auto& page : f.dag.reader.root().pages) package_raw += page.raw_size;
+  const uint64_t large = sent_for(package_raw), small = sent_for(package_raw / 4);
+  EXPECT_GT(small, 0u);
+  EXPECT_LT(small, large);
+  EXPECT_LE(small, package_raw / 4);
 }

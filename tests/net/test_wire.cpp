@@ -37,7 +37,8 @@ TEST(Wire, EveryMessageRoundTrips) {
                                 Ack{42, 123456, 3.25, 3.0},
                                 Welcome{{1, 2}, 99999, 17},
                                 Page{5, 9, 1.5, {1, 2, 3, 4, 5}},
-                                Bye{"cache full"}};
+                                Bye{"cache full"},
+                                Released{{{3, 2}, {9, 1}}}};
   for (const auto& m : messages) {
     auto frame = encode(m);
     Message back = decode(frame);
@@ -104,7 +105,9 @@ TEST(Wire, InvalidFieldsAreNamed) {
   frame = encode(hello());
   uint32_t huge = 0x40000000;
   std::memcpy(frame.data() + kHeaderBytes + 4 + 4 + 16, &huge, 4);
-  expect_error(frame, "held run count");
+  expect_error(frame, "held runs count");
+  expect_error(encode(Released{}), "released runs");                  // nothing released
+  expect_error(encode(Released{{{4, 2}, {5, 1}}}), "released runs");  // overlapping
 }
 
 TEST(Wire, RandomBytesNeverCrash) {

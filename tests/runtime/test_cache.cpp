@@ -21,11 +21,16 @@ TEST(PageCache, StaysUnderBudgetLeastRecentlyUsedFirstAmongEquals) {
   cache.insert(kA, 0, bytes(100));
   cache.insert(kA, 1, bytes(100));
   cache.insert(kA, 2, bytes(100));
+  cache.set_usefulness(kA, {}, {{0, 1.0}, {1, 1.0}, {2, 1.0}});
   ASSERT_NE(cache.find(kA, 0), nullptr);  // 0 is now more recent than 1
   cache.insert(kA, 3, bytes(100));
   EXPECT_EQ(cache.bytes(), 300u);
   EXPECT_EQ(cache.pages(kA), (std::vector<uint32_t>{0, 2, 3}));
   EXPECT_EQ(cache.evicted_pages(), 1u);
+  // Unrated arrivals that overflow the budget: the newest goes (they arrive most useful first).
+  PageCache burst(300);
+  for (uint32_t p = 0; p < 5; ++p) burst.insert(kA, p, bytes(100));
+  EXPECT_EQ(burst.pages(kA), (std::vector<uint32_t>{0, 1, 2}));
   EXPECT_EQ(*cache.find(kA, 3), bytes(100));
   cache.insert(kA, 3, bytes(50, 9));  // replacing a page updates the byte count
   EXPECT_EQ(cache.bytes(), 250u);

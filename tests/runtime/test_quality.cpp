@@ -88,6 +88,37 @@ TEST(Quality, BenefitRatioAndPixelErrorOfHandMadeCuts) {
   EXPECT_DOUBLE_EQ(frame_quality(scene, nodes, cut, v, 1.0).benefit_ratio, 1.0);
 }
 
+TEST(Quality, AProgressivePrefixIsDrawnAtItsLastStepsError) {
+  // One object drawn as progressive steps 0..2 (nodes 0, 1, 2; steps 0 and 1 refined by the next one).
+  struct Nodes : NodeSource {
+    std::vector<package::NodeRecord> r = std::vector<package::NodeRecord>(3);
+    const package::NodeRecord* record(uint32_t id) const override { return &r.at(id); }
+    bool available(uint32_t) const override { return true; }
+  } nodes;
+  for (package::NodeRecord& n : nodes.r) {
+    n.kind = package::NodeKind::progressive_step;
+    n.sphere = {{0, 0, 0}, 1.0f};
+  }
+  package::PackageScene scene;
+  package::Representation rep;
+  rep.kind = package::RepresentationKind::progressive_mesh;
+  rep.bounds.add(glm::vec3(-0.5f));
+  rep.bounds.add(glm::vec3(0.5f));
+  scene.representations = {rep};
+  scene.objects = {{"o", glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, -10)), 0}};
+  Cut cut;
+  cut.objects = {ObjectState::drawn};
+  cut.drawn = {{0, 0, 8.0, 100, true}, {0, 1, 2.0, 100, true}, {0, 2, 0.5, 200, false}};
+  FrameQuality q = frame_quality(scene, nodes, cut, test_view(), 1.0);
+  EXPECT_DOUBLE_EQ(q.benefit_ratio, 1.0) << "step 2 is within tau; the coarser steps it refines do not count";
+  EXPECT_DOUBLE_EQ(q.pixel_error_max, 0.5);
+  cut.drawn.pop_back();
+  cut.drawn.back().refined = false;  // the prefix ends at step 1 (2 px)
+  q = frame_quality(scene, nodes, cut, test_view(), 1.0);
+  EXPECT_DOUBLE_EQ(q.benefit_ratio, 0.5);
+  EXPECT_DOUBLE_EQ(q.pixel_error_max, 2.0);
+}
+
 TEST(Quality, AreaWeightedOverTheDrawnNodesOfASelectedCut) {
   test::SyntheticDag dag = test::SyntheticDag::make();
   test::TestNodes nodes(dag);

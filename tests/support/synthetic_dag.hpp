@@ -91,6 +91,8 @@ struct SyntheticDag {
     rep.roots = roots;
     s.representations.push_back(rep);
     for (const auto& t : transforms) s.objects.push_back({"o", t, 0});
+    for (const package::NodeRecord& r : records)  // the finest level: what it was "baked" from
+      if (r.children.empty()) s.input_triangles += r.triangles * transforms.size();
     return s;
   }
 };
