@@ -2,7 +2,7 @@
 // --pm-max-triangles N` turns the motorBike's objects of at most N triangles into progressive meshes and the
 // others into cluster DAGs; the package verifies (every prefix of every progressive mesh assembles into a
 // valid mesh, errors fall along each chain), stores fewer triangles than an all-DAG bake, and its cut at 1 px
-// renders like the source model.
+// renders like the source model. Node codec 2 stores progressive steps too.
 #include <gtest/gtest.h>
 
 #include "baked.hpp"
@@ -12,9 +12,10 @@ using namespace lodstream;
 
 namespace {
 
-nlohmann::json bake(const std::string& model, const std::string& file, const std::string& pm_max) {
-  auto r = test::run_lodstream(
-      {"bake", test::data_file(model).string(), "-o", file, "--pm-max-triangles", pm_max, "--json"});
+nlohmann::json bake(const std::string& model, const std::string& file, const std::string& pm_max,
+                    const std::string& codec = "1") {
+  auto r = test::run_lodstream({"bake", test::data_file(model).string(), "-o", file, "--pm-max-triangles",
+                                pm_max, "--codec", codec, "--json"});
   EXPECT_EQ(r.status, 0) << r.err;
   return r.json();
 }
@@ -83,4 +84,16 @@ TEST(BakeProgressive, AnHlodOverProgressiveMeshesVerifies) {
   EXPECT_GT(r.json()["progressive_meshes"].get<int>(), 0);
   EXPECT_GT(r.json()["hlod"]["nodes"].get<int>(), 0);
   expect_verifies(file);
+}
+
+TEST(BakeProgressive, CodecTwoStoresAProgressiveMeshThatVerifiesAndIsSmaller) {
+  const auto dir = test::temp_dir();
+  const std::string one = (dir / "one.lods").string(), two = (dir / "two.lods").string();
+  const nlohmann::json a = bake("elephant.off", one, "8192", "1");
+  const nlohmann::json b = bake("elephant.off", two, "8192", "2");
+  EXPECT_EQ(b["progressive_meshes"].get<int>(), 1);
+  EXPECT_EQ(b["nodes"], a["nodes"]);
+  EXPECT_EQ(b["stored_triangles"], a["stored_triangles"]);
+  EXPECT_LT(b["bytes"].get<int64_t>(), a["bytes"].get<int64_t>()) << "predicted positions and normals";
+  expect_verifies(two);
 }
