@@ -97,14 +97,21 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
              const WeightedView& v, double tau, std::map<uint64_t, Exchange>& exchanges,
              std::map<uint32_t, double>& unknown) {
   const double total = view_area(scene, cut, v.view);
-  // W_i: the screen area of the nodes drawn now for object i (the weights of alpha_i's mean).
-  std::vector<double> drawn_area(scene.objects.size(), 0.0);
+  // A_i per object in the frustum (0 when culled), and W_i: the screen area of the nodes drawn now for
+  // object i (the weights of alpha_i's mean).
+  std::vector<double> object_area(scene.objects.size(), 0.0), drawn_area(scene.objects.size(), 0.0);
+  for (uint32_t o = 0; o < scene.objects.size(); ++o)
+    if (cut.objects[o] != ObjectState::culled)
+      object_area[o] = projected_area(object_sphere(scene, o), v.view);
   for (const DrawnNode& d : cut.drawn) {
-    if (d.object == package::kNone) continue;  // an HLOD proxy: its exchanges weigh its own sphere
+    if (d.object == package::kNone) continue;  // an HLOD proxy: its exchanges weigh its objects' A_i
     const package::ObjectRecord& o = scene.objects[d.object];
     drawn_area[d.object] +=
         projected_area(to_world(records.record(d.node)->sphere, o.transform, max_scale(o.transform)), v.view);
   }
+  auto known = [&](const std::vector<uint32_t>& ids) {
+    return std::all_of(ids.begin(), ids.end(), [&](uint32_t n) { return records.record(n) != nullptr; });
+  };
   std::vector<uint64_t> seen;
   for (const MissingNode& m : cut.missing) {
     if (!m.record_known) {
@@ -113,10 +120,47 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
       continue;
     }
     const package::NodeRecord& r = *records.record(m.node);
-    const bool proxy = m.object == package::kNone;  // HLOD nodes: world space, their own sphere's area
-    const glm::mat4 transform = proxy ? glm::mat4(1.0f) : scene.objects[m.object].transform;
-    const double scale = max_scale(transform);
+    const bool proxy = m.object == package::kNone;
     const bool root = r.parents.empty();
+    // Gain per unit of area: roots where nothing is drawn count kRootGain; anything that replaces something
+    // drawn (a P, a proxy, or for an object's roots the leaf proxy that draws it now: a finite
+    // parent_error_px) the log of the error it removes.
+    const double gain = std::isinf(m.parent_error_px)
+                            ? kRootGain
+                            : std::log(std::max(m.parent_error_px, tau) / std::max(m.error_px, tau));
+    if (proxy || m.proxy != package::kNone) {
+      // HLOD (cut.hpp): the exchange below proxy P (its child proxies, or for a leaf its objects' roots, all
+      // refined together), or the HLOD's roots. Each object is drawn by one proxy whole, so its share is
+      // all of A_i: the benefit sums A_i x gain over the objects the exchange's members stand for (a member
+      // proxy: its objects; an object's roots: that object, once).
+      const uint32_t p = proxy ? (root ? package::kNone : r.parents[0]) : m.proxy;
+      const std::vector<uint32_t>& g =
+          proxy ? (root ? scene.representations[r.representation].roots : records.record(p)->children)
+                : scene.representations[scene.objects[m.object].representation].roots;
+      if (!known(g)) continue;  // its unknown records are in `unknown`
+      auto [it, inserted] = exchanges.try_emplace(uint64_t(package::kNone) << 32 | p);
+      Exchange& e = it->second;
+      if (inserted) {
+        e.object = package::kNone;
+        if (p != package::kNone) e.p = {p};
+        if (proxy) e.g = g;
+      }
+      double area = 0.0;
+      if (proxy) {
+        for (uint32_t o : r.objects)
+          if (o < object_area.size()) area += object_area[o];
+      } else {
+        const uint64_t object_key = uint64_t(m.object) << 32 | p;
+        if (std::find(seen.begin(), seen.end(), object_key) != seen.end()) continue;
+        seen.push_back(object_key);
+        e.g.insert(e.g.end(), g.begin(), g.end());
+        area = object_area[m.object];
+      }
+      e.benefit += v.weight * area * gain / total;
+      e.secondary = std::max(e.secondary, v.weight * std::min(m.parent_error_px, 1e300));
+      continue;
+    }
+    const glm::mat4& transform = scene.objects[m.object].transform;
     const uint64_t key = uint64_t(m.object) << 32 |
                          (root ? package::kNone : *std::min_element(r.parents.begin(), r.parents.end()));
     if (std::find(seen.begin(), seen.end(), key) != seen.end()) continue;
@@ -124,31 +168,21 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
     Exchange e;
     e.object = m.object;
     if (root) {
-      e.g = scene.representations[proxy ? r.representation : scene.objects[m.object].representation].roots;
-      if (m.proxy != package::kNone) e.p = {m.proxy};  // refines an HLOD leaf: eligible once it is held
+      e.g = scene.representations[scene.objects[m.object].representation].roots;
     } else {
       e.p = r.parents;
       std::sort(e.p.begin(), e.p.end());
       e.g = records.record(e.p[0])->children;
     }
-    if (!std::all_of(e.g.begin(), e.g.end(), [&](uint32_t n) { return records.record(n) != nullptr; }))
-      continue;  // its unknown records are in `unknown`
+    if (!known(e.g)) continue;  // its unknown records are in `unknown`
     // The object's share that changes: all of A_i for its roots; for P, its nodes' weight in alpha_i's mean
     // (|P| spheres of area a(P) out of W_i), at most all of it.
-    // A proxy's share is its parent's (or, for a root, its own) sphere's area.
-    double area = projected_area(
-        proxy ? to_world(root ? r.sphere : r.parent_sphere, transform, 1.0) : object_sphere(scene, m.object),
-        v.view);
-    if (!root && !proxy) {
-      const double a_p =
-          double(e.p.size()) * projected_area(to_world(r.parent_sphere, transform, scale), v.view);
+    double area = object_area[m.object];
+    if (!root) {
+      const double a_p = double(e.p.size()) *
+                         projected_area(to_world(r.parent_sphere, transform, max_scale(transform)), v.view);
       area = drawn_area[m.object] > 0.0 ? area * std::min(1.0, a_p / drawn_area[m.object]) : a_p;
     }
-    // Roots count kRootGain where nothing is drawn; an object's roots that refine an HLOD leaf proxy (a
-    // finite parent_error_px: the proxy's) gain the log of the error they remove, like any exchange.
-    const double gain = root && std::isinf(m.parent_error_px)
-                            ? kRootGain
-                            : std::log(std::max(m.parent_error_px, tau) / std::max(m.error_px, tau));
     auto [it, inserted] = exchanges.try_emplace(key, std::move(e));
     it->second.benefit += v.weight * area * gain / total;
     it->second.secondary = std::max(it->second.secondary, v.weight * std::min(m.parent_error_px, 1e300));
