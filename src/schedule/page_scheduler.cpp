@@ -91,6 +91,58 @@ double view_area(const package::PackageScene& scene, const Cut& cut, const View&
   return total > 0.0 ? total : 1.0;
 }
 
+// Adds view `v`'s benefit of the HLOD exchange below proxy `p` (cut.hpp; package::kNone: the HLOD's roots,
+// where nothing is drawn) to `exchanges`. Every object a proxy draws is drawn by it whole, so the benefit
+// sums, over the objects of the exchange's members in the frustum, A_i x the log gain from e_P (`p_error_px`)
+// to the member's error: members are p's child proxies, or for a leaf the roots of its objects (one
+// exchange: the cut refines a leaf only when all of them are available); members already held count too
+// (their objects gain as much when P is replaced). Skipped while a member's record is unknown.
+void add_hlod_exchange(const package::PackageScene& scene, const NodeSource& records, const Cut& cut,
+                       const WeightedView& v, double tau, uint32_t p, double p_error_px,
+                       const std::vector<double>& object_area, double total,
+                       std::map<uint64_t, Exchange>& exchanges) {
+  auto gain = [&](double e_px) {
+    return std::isinf(p_error_px) ? kRootGain : std::log(std::max(p_error_px, tau) / std::max(e_px, tau));
+  };
+  const package::NodeRecord* proxy = p == package::kNone ? nullptr : records.record(p);
+  std::vector<uint32_t> g;
+  double benefit = 0.0;
+  if (!proxy || !proxy->children.empty()) {
+    std::vector<uint32_t> members;
+    for (const package::Representation& rep : scene.representations)
+      if (rep.kind == package::RepresentationKind::hlod && !proxy) members = rep.roots;
+    if (proxy) members = proxy->children;
+    for (uint32_t c : members) {
+      const package::NodeRecord* r = records.record(c);
+      if (!r) return;
+      g.push_back(c);
+      double area = 0.0;
+      for (uint32_t o : r->objects)
+        if (o < object_area.size()) area += object_area[o];
+      if (area > 0.0) benefit += area * gain(projected_error(scene, package::kNone, *r, v.view));
+    }
+  } else {
+    for (uint32_t o : proxy->objects) {
+      if (o >= cut.objects.size() || cut.objects[o] == ObjectState::culled) continue;
+      double e_px = 0.0;
+      for (uint32_t root : scene.representations[scene.objects[o].representation].roots) {
+        const package::NodeRecord* r = records.record(root);
+        if (!r) return;
+        g.push_back(root);
+        e_px = std::max(e_px, projected_error(scene, o, *r, v.view));
+      }
+      benefit += object_area[o] * gain(e_px);
+    }
+  }
+  Exchange& e = exchanges[uint64_t(package::kNone) << 32 | p];
+  e.object = package::kNone;
+  if (proxy) e.p = {p};
+  for (uint32_t n : g)
+    if (std::find(e.g.begin(), e.g.end(), n) == e.g.end()) e.g.push_back(n);
+  e.benefit += v.weight * benefit / total;
+  e.secondary = std::max(e.secondary, v.weight * std::min(p_error_px, 1e300));
+}
+
 // Adds view `v`'s exchanges (from its cut's missing nodes) to `exchanges`; unknown records go to
 // `unknown` (node -> the largest weighted error their arrival may remove).
 void collect(const package::PackageScene& scene, const NodeSource& records, const Cut& cut,
@@ -122,44 +174,17 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
     const package::NodeRecord& r = *records.record(m.node);
     const bool proxy = m.object == package::kNone;
     const bool root = r.parents.empty();
-    // Gain per unit of area: roots where nothing is drawn count kRootGain; anything that replaces something
-    // drawn (a P, a proxy, or for an object's roots the leaf proxy that draws it now: a finite
-    // parent_error_px) the log of the error it removes.
-    const double gain = std::isinf(m.parent_error_px)
-                            ? kRootGain
-                            : std::log(std::max(m.parent_error_px, tau) / std::max(m.error_px, tau));
     if (proxy || m.proxy != package::kNone) {
-      // HLOD (cut.hpp): the exchange below proxy P (its child proxies, or for a leaf its objects' roots, all
-      // refined together), or the HLOD's roots. Each object is drawn by one proxy whole, so its share is
-      // all of A_i: the benefit sums A_i x gain over the objects the exchange's members stand for (a member
-      // proxy: its objects; an object's roots: that object, once).
       const uint32_t p = proxy ? (root ? package::kNone : r.parents[0]) : m.proxy;
-      const std::vector<uint32_t>& g =
-          proxy ? (root ? scene.representations[r.representation].roots : records.record(p)->children)
-                : scene.representations[scene.objects[m.object].representation].roots;
-      if (!known(g)) continue;  // its unknown records are in `unknown`
-      auto [it, inserted] = exchanges.try_emplace(uint64_t(package::kNone) << 32 | p);
-      Exchange& e = it->second;
-      if (inserted) {
-        e.object = package::kNone;
-        if (p != package::kNone) e.p = {p};
-        if (proxy) e.g = g;
-      }
-      double area = 0.0;
-      if (proxy) {
-        for (uint32_t o : r.objects)
-          if (o < object_area.size()) area += object_area[o];
-      } else {
-        const uint64_t object_key = uint64_t(m.object) << 32 | p;
-        if (std::find(seen.begin(), seen.end(), object_key) != seen.end()) continue;
-        seen.push_back(object_key);
-        e.g.insert(e.g.end(), g.begin(), g.end());
-        area = object_area[m.object];
-      }
-      e.benefit += v.weight * area * gain / total;
-      e.secondary = std::max(e.secondary, v.weight * std::min(m.parent_error_px, 1e300));
+      const uint64_t key = uint64_t(package::kNone) << 32 | p;
+      if (std::find(seen.begin(), seen.end(), key) != seen.end()) continue;
+      seen.push_back(key);
+      add_hlod_exchange(scene, records, cut, v, tau, p, m.parent_error_px, object_area, total, exchanges);
       continue;
     }
+    // Roots where nothing is drawn count kRootGain; a P replaced by G the log of the error it removes.
+    const double gain =
+        root ? kRootGain : std::log(std::max(m.parent_error_px, tau) / std::max(m.error_px, tau));
     const glm::mat4& transform = scene.objects[m.object].transform;
     const uint64_t key = uint64_t(m.object) << 32 |
                          (root ? package::kNone : *std::min_element(r.parents.begin(), r.parents.end()));
