@@ -210,9 +210,20 @@ int run_bake(const BakeArgs& args) {
     for (const hierarchy::HlodObject& h : inputs) world.add(h.bounds.min), world.add(h.bounds.max);
     hierarchy::HlodOptions options;
     options.position_tolerance = float(std::sqrt(3.0) * 0.5 * PositionGrid::for_bounds(world, 14).step);
+    for (const Material& m : scene.materials) options.material_colors.push_back(m.base_color);
+    options.mixed_material = uint32_t(scene.materials.size());
     hlod = hierarchy::build_hlod(inputs, options);
-    for (hierarchy::HlodNode& n : hlod.nodes)
+    bool mixed = false;
+    for (hierarchy::HlodNode& n : hlod.nodes) {
       for (uint32_t& o : n.objects) o = hlod_objects[o];
+      mixed = mixed || n.mesh.material == options.mixed_material;
+    }
+    if (mixed) {  // proxies of several materials: white, untextured, their vertex colours carry the look
+      Material white;
+      white.name = "hlod-vertex-colors";
+      white.base_color = glm::vec4(1.0f);
+      scene.materials.push_back(std::move(white));
+    }
   }
   const double hlod_time = elapsed() - hlod_start;
 
