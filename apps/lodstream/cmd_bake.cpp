@@ -1,8 +1,9 @@
-// `lodstream bake MODEL... -o SCENE.lods [--json] [--hlod]`: every mesh of the imported models becomes a
+// `lodstream bake MODEL... -o SCENE.lods [--json] [--no-hlod]`: every mesh of the imported models becomes a
 // cluster DAG (hierarchy/cluster_dag.hpp), written into one .lods package (package/writer.hpp). Objects keep
-// their transforms; objects that instance one mesh share its representation. With --hlod, a scene of two or
-// more objects also gets an HLOD (hierarchy/hlod.hpp) over its objects' roots: one more representation, of
-// kind hlod, whose nodes are world-space proxies listing the objects they stand for.
+// their transforms; objects that instance one mesh share its representation. Unless --no-hlod, a scene of
+// two or more objects also gets an HLOD (hierarchy/hlod.hpp) over its objects' roots: one more
+// representation, of kind hlod, whose nodes are world-space proxies listing the objects they stand for (and
+// a white material "hlod-vertex-colors" when a proxy merges several materials).
 //
 // Node order (ids) and page order: first the HLOD's top levels (its root, children and grandchildren) and the
 // roots of every representation (the root index, enough for a first frame), then the other HLOD nodes, each
@@ -51,7 +52,7 @@ using namespace package;
 struct BakeArgs {
   std::vector<std::string> models;
   std::string output;
-  bool json = false, hlod = false;
+  bool json = false, hlod = true;
   uint32_t normal_bits = 10;
   int max_grid_bits = 20;
 };
@@ -481,10 +482,9 @@ const bool registered = register_command(
                       "finest grid: at most 2^-N of a mesh's diagonal (14..20, default 20), fewer when its "
                       "vertices stay apart with fewer");
        sub.add_flag(
-           "--hlod", args->hlod,
-           "an HLOD over the objects (merged proxies: a distant group of objects is a few nodes); off by "
-           "default until the push scheduler orders proxies well (city: push to 0.95 in 5.7 s with it, "
-           "2.2 s without)");
+           "--hlod,!--no-hlod", args->hlod,
+           "an HLOD over the objects (merged proxies: a distant group of objects is a few nodes); on "
+           "by default for a scene of two or more objects, --no-hlod turns it off");
        sub.add_flag("--json", args->json,
                     "print one JSON object: input_triangles, objects, nodes, pages, levels, bytes, time_s, "
                     "peak_rss_bytes");
