@@ -172,10 +172,15 @@ void make_proxy(Hlod& hlod, uint32_t id, std::span<const HlodObject> objects, co
 Hlod build_hlod(std::span<const HlodObject> objects, const HlodOptions& options) {
   Bounds scene;
   for (const HlodObject& o : objects) scene.add(o.bounds.min), scene.add(o.bounds.max);
+  std::vector<float> errors;
+  for (const HlodObject& o : objects) errors.push_back(o.error);
+  std::nth_element(errors.begin(), errors.begin() + ptrdiff_t(errors.size() / 2), errors.end());
+  const double median = errors.empty() ? 0.0 : double(errors[errors.size() / 2]);
+  const double coarse = std::max(options.coarse_median_factor * median,
+                                 options.coarse_scene_fraction * double(scene.diagonal()));
   std::vector<uint32_t> members;  // the objects the HLOD covers (hlod.hpp: coarse ones stay out)
   for (uint32_t o = 0; o < objects.size(); ++o)
-    if (double(objects[o].error) <= options.max_error_fraction * double(scene.diagonal()))
-      members.push_back(o);
+    if (double(objects[o].error) <= coarse) members.push_back(o);
   if (members.size() <= 1) return {};
   Builder b{objects, options, {}};
   b.build(std::move(members));

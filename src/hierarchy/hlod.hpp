@@ -19,12 +19,14 @@
 // errors are monotonic up the tree and across HLOD -> object roots. sphere(node) contains the spheres of what
 // it replaces and its own proxy's vertices. The cut rule (draw a node when its own error projects to <= tau
 // and its parent's to > tau) then extends from the HLOD root down to each object's roots.
-// Objects whose coarse error exceeds `max_error_fraction` of the scene's diagonal stay out of the HLOD (drawn
-// from their own roots, never under a proxy): a proxy's error is at least its objects', so one such object
-// (the city's two buildings objects, root errors 91 and 75 in a 280-unit scene, where the 804 motorbike parts
-// have at most 1.9) would make every proxy above it as coarse as it is, and its neighbours drawn at that
-// error until it is refined. A scene of at most one object (after that) has no HLOD (an empty result): a
-// proxy would only duplicate that object.
+// Coarse objects stay out of the HLOD (drawn from their own roots, never under a proxy): those whose coarse
+// error exceeds both `coarse_median_factor` x the median of the objects' coarse errors and
+// `coarse_scene_fraction` of the scene's diagonal. A proxy's error is at least its objects', so one such
+// object would make every proxy above it as coarse as it is, and its neighbours drawn at that error until it
+// is refined: the city's two buildings objects have root errors 91 and 75 where the median of its 806
+// objects is 0.055 and the largest of the 804 motorbike parts 1.86 (34 x the median); a layout of copies of
+// one model (all errors equal) keeps every object. A scene of at most one object (after that) has no HLOD
+// (an empty result): a proxy would only duplicate that object.
 #pragma once
 
 #include <cstdint>
@@ -50,12 +52,13 @@ struct HlodObject {
 };
 
 struct HlodOptions {
-  size_t leaf_objects = 4;            // objects per leaf, at most
-  size_t branching = 4;               // children per inner node, at most
-  size_t max_proxy_triangles = 2048;  // budget of one proxy
-  double ratio = 0.5;                 // a proxy keeps at most this fraction of its merged input
-  float position_tolerance = 0.0f;    // added to every error and radius (the package's rounding)
-  double max_error_fraction = 0.02;   // of the scene's diagonal: coarser objects stay out (above)
+  size_t leaf_objects = 4;              // objects per leaf, at most
+  size_t branching = 4;                 // children per inner node, at most
+  size_t max_proxy_triangles = 2048;    // budget of one proxy
+  double ratio = 0.5;                   // a proxy keeps at most this fraction of its merged input
+  float position_tolerance = 0.0f;      // added to every error and radius (the package's rounding)
+  double coarse_median_factor = 100.0;  // coarse objects stay out (above): error > this x the median
+  double coarse_scene_fraction = 0.01;  // and > this fraction of the scene's diagonal
   // Base colour (linear RGBA) of each material the objects use; empty: a proxy of several materials takes
   // the most used one, positions and normals only.
   std::vector<glm::vec4> material_colors;

@@ -129,7 +129,7 @@ TEST(CliBakeHlod, AProxyOfTwoMaterialsRendersWithTheirColours) {
                           "--size", "320x240", "--pixel-error", "1000", "-o", image.string(), "--json"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.json()["nodes"].get<size_t>(), 1u) << "the proxy alone";
-  const Image img = lodstream::load_image(image);
+  const lodstream::Image img = lodstream::load_image(image);
   size_t red_left = 0, blue_right = 0, misplaced = 0;
   for (int y = 0; y < img.height; ++y)
     for (int x = 0; x < img.width; ++x) {

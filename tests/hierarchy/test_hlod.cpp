@@ -177,7 +177,7 @@ TEST(Hlod, AProxyOfTwoMaterialsCarriesTheirColours) {
 
 TEST(Hlod, ACoarseObjectStaysOutOfTheHlod) {
   std::vector<HlodObject> objects = sphere_field(4);  // 16 objects over about 12 units
-  objects[5].error = 2.0f;                            // > 2 % of the diagonal
+  objects[5].error = 2.0f;  // > 100 x the median (0.003) and > 1 % of the diagonal (16)
   const Hlod hlod = build_hlod(objects);
   ASSERT_NE(hlod.root, kNoHlodNode);
   const std::vector<uint32_t>& covered = hlod.nodes[hlod.root].objects;
