@@ -1,11 +1,12 @@
-// `lodstream bake MODEL... -o SCENE.lods [--json] [--hlod] [--pm-max-triangles N]`: every mesh of the
+// `lodstream bake MODEL... -o SCENE.lods [--json] [--no-hlod] [--pm-max-triangles N]`: every mesh of the
 // imported models becomes a cluster DAG (hierarchy/cluster_dag.hpp), or, with at most N triangles, a
 // progressive mesh (hierarchy/progressive_steps.hpp: one node per prefix step, chained step k -> k+1, stored
 // on the mesh's finest grid in vertex order with the full-resolution corners and chains of
 // package/progressive_prefix.hpp), written into one .lods package (package/writer.hpp). Objects keep their
-// transforms; objects that instance one mesh share its representation. With --hlod, a scene of two or more
-// objects also gets an HLOD (hierarchy/hlod.hpp) over its objects' roots: one more representation, of kind
-// hlod, whose nodes are world-space proxies listing the objects they stand for.
+// transforms; objects that instance one mesh share its representation. Unless --no-hlod, a scene of two or
+// more objects also gets an HLOD (hierarchy/hlod.hpp) over its objects' roots: one more representation, of
+// kind hlod, whose nodes are world-space proxies listing the objects they stand for (and a white material
+// "hlod-vertex-colors" when a proxy merges several materials).
 //
 // Node order (ids) and page order: first the HLOD's top levels (its root, children and grandchildren) and the
 // roots of every representation (a progressive mesh's: step 0; the root index, enough for a first frame),
@@ -71,7 +72,7 @@ constexpr uint32_t kMaxPmTriangles = 21845;
 struct BakeArgs {
   std::vector<std::string> models;
   std::string output;
-  bool json = false, hlod = false;
+  bool json = false, hlod = true;
   uint32_t normal_bits = 10;
   int max_grid_bits = 20;
   uint32_t codec = default_node_codec().id();
@@ -261,9 +262,20 @@ int run_bake(const BakeArgs& args) {
     for (const hierarchy::HlodObject& h : inputs) world.add(h.bounds.min), world.add(h.bounds.max);
     hierarchy::HlodOptions options;
     options.position_tolerance = float(std::sqrt(3.0) * 0.5 * PositionGrid::for_bounds(world, 14).step);
+    for (const Material& m : scene.materials) options.material_colors.push_back(m.base_color);
+    options.mixed_material = uint32_t(scene.materials.size());
     hlod = hierarchy::build_hlod(inputs, options);
-    for (hierarchy::HlodNode& n : hlod.nodes)
+    bool mixed = false;
+    for (hierarchy::HlodNode& n : hlod.nodes) {
       for (uint32_t& o : n.objects) o = hlod_objects[o];
+      mixed = mixed || n.mesh.material == options.mixed_material;
+    }
+    if (mixed) {  // proxies of several materials: white, untextured, their vertex colours carry the look
+      Material white;
+      white.name = "hlod-vertex-colors";
+      white.base_color = glm::vec4(1.0f);
+      scene.materials.push_back(std::move(white));
+    }
   }
   const double hlod_time = elapsed() - hlod_start;
 
@@ -591,10 +603,9 @@ const bool registered = register_command(
                           std::to_string(kMaxPmTriangles) + "; default " +
                           std::to_string(kDefaultPmMaxTriangles) + ")");
        sub.add_flag(
-           "--hlod", args->hlod,
-           "an HLOD over the objects (merged proxies: a distant group of objects is a few nodes); off by "
-           "default until the push scheduler orders proxies well (city: push to 0.95 in 5.7 s with it, "
-           "2.2 s without)");
+           "--hlod,!--no-hlod", args->hlod,
+           "an HLOD over the objects (merged proxies: a distant group of objects is a few nodes); on "
+           "by default for a scene of two or more objects, --no-hlod turns it off");
        sub.add_flag("--json", args->json,
                     "print one JSON object: input_triangles, objects, nodes, pages, levels, bytes, time_s, "
                     "peak_rss_bytes");

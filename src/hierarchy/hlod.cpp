@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <numeric>
 
 #include "hierarchy/bounding_sphere.hpp"
 #include "simplify/simplify.hpp"
@@ -66,8 +65,42 @@ struct Builder {
   }
 };
 
-// World-space mesh with positions and normals only, appended to `merged`; counts triangles per material.
-void append(Mesh& merged, const Mesh& part, std::map<uint32_t, size_t>& per_material) {
+// How a proxy keeps the look of what it merges (hlod.hpp, HlodOptions::material_colors): one material for
+// all of its parts keeps that material, the parts' UVs (when every part has them) and colours; several
+// materials become `mixed_material` with each part's base colour (times its vertex colours) as vertex
+// colours.
+struct ProxyLook {
+  uint32_t material = 0;
+  bool uvs = false, colors = false, bake_material = false;
+};
+
+ProxyLook proxy_look(const std::vector<const Mesh*>& parts, const HlodOptions& options) {
+  ProxyLook look;
+  std::map<uint32_t, size_t> per_material;
+  bool all_uvs = true, any_colors = false;
+  for (const Mesh* part : parts) {
+    if (part->triangle_count() == 0) continue;
+    per_material[part->material] += part->triangle_count();
+    all_uvs = all_uvs && part->has_uvs();
+    any_colors = any_colors || part->has_colors();
+  }
+  if (per_material.empty()) return look;
+  look.material =
+      std::max_element(per_material.begin(), per_material.end(), [](const auto& a, const auto& b) {
+        return a.second < b.second;
+      })->first;
+  if (per_material.size() == 1) {
+    look.uvs = all_uvs;
+    look.colors = any_colors;
+  } else if (!options.material_colors.empty()) {
+    look.material = options.mixed_material;
+    look.colors = look.bake_material = true;
+  }  // else: the most used material, positions and normals only
+  return look;
+}
+
+// Appends `part` (world space) to `merged` with the attributes `look` keeps; normals computed where absent.
+void append(Mesh& merged, const Mesh& part, const ProxyLook& look, const HlodOptions& options) {
   Mesh m;
   m.positions = part.positions;
   m.indices = part.indices;
@@ -78,8 +111,16 @@ void append(Mesh& merged, const Mesh& part, std::map<uint32_t, size_t>& per_mate
   const uint32_t base = uint32_t(merged.positions.size());
   merged.positions.insert(merged.positions.end(), m.positions.begin(), m.positions.end());
   merged.normals.insert(merged.normals.end(), m.normals.begin(), m.normals.end());
+  if (look.uvs) merged.uvs.insert(merged.uvs.end(), part.uvs.begin(), part.uvs.end());
+  if (look.colors) {
+    const glm::vec4 tint = look.bake_material && part.material != options.mixed_material &&
+                                   part.material < options.material_colors.size()
+                               ? options.material_colors[part.material]
+                               : glm::vec4(1.0f);
+    for (size_t v = 0; v < part.positions.size(); ++v)
+      merged.colors.push_back(tint * (part.has_colors() ? part.colors[v] : glm::vec4(1.0f)));
+  }
   for (uint32_t i : m.indices) merged.indices.push_back(base + i);
-  per_material[part.material] += part.triangle_count();
 }
 
 float round_up(double value) {
@@ -90,38 +131,34 @@ float round_up(double value) {
 // Makes node `id`'s proxy from its children's proxies (or its objects' coarse meshes).
 void make_proxy(Hlod& hlod, uint32_t id, std::span<const HlodObject> objects, const HlodOptions& options) {
   HlodNode& node = hlod.nodes[id];
-  Mesh merged;
-  std::map<uint32_t, size_t> per_material;
+  std::vector<const Mesh*> parts;
   std::vector<Sphere> spheres;
   double replaced_error = 0.0;
   if (node.children.empty()) {
     for (uint32_t o : node.objects) {
-      append(merged, objects[o].coarse, per_material);
+      parts.push_back(&objects[o].coarse);
       spheres.push_back(objects[o].sphere);
       replaced_error = std::max(replaced_error, double(objects[o].error));
     }
   } else {
     for (uint32_t c : node.children) {
       const HlodNode& child = hlod.nodes[c];
-      append(merged, child.mesh, per_material);
+      parts.push_back(&child.mesh);
       spheres.push_back(child.sphere);
       replaced_error = std::max(replaced_error, double(child.error));
       node.level = std::max(node.level, child.level + 1);
     }
   }
-  simplify::Options so;
+  const ProxyLook look = proxy_look(parts, options);
+  Mesh merged;
+  for (const Mesh* part : parts) append(merged, *part, look, options);
+  simplify::Options so;  // default attribute weights: UVs and colours are interpolated, not dropped
   so.target_triangles = std::min(options.max_proxy_triangles,
                                  size_t(std::ceil(options.ratio * double(merged.triangle_count()))));
-  so.uv_weight = so.color_weight = 0.0f;
   so.allow_topology_change = true;
   simplify::Result r = simplify::simplify_mesh(merged, so);
   node.mesh = std::move(r.mesh);
-  node.mesh.material =
-      per_material.empty()
-          ? 0
-          : std::max_element(per_material.begin(), per_material.end(), [](const auto& a, const auto& b) {
-              return a.second < b.second;
-            })->first;
+  node.mesh.material = look.material;
   node.simplification_bound = r.error_bound;
   const double tolerance = double(options.position_tolerance);
   node.error = round_up(replaced_error + r.error_bound + tolerance);
@@ -133,11 +170,20 @@ void make_proxy(Hlod& hlod, uint32_t id, std::span<const HlodObject> objects, co
 }  // namespace
 
 Hlod build_hlod(std::span<const HlodObject> objects, const HlodOptions& options) {
-  if (objects.size() <= 1) return {};
+  Bounds scene;
+  for (const HlodObject& o : objects) scene.add(o.bounds.min), scene.add(o.bounds.max);
+  std::vector<float> errors;
+  for (const HlodObject& o : objects) errors.push_back(o.error);
+  std::nth_element(errors.begin(), errors.begin() + ptrdiff_t(errors.size() / 2), errors.end());
+  const double median = errors.empty() ? 0.0 : double(errors[errors.size() / 2]);
+  const double coarse = std::max(options.coarse_median_factor * median,
+                                 options.coarse_scene_fraction * double(scene.diagonal()));
+  std::vector<uint32_t> members;  // the objects the HLOD covers (hlod.hpp: coarse ones stay out)
+  for (uint32_t o = 0; o < objects.size(); ++o)
+    if (double(objects[o].error) <= coarse) members.push_back(o);
+  if (members.size() <= 1) return {};
   Builder b{objects, options, {}};
-  std::vector<uint32_t> all(objects.size());
-  std::iota(all.begin(), all.end(), 0u);
-  b.build(std::move(all));
+  b.build(std::move(members));
   Hlod hlod = std::move(b.hlod);
   // Bottom-up by depth (children have higher ids, so deepest first): one depth at a time, in parallel.
   std::vector<uint32_t> depth(hlod.nodes.size(), 0);

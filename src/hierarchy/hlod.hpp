@@ -7,14 +7,26 @@
 //   Proxies, bottom-up (nodes of one level in parallel): a leaf proxy merges its objects' coarsest
 //   representations (in world space, as the caller gives them), an inner proxy merges its children's proxies;
 //   the merge is simplified (quadric edge collapse with vertex clustering allowed, so separate parts may
-//   fuse; positions and normals) to min(max_proxy_triangles, ratio x its input).
+//   fuse; the default attribute weights, so UVs and colours are interpolated) to min(max_proxy_triangles,
+//   ratio x its input).
+// Materials: a proxy whose parts share one material keeps it, with the parts' UVs (when all have them: their
+//   texture applies as on the objects) and colours. Parts of several materials make a proxy of
+//   `mixed_material` (the caller's untextured white material) whose vertex colours are each part's material
+//   base colour times its vertex colours; a textured part then shows its base colour factor only.
 // Errors are totals in world units with the cluster DAG's semantics: error(node) = max over what it replaces
 // (its children's proxies, or its objects' coarsest representations) of their error + the simplification's
 // two-sided bound + `position_tolerance` (what the package's quantization adds), rounded up to float; so
 // errors are monotonic up the tree and across HLOD -> object roots. sphere(node) contains the spheres of what
 // it replaces and its own proxy's vertices. The cut rule (draw a node when its own error projects to <= tau
 // and its parent's to > tau) then extends from the HLOD root down to each object's roots.
-// A scene of at most one object has no HLOD (an empty result): a proxy would only duplicate that object.
+// Coarse objects stay out of the HLOD (drawn from their own roots, never under a proxy): those whose coarse
+// error exceeds both `coarse_median_factor` x the median of the objects' coarse errors and
+// `coarse_scene_fraction` of the scene's diagonal. A proxy's error is at least its objects', so one such
+// object would make every proxy above it as coarse as it is, and its neighbours drawn at that error until it
+// is refined: the city's two buildings objects have root errors 91 and 75 where the median of its 806
+// objects is 0.055 and the largest of the 804 motorbike parts 1.86 (34 x the median); a layout of copies of
+// one model (all errors equal) keeps every object. A scene of at most one object (after that) has no HLOD
+// (an empty result): a proxy would only duplicate that object.
 #pragma once
 
 #include <cstdint>
@@ -40,15 +52,21 @@ struct HlodObject {
 };
 
 struct HlodOptions {
-  size_t leaf_objects = 4;            // objects per leaf, at most
-  size_t branching = 4;               // children per inner node, at most
-  size_t max_proxy_triangles = 2048;  // budget of one proxy
-  double ratio = 0.5;                 // a proxy keeps at most this fraction of its merged input
-  float position_tolerance = 0.0f;    // added to every error and radius (the package's rounding)
+  size_t leaf_objects = 4;              // objects per leaf, at most
+  size_t branching = 4;                 // children per inner node, at most
+  size_t max_proxy_triangles = 2048;    // budget of one proxy
+  double ratio = 0.5;                   // a proxy keeps at most this fraction of its merged input
+  float position_tolerance = 0.0f;      // added to every error and radius (the package's rounding)
+  double coarse_median_factor = 100.0;  // coarse objects stay out (above): error > this x the median
+  double coarse_scene_fraction = 0.01;  // and > this fraction of the scene's diagonal
+  // Base colour (linear RGBA) of each material the objects use; empty: a proxy of several materials takes
+  // the most used one, positions and normals only.
+  std::vector<glm::vec4> material_colors;
+  uint32_t mixed_material = 0;  // material of proxies of several materials (white, untextured)
 };
 
 struct HlodNode {
-  Mesh mesh;  // the proxy: world space, positions and normals, one material (the input's most used)
+  Mesh mesh;  // the proxy: world space, normals, UVs / colours as the header says, one material
   float error = 0.0f;
   Sphere sphere;
   uint32_t level = 1;  // 1 = leaf (its children are objects), parents one more than their highest child

@@ -62,6 +62,14 @@ WorldSphere proxy_sphere(const package::NodeRecord& r) {
   return {glm::dvec3(r.sphere.center), double(r.sphere.radius)};
 }
 
+// Node `r`'s projected error under `transform` (largest axis scale `scale`), or world space (a proxy) when
+// `transform` is null.
+double project_node(const package::NodeRecord& r, const glm::mat4* transform, double scale,
+                    const View& view) {
+  if (!transform) return screen_error(double(r.error), proxy_sphere(r), view);
+  return screen_error(double(r.error) * scale, to_world(r.sphere, *transform, scale), view);
+}
+
 class Traversal {
  public:
   Traversal(const package::PackageScene& scene, const NodeSource& nodes, const View& view,
@@ -219,9 +227,9 @@ class Traversal {
   }
 
   double project(uint32_t object, const package::NodeRecord& r) const {
-    if (object == package::kNone) return screen_error(double(r.error), proxy_sphere(r), view_);
+    if (object == package::kNone) return project_node(r, nullptr, 1.0, view_);
     const ObjectView& o = (*objects_)[object];
-    return screen_error(double(r.error) * o.scale, to_world(r.sphere, o.transform, o.scale), view_);
+    return project_node(r, &o.transform, o.scale, view_);
   }
 
   void check_exchange(uint32_t id, const package::NodeRecord& p,
@@ -261,6 +269,13 @@ WorldSphere object_sphere(const package::PackageScene& scene, uint32_t object) {
   const package::ObjectRecord& o = scene.objects[object];
   const Bounds& b = scene.representations[o.representation].bounds;
   return to_world(Sphere{b.center(), 0.5f * b.diagonal()}, o.transform, max_scale(o.transform));
+}
+
+double projected_error(const package::PackageScene& scene, uint32_t object, const package::NodeRecord& r,
+                       const View& view) {
+  if (object == package::kNone) return project_node(r, nullptr, 1.0, view);
+  const glm::mat4& transform = scene.objects[object].transform;
+  return project_node(r, &transform, max_scale(transform), view);
 }
 
 Cut select_cut(const package::PackageScene& scene, const NodeSource& nodes, const View& view,

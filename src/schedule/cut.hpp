@@ -117,6 +117,11 @@ struct Cut {
 // its transform (radius scaled by the largest axis scale). What culling and the benefit ratio's A_i use.
 WorldSphere object_sphere(const package::PackageScene& scene, uint32_t object);
 
+// Node `r`'s own error projected for `view` (DESIGN.md's e_px): of `object` under its transform (error scaled
+// by its largest axis scale), or for object package::kNone an HLOD proxy (world space).
+double projected_error(const package::PackageScene& scene, uint32_t object, const package::NodeRecord& r,
+                       const View& view);
+
 // Selects the cut for `view` over `scene`'s objects. Throws lodstream::Error (naming the node) when node
 // links do not form group exchanges (a G member's parents differ from P, a P member's children from G).
 Cut select_cut(const package::PackageScene& scene, const NodeSource& nodes, const View& view,

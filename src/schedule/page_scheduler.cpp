@@ -92,21 +92,80 @@ double view_area(const package::PackageScene& scene, const Cut& cut, const View&
   return total > 0.0 ? total : 1.0;
 }
 
+// Adds view `v`'s benefit of the HLOD exchange below proxy `p` (cut.hpp; package::kNone: the HLOD's roots,
+// where nothing is drawn) to `exchanges`. Every object a proxy draws is drawn by it whole, so the benefit
+// sums, over the objects of the exchange's members in the frustum, A_i x the log gain from e_P (`p_error_px`)
+// to the member's error: members are p's child proxies, or for a leaf the roots of its objects (one
+// exchange: the cut refines a leaf only when all of them are available); members already held count too
+// (their objects gain as much when P is replaced). Skipped while a member's record is unknown.
+void add_hlod_exchange(const package::PackageScene& scene, const NodeSource& records, const Cut& cut,
+                       const WeightedView& v, double tau, uint32_t p, double p_error_px,
+                       const std::vector<double>& object_area, double total,
+                       std::map<uint64_t, Exchange>& exchanges) {
+  auto gain = [&](double e_px) {
+    return std::isinf(p_error_px) ? kRootGain : std::log(std::max(p_error_px, tau) / std::max(e_px, tau));
+  };
+  const package::NodeRecord* proxy = p == package::kNone ? nullptr : records.record(p);
+  std::vector<uint32_t> g;
+  double benefit = 0.0;
+  if (!proxy || !proxy->children.empty()) {
+    std::vector<uint32_t> members;
+    for (const package::Representation& rep : scene.representations)
+      if (rep.kind == package::RepresentationKind::hlod && !proxy) members = rep.roots;
+    if (proxy) members = proxy->children;
+    for (uint32_t c : members) {
+      const package::NodeRecord* r = records.record(c);
+      if (!r) return;
+      g.push_back(c);
+      double area = 0.0;
+      for (uint32_t o : r->objects)
+        if (o < object_area.size()) area += object_area[o];
+      if (area > 0.0) benefit += area * gain(projected_error(scene, package::kNone, *r, v.view));
+    }
+  } else {
+    for (uint32_t o : proxy->objects) {
+      if (o >= cut.objects.size() || cut.objects[o] == ObjectState::culled) continue;
+      double e_px = 0.0;
+      for (uint32_t root : scene.representations[scene.objects[o].representation].roots) {
+        const package::NodeRecord* r = records.record(root);
+        if (!r) return;
+        g.push_back(root);
+        e_px = std::max(e_px, projected_error(scene, o, *r, v.view));
+      }
+      benefit += object_area[o] * gain(e_px);
+    }
+  }
+  Exchange& e = exchanges[uint64_t(package::kNone) << 32 | p];
+  e.object = package::kNone;
+  if (proxy) e.p = {p};
+  for (uint32_t n : g)
+    if (std::find(e.g.begin(), e.g.end(), n) == e.g.end()) e.g.push_back(n);
+  e.benefit += v.weight * benefit / total;
+  e.secondary = std::max(e.secondary, v.weight * std::min(p_error_px, 1e300));
+}
+
 // Adds view `v`'s exchanges (from its cut's missing nodes) to `exchanges`; unknown records go to
 // `unknown` (node -> the largest weighted error their arrival may remove).
 void collect(const package::PackageScene& scene, const NodeSource& records, const Cut& cut,
              const WeightedView& v, double tau, std::map<uint64_t, Exchange>& exchanges,
              std::map<uint32_t, double>& unknown) {
   const double total = view_area(scene, cut, v.view);
-  // W_i: the screen area of the nodes drawn now for object i (the weights of alpha_i's mean).
-  std::vector<double> drawn_area(scene.objects.size(), 0.0);
+  // A_i per object in the frustum (0 when culled), and W_i: the screen area of the nodes drawn now for
+  // object i (the weights of alpha_i's mean).
+  std::vector<double> object_area(scene.objects.size(), 0.0), drawn_area(scene.objects.size(), 0.0);
+  for (uint32_t o = 0; o < scene.objects.size(); ++o)
+    if (cut.objects[o] != ObjectState::culled)
+      object_area[o] = projected_area(object_sphere(scene, o), v.view);
   for (const DrawnNode& d : cut.drawn) {
-    if (d.object == package::kNone) continue;  // an HLOD proxy: its exchanges weigh its own sphere
+    if (d.object == package::kNone) continue;  // an HLOD proxy: its exchanges weigh its objects' A_i
     if (d.refined) continue;                   // a progressive prefix weighs its object's sphere once
     const package::ObjectRecord& o = scene.objects[d.object];
     drawn_area[d.object] +=
         projected_area(to_world(records.record(d.node)->sphere, o.transform, max_scale(o.transform)), v.view);
   }
+  auto known = [&](const std::vector<uint32_t>& ids) {
+    return std::all_of(ids.begin(), ids.end(), [&](uint32_t n) { return records.record(n) != nullptr; });
+  };
   std::unordered_set<uint64_t> seen;  // exchanges of this view (a linear search was quadratic in the cut)
   for (const MissingNode& m : cut.missing) {
     if (!m.record_known) {
@@ -115,41 +174,40 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
       continue;
     }
     const package::NodeRecord& r = *records.record(m.node);
-    const bool proxy = m.object == package::kNone;  // HLOD nodes: world space, their own sphere's area
-    const glm::mat4 transform = proxy ? glm::mat4(1.0f) : scene.objects[m.object].transform;
-    const double scale = max_scale(transform);
+    const bool proxy = m.object == package::kNone;
     const bool root = r.parents.empty();
+    if (proxy || m.proxy != package::kNone) {
+      const uint32_t p = proxy ? (root ? package::kNone : r.parents[0]) : m.proxy;
+      const uint64_t key = uint64_t(package::kNone) << 32 | p;
+      if (!seen.insert(key).second) continue;
+      add_hlod_exchange(scene, records, cut, v, tau, p, m.parent_error_px, object_area, total, exchanges);
+      continue;
+    }
+    // Roots where nothing is drawn count kRootGain; a P replaced by G the log of the error it removes.
+    const double gain =
+        root ? kRootGain : std::log(std::max(m.parent_error_px, tau) / std::max(m.error_px, tau));
+    const glm::mat4& transform = scene.objects[m.object].transform;
     const uint64_t key = uint64_t(m.object) << 32 |
                          (root ? package::kNone : *std::min_element(r.parents.begin(), r.parents.end()));
     if (!seen.insert(key).second) continue;
     Exchange e;
     e.object = m.object;
     if (root) {
-      e.g = scene.representations[proxy ? r.representation : scene.objects[m.object].representation].roots;
-      if (m.proxy != package::kNone) e.p = {m.proxy};  // refines an HLOD leaf: eligible once it is held
+      e.g = scene.representations[scene.objects[m.object].representation].roots;
     } else {
       e.p = r.parents;
       std::sort(e.p.begin(), e.p.end());
       e.g = records.record(e.p[0])->children;
     }
-    if (!std::all_of(e.g.begin(), e.g.end(), [&](uint32_t n) { return records.record(n) != nullptr; }))
-      continue;  // its unknown records are in `unknown`
+    if (!known(e.g)) continue;  // its unknown records are in `unknown`
     // The object's share that changes: all of A_i for its roots; for P, its nodes' weight in alpha_i's mean
     // (|P| spheres of area a(P) out of W_i), at most all of it.
-    // A proxy's share is its parent's (or, for a root, its own) sphere's area.
-    double area = projected_area(
-        proxy ? to_world(root ? r.sphere : r.parent_sphere, transform, 1.0) : object_sphere(scene, m.object),
-        v.view);
-    if (!root && !proxy) {
-      const double a_p =
-          double(e.p.size()) * projected_area(to_world(r.parent_sphere, transform, scale), v.view);
+    double area = object_area[m.object];
+    if (!root) {
+      const double a_p = double(e.p.size()) *
+                         projected_area(to_world(r.parent_sphere, transform, max_scale(transform)), v.view);
       area = drawn_area[m.object] > 0.0 ? area * std::min(1.0, a_p / drawn_area[m.object]) : a_p;
     }
-    // Roots count kRootGain where nothing is drawn; an object's roots that refine an HLOD leaf proxy (a
-    // finite parent_error_px: the proxy's) gain the log of the error they remove, like any exchange.
-    const double gain = root && std::isinf(m.parent_error_px)
-                            ? kRootGain
-                            : std::log(std::max(m.parent_error_px, tau) / std::max(m.error_px, tau));
     auto [it, inserted] = exchanges.try_emplace(key, std::move(e));
     it->second.benefit += v.weight * area * gain / total;
     it->second.secondary = std::max(it->second.secondary, v.weight * std::min(m.parent_error_px, 1e300));

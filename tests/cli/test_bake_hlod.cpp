@@ -1,11 +1,15 @@
-// HLOD end to end: a layout of many objects (`lodstream gen layout`) bakes with an HLOD that `inspect
+// HLOD end to end: a layout of many objects (`lodstream gen layout`) bakes by default with an HLOD that
+// `inspect
 // --verify` accepts (proxy invariants, and the per-object crack test as before); rendered from far away the
-// package draws a few proxies where it drew every object's roots without HLOD, and up close it still draws
-// objects; a single object gets no HLOD. Also the buildings.obj verify failure (vertices closer than the
-// 2^-14 grid step): its finest grid gets the bits that keep its vertices apart, and it verifies.
+// package draws a few proxies where it drew every object's roots without HLOD (--no-hlod), and up close it
+// still draws objects; a single object gets no HLOD. Also the buildings.obj verify failure (vertices closer
+// than the 2^-14 grid step): its finest grid gets the bits that keep its vertices apart, and it verifies.
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+
+#include "core/image.hpp"
 
 #include "support/run.hpp"
 
@@ -38,13 +42,13 @@ TEST(CliBakeHlod, ALayoutOfManyObjectsVerifiesAndIsFewNodesFromAfar) {
       {"gen", "layout", data_file("elephant.off").string(), "--copies", "36", "-o", layout.string()});
   ASSERT_EQ(gen.status, 0) << gen.err;
   const auto with = dir / "with.lods", without = dir / "without.lods";
-  auto bake = run_lodstream({"bake", layout.string(), "-o", with.string(), "--json", "--hlod"});
+  auto bake = run_lodstream({"bake", layout.string(), "-o", with.string(), "--json"});  // HLOD by default
   ASSERT_EQ(bake.status, 0) << bake.err;
   const auto j = bake.json();
   EXPECT_EQ(j["objects"].get<size_t>(), 36u);
   EXPECT_GE(j["hlod"]["nodes"].get<size_t>(), 9u + 3u);  // leaves of <= 4 objects, and their parents
   EXPECT_GE(j["hlod"]["levels"].get<uint32_t>(), 2u);
-  auto plain = run_lodstream({"bake", layout.string(), "-o", without.string(), "--json"});
+  auto plain = run_lodstream({"bake", layout.string(), "-o", without.string(), "--json", "--no-hlod"});
   ASSERT_EQ(plain.status, 0) << plain.err;
   EXPECT_EQ(plain.json()["hlod"]["nodes"].get<size_t>(), 0u);
   EXPECT_EQ(plain.json()["nodes"].get<size_t>() + j["hlod"]["nodes"].get<size_t>(), j["nodes"].get<size_t>());
@@ -92,6 +96,53 @@ TEST(CliBakeHlod, BuildingsVerifiesOnItsSeparatingGrid) {
   auto inspect = run_lodstream({"inspect", out.string(), "--verify", "--json"});
   EXPECT_EQ(inspect.status, 0) << inspect.err;
   EXPECT_EQ(inspect.json()["verified"], true) << inspect.out;
+}
+
+// Two flat 8 x 8 grids side by side, objects of their own, the left one red, the right one blue: from afar
+// the package draws the one proxy that merges them, and it shows both colours where the objects are.
+TEST(CliBakeHlod, AProxyOfTwoMaterialsRendersWithTheirColours) {
+  const auto dir = temp_dir();
+  std::ofstream(dir / "two.mtl") << "newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\n";
+  {
+    std::ofstream obj(dir / "two.obj");
+    obj << "mtllib two.mtl\n";
+    const int n = 8;
+    for (int g = 0; g < 2; ++g) {
+      obj << "o grid" << g << "\nusemtl " << (g == 0 ? "red" : "blue") << "\n";
+      const int base = g * (n + 1) * (n + 1) + 1;
+      for (int y = 0; y <= n; ++y)
+        for (int x = 0; x <= n; ++x)
+          obj << "v " << (g == 0 ? -3.0 : 1.0) + 2.0 * x / n << " " << -1.0 + 2.0 * y / n << " 0\n";
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+          const int a = base + y * (n + 1) + x;
+          obj << "f " << a << " " << a + 1 << " " << a + n + 2 << "\nf " << a << " " << a + n + 2 << " "
+              << a + n + 1 << "\n";
+        }
+    }
+  }
+  const auto package = dir / "two.lods", image = dir / "two.png";
+  auto bake = run_lodstream({"bake", (dir / "two.obj").string(), "-o", package.string(), "--json"});
+  ASSERT_EQ(bake.status, 0) << bake.err;
+  ASSERT_EQ(bake.json()["hlod"]["nodes"].get<size_t>(), 1u);
+  auto r = run_lodstream({"render", package.string(), "--eye", "0,0,12", "--target", "0,0,0", "--up", "0,1,0",
+                          "--size", "320x240", "--pixel-error", "1000", "-o", image.string(), "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.json()["nodes"].get<size_t>(), 1u) << "the proxy alone";
+  const lodstream::Image img = lodstream::load_image(image);
+  size_t red_left = 0, blue_right = 0, misplaced = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const uint8_t* p = img.pixel(x, y);
+      const bool red = p[0] > 2 * p[2] + 40, blue = p[2] > 2 * p[0] + 40;
+      const bool left = x < img.width / 2;
+      red_left += red && left;
+      blue_right += blue && !left;
+      misplaced += (red && !left) || (blue && left);
+    }
+  EXPECT_GT(red_left, 500u);
+  EXPECT_GT(blue_right, 500u);
+  EXPECT_EQ(misplaced, 0u);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // HLOD over many objects (hierarchy/hlod.hpp): errors monotonic up the tree and bounding the objects',
 // spheres containing the children's and the proxies' own vertices, object sets that nest and partition, a
-// bounded proxy size, and no HLOD for a single object.
+// bounded proxy size, and no HLOD for a single object; proxies keep their objects' material (UVs and colours
+// interpolated) or, over several materials, their base colours as vertex colours; coarse objects stay out.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -110,6 +111,79 @@ TEST(Hlod, SplitsAlongTheLongestAxis) {
     ASSERT_EQ(run.size(), 4u);
     EXPECT_EQ(run.back() - run.front(), 3u) << "a contiguous run along x";
   }
+}
+
+// Two UV spheres 3 units apart along x, of materials `material_a` and `material_b`.
+std::vector<HlodObject> two_objects(uint32_t material_a, uint32_t material_b) {
+  std::vector<HlodObject> objects;
+  for (int i = 0; i < 2; ++i) {
+    HlodObject o;
+    o.coarse = test::uv_sphere(1.0f, 8, 16);
+    o.coarse.material = i == 0 ? material_a : material_b;
+    for (glm::vec3& p : o.coarse.positions) p.x += 3.0f * float(i);
+    o.bounds = o.coarse.bounds();
+    o.sphere = sphere_of_points(o.coarse.positions);
+    objects.push_back(std::move(o));
+  }
+  return objects;
+}
+
+TEST(Hlod, AProxyOfOneTexturedMaterialKeepsItsUvs) {
+  HlodOptions options;
+  options.material_colors = {glm::vec4(0.8f), glm::vec4(0.8f)};
+  options.mixed_material = 2;
+  const Hlod hlod = build_hlod(two_objects(1, 1), options);
+  ASSERT_NE(hlod.root, kNoHlodNode);
+  const Mesh& proxy = hlod.nodes[hlod.root].mesh;
+  EXPECT_EQ(proxy.material, 1u);
+  ASSERT_EQ(proxy.uvs.size(), proxy.positions.size());
+  // UVs interpolated from the sphere's [0,1]^2 parametrisation: they stay in range and vary.
+  glm::vec2 lo(1.0f), hi(0.0f);
+  for (const glm::vec2& uv : proxy.uvs) lo = glm::min(lo, uv), hi = glm::max(hi, uv);
+  EXPECT_GE(lo.x, -1e-4f);
+  EXPECT_LE(hi.y, 1.0f + 1e-4f);
+  EXPECT_GT(hi.x - lo.x, 0.5f);
+  EXPECT_GT(hi.y - lo.y, 0.5f);
+}
+
+TEST(Hlod, AProxyOfTwoMaterialsCarriesTheirColours) {
+  HlodOptions options;
+  const glm::vec4 red(1.0f, 0.0f, 0.0f, 1.0f), blue(0.0f, 0.0f, 1.0f, 1.0f);
+  options.material_colors = {red, blue};
+  options.mixed_material = 2;
+  const Hlod hlod = build_hlod(two_objects(0, 1), options);
+  ASSERT_NE(hlod.root, kNoHlodNode);
+  const Mesh& proxy = hlod.nodes[hlod.root].mesh;
+  EXPECT_EQ(proxy.material, 2u);
+  ASSERT_EQ(proxy.colors.size(), proxy.positions.size());
+  // The first sphere (x < 1.5) stays red, the second blue.
+  size_t reddish = 0, bluish = 0;
+  for (size_t v = 0; v < proxy.positions.size(); ++v) {
+    const glm::vec4& c = proxy.colors[v];
+    if (proxy.positions[v].x < 1.0f) reddish += c.r > 0.9f && c.b < 0.1f;
+    if (proxy.positions[v].x > 2.0f) bluish += c.b > 0.9f && c.r < 0.1f;
+  }
+  EXPECT_GT(reddish, 0u);
+  EXPECT_GT(bluish, 0u);
+  for (size_t v = 0; v < proxy.positions.size(); ++v) {
+    if (proxy.positions[v].x < 1.0f) {
+      EXPECT_GT(proxy.colors[v].r, 0.5f) << "vertex " << v;
+    }
+    if (proxy.positions[v].x > 2.0f) {
+      EXPECT_GT(proxy.colors[v].b, 0.5f) << "vertex " << v;
+    }
+  }
+}
+
+TEST(Hlod, ACoarseObjectStaysOutOfTheHlod) {
+  std::vector<HlodObject> objects = sphere_field(4);  // 16 objects over about 12 units
+  objects[5].error = 2.0f;  // > 100 x the median (0.003) and > 1 % of the diagonal (16)
+  const Hlod hlod = build_hlod(objects);
+  ASSERT_NE(hlod.root, kNoHlodNode);
+  const std::vector<uint32_t>& covered = hlod.nodes[hlod.root].objects;
+  EXPECT_EQ(covered.size(), 15u);
+  EXPECT_EQ(std::count(covered.begin(), covered.end(), 5u), 0);
+  EXPECT_LT(hlod.nodes[hlod.root].error, 2.0f) << "no proxy is as coarse as the object left out";
 }
 
 }  // namespace
