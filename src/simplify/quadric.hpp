@@ -43,9 +43,7 @@ struct Reduced {
   double b0 = 0, b1 = 0, b2 = 0;
   double c = 0;
 
-  // Adds a Quadric's or another Reduced's terms (the area w is not kept here).
-  template <class Q>
-  void add(const Q& q) {
+  void add(const Quadric& q) {
     a00 += q.a00, a01 += q.a01, a02 += q.a02, a11 += q.a11, a12 += q.a12, a22 += q.a22;
     b0 += q.b0, b1 += q.b1, b2 += q.b2, c += q.c;
   }
