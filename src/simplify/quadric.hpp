@@ -4,7 +4,9 @@
 // d^2, so that Q(p) = p^T A p + 2 b.p + c (the book's Δ(x), digest §7.6.2). An attribute s interpolated
 // linearly over a face as s(p) = g.p + d adds (g.p + d - s)^2 per unit area; minimising over s gives s* =
 // (G.p + D) / W with G = sum area g, D = sum area d, W = sum area, and leaves the reduced position quadric A
-// - G G^T / W, b - G D / W, c - D^2 / W (Hoppe 99, eq. 3 eliminated in closed form).
+// - G G^T / W, b - G D / W, c - D^2 / W (Hoppe 99, eq. 3 eliminated in closed form). p is relative to an
+// origin near the quadric's planes (edge_collapse.cpp stores each vertex's relative to its input position):
+// the terms then stay about W dist^2 instead of cancelling from about W, which float rounding would drown.
 #pragma once
 
 #include <cmath>
