@@ -382,23 +382,24 @@ class Simplifier {
       if (!(len > 0)) continue;
       float area = 0.5f * len;
       glm::vec3 nu = n / len;
-      Quadric q;
-      q.add_plane(nu, -glm::dot(nu, p0), area);
-      q.w = area;
+      glm::vec3 ge1{0.0f}, ge2{0.0f};
       if (channels_ > 0) {
         channel_values(v0, s0.data()), channel_values(v1, s1.data()), channel_values(v2, s2.data());
-        glm::vec3 ge1 = glm::cross(e2, n) / (len * len), ge2 = glm::cross(n, e1) / (len * len);
+        ge1 = glm::cross(e2, n) / (len * len), ge2 = glm::cross(n, e1) / (len * len);
+      }
+      for (uint32_t v : {v0, v1, v2}) {  // each corner's planes relative to its own origin (origin_of)
+        const glm::vec3 rel = p0 - pos_[v];
+        Quadric& q = quadric_[v];
+        q.add_plane(nu, -glm::dot(nu, rel), area);
+        q.w += area;
         for (int j = 0; j < channels_; ++j) {
           glm::vec3 g = (s1[j] - s0[j]) * ge1 + (s2[j] - s0[j]) * ge2;
-          float d = s0[j] - glm::dot(g, p0);
+          float d = s0[j] - glm::dot(g, rel);
           q.add_plane(g, d, area);
-          for (uint32_t v : {v0, v1, v2}) {
-            attr_[v * size_t(channels_) + j].g += area * g;
-            attr_[v * size_t(channels_) + j].d += area * d;
-          }
+          attr_[v * size_t(channels_) + j].g += area * g;
+          attr_[v * size_t(channels_) + j].d += area * d;
         }
       }
-      quadric_[v0].add(q), quadric_[v1].add(q), quadric_[v2].add(q);
     }
     // Penalty planes through open edges (borders and both sides of seams), perpendicular to their face.
     std::vector<uint32_t> outs, ins;
@@ -412,9 +413,9 @@ class Simplifier {
         float l = glm::length(pn);
         if (!(l > 0)) continue;
         pn /= l;
-        Quadric q;
-        q.add_plane(pn, -glm::dot(pn, pa), opt_.boundary_weight * glm::dot(e, e));
-        quadric_[v].add(q), quadric_[outs[i]].add(q);
+        const float weight = opt_.boundary_weight * glm::dot(e, e);
+        quadric_[v].add_plane(pn, 0.0f, weight);
+        quadric_[outs[i]].add_plane(pn, -glm::dot(pn, pa - pb), weight);
       }
     }
   }
@@ -443,6 +444,14 @@ class Simplifier {
       for (int i = 0; i < 4; ++i) s[j++] = col_[v][i] * opt_.color_weight;
   }
 
+  // The origin of v's quadric and attribute terms: its input position (normalized), the same for all its
+  // wedges. Quadrics relative to a nearby origin keep their float terms small: relative to the model's
+  // corner, A, b and c are about W and cancel to W dist^2, which float rounding (1e-7 W) drowned at the
+  // fine levels (distances up to 3e-4 of the extent, the Hausdorff distances being compared).
+  glm::dvec3 origin_of(uint32_t v) const {
+    return glm::dvec3((in_.positions[source_[v]] - origin_) / scale_);
+  }
+
   // ---- planning ----------------------------------------------------------------------------------------
 
   // Kind rules: may a be removed into b? Finds the seam twin a2 -> b2.
@@ -465,16 +474,33 @@ class Simplifier {
     }
   }
 
-  // Placement and cost of a planned collapse: the summed quadric of both positions (all wedges), attribute
-  // channels eliminated per merged wedge pair; optimal x when both ends may move, else x = b.
+  // Placement and cost of a planned collapse: the summed quadric Q = Q_a + Q_b of both positions (all
+  // wedges), attribute channels eliminated per merged wedge pair; optimal x when both ends may move, else
+  // x = b. The cost is Q(x) / W, the area-weighted mean squared distance to both ends' planes (and
+  // attribute error). Positions only, it is never below kEndShare times either end's own:
+  //   cost = max(Q(x) / W, k Q_a(x) / W_a, k Q_b(x) / W_b),  k = kEndShare.
+  // The sum alone dilutes a small end's error into a large end's area (a ridge vertex merged into one that
+  // already stands for a wide smooth region is nearly free). meshoptimizer ranks by the removed end's own
+  // quadric, Q_a(b) / W_a, which never dilutes; k = 1 raised the mean distance by 16 %, k = 0.1 keeps it.
+  // Measured with quadrics relative to each vertex (origin_of) it changes little: elephant_1m 10 %
+  // identical, horse 10 % Hausdorff 0.87x -> 0.85x meshoptimizer's, 1 % 0.54x -> 0.52x. With attribute
+  // weights (attributes eliminated per end) it measured mixed, so it applies positions only.
   void place(Plan& p) const {
+    constexpr double kEndShare = 0.1;
     Reduced r;
     double w = 0;
-    for (uint32_t end : {p.a, p.b}) {
+    std::array<Reduced, 2> own;  // Q_a, Q_b (positions only)
+    std::array<double, 2> own_w{0.0, 0.0};
+    // Everything relative to b's origin o (a's quadrics shifted by o - o_a), x = o + y.
+    const glm::dvec3 o = origin_of(p.b), shift = o - origin_of(p.a);
+    for (int side = 0; side < 2; ++side) {
+      const uint32_t end = side ? p.b : p.a;
+      const glm::dvec3 d = side ? glm::dvec3(0.0) : shift;
       uint32_t v = end;
       do {
-        r.add(quadric_[v]);
+        r.add(quadric_[v], d);
         w += quadric_[v].w;
+        if (channels_ == 0) own[side].add(quadric_[v], d), own_w[side] += quadric_[v].w;
         v = wedge_[v];
       } while (v != end);
     }
@@ -485,10 +511,11 @@ class Simplifier {
       if (!(ww > 0)) continue;
       for (int j = 0; j < channels_; ++j) {
         const AttributeTerm &ta = attr_[a * size_t(channels_) + j], &tb = attr_[b * size_t(channels_) + j];
-        r.eliminate(glm::dvec3(ta.g) + glm::dvec3(tb.g), double(ta.d) + tb.d, ww);
+        r.eliminate(glm::dvec3(ta.g) + glm::dvec3(tb.g),
+                    double(ta.d) + glm::dot(glm::dvec3(ta.g), shift) + tb.d, ww);
       }
     }
-    const glm::dvec3 pa(pos_[p.a]), pb(pos_[p.b]);
+    const glm::dvec3 pa = glm::dvec3(pos_[p.a]) - o, pb = glm::dvec3(pos_[p.b]) - o;
     const uint8_t ka = kind_[p.a], kb = kind_[p.b];
     p.move = !opt_.half_edge && ka == kb && ka != kLocked;
     if (!p.move) {
@@ -512,7 +539,15 @@ class Simplifier {
       }
       p.x = x;
     }
-    p.cost = r.eval(p.x) / (w + 1e-20);
+    const glm::dvec3 y = p.x;
+    p.x += o;
+    p.cost = r.eval(y) / (w + 1e-20);
+    if (channels_ > 0) return;
+    // An end's own term can exceed the sum's only when W_side < k W (Q_side(x) <= Q(x), rounding aside:
+    // both are sums of squares), so only the smaller end of an unbalanced edge is evaluated.
+    for (int side = 0; side < 2; ++side)
+      if (own_w[side] > 0 && own_w[side] < kEndShare * w)
+        p.cost = std::max(p.cost, kEndShare * own[side].eval(y) / own_w[side]);
   }
 
   // The cheaper allowed direction of edge (i, j), as a candidate; cost = +inf when neither is allowed.
@@ -1001,6 +1036,7 @@ class Simplifier {
   // Merges quadrics and sets b's attributes: the attribute quadric's optimum s* = (G.x + D)/W for weighted
   // channels, linear interpolation along the edge for the others; half-edge collapses keep b's.
   void merge(uint32_t a, uint32_t b, const Plan& p) {
+    const glm::dvec3 ob = origin_of(b), shift = ob - origin_of(a);
     if (p.move) {
       glm::dvec3 pa(pos_[a]), pb(pos_[b]), e = pa - pb;
       double ee = glm::dot(e, e);
@@ -1014,7 +1050,9 @@ class Simplifier {
         auto solved = [&](float weight) {
           const AttributeTerm &ta = attr_[a * size_t(channels_) + j], &tb = attr_[b * size_t(channels_) + j];
           ++j;
-          return float((glm::dot(glm::dvec3(ta.g) + glm::dvec3(tb.g), p.x) + ta.d + tb.d) / w / weight);
+          return float((glm::dot(glm::dvec3(ta.g) + glm::dvec3(tb.g), p.x - ob) + ta.d +
+                        glm::dot(glm::dvec3(ta.g), shift) + tb.d) /
+                       w / weight);
         };
         if (!nrm_.empty() && opt_.normal_weight > 0)
           for (int i = 0; i < 3; ++i) nrm_[b][i] = solved(opt_.normal_weight);
@@ -1029,10 +1067,11 @@ class Simplifier {
       }
       if (!col_.empty()) col_[b] = glm::clamp(col_[b], 0.0f, 1.0f);
     }
-    quadric_[b].add(quadric_[a]);
+    quadric_[b].add_shifted(quadric_[a], shift);
     for (int j = 0; j < channels_; ++j) {
-      attr_[b * size_t(channels_) + j].g += attr_[a * size_t(channels_) + j].g;
-      attr_[b * size_t(channels_) + j].d += attr_[a * size_t(channels_) + j].d;
+      const AttributeTerm& ta = attr_[a * size_t(channels_) + j];
+      attr_[b * size_t(channels_) + j].g += ta.g;
+      attr_[b * size_t(channels_) + j].d += float(ta.d + glm::dot(glm::dvec3(ta.g), shift));
     }
   }
 

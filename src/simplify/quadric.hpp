@@ -4,7 +4,9 @@
 // d^2, so that Q(p) = p^T A p + 2 b.p + c (the book's Δ(x), digest §7.6.2). An attribute s interpolated
 // linearly over a face as s(p) = g.p + d adds (g.p + d - s)^2 per unit area; minimising over s gives s* =
 // (G.p + D) / W with G = sum area g, D = sum area d, W = sum area, and leaves the reduced position quadric A
-// - G G^T / W, b - G D / W, c - D^2 / W (Hoppe 99, eq. 3 eliminated in closed form).
+// - G G^T / W, b - G D / W, c - D^2 / W (Hoppe 99, eq. 3 eliminated in closed form). p is relative to an
+// origin near the quadric's planes (edge_collapse.cpp stores each vertex's relative to its input position):
+// the terms then stay about W dist^2 instead of cancelling from about W, which float rounding would drown.
 #pragma once
 
 #include <cmath>
@@ -22,6 +24,8 @@ struct Quadric {
     a00 += q.a00, a01 += q.a01, a02 += q.a02, a11 += q.a11, a12 += q.a12, a22 += q.a22;
     b0 += q.b0, b1 += q.b1, b2 += q.b2, c += q.c, w += q.w;
   }
+  // Adds q, which is stored relative to an origin `d` away from this one's (see Reduced::add).
+  inline void add_shifted(const Quadric& q, const glm::dvec3& d);
   // Adds weight * (n.p + d)^2 (n need not be unit: a gradient g with offset d adds (g.p + d)^2).
   void add_plane(const glm::vec3& n, float d, float weight) {
     a00 += weight * n.x * n.x, a01 += weight * n.x * n.y, a02 += weight * n.x * n.z;
@@ -46,6 +50,16 @@ struct Reduced {
   void add(const Quadric& q) {
     a00 += q.a00, a01 += q.a01, a02 += q.a02, a11 += q.a11, a12 += q.a12, a22 += q.a22;
     b0 += q.b0, b1 += q.b1, b2 += q.b2, c += q.c;
+  }
+  // Adds q stored relative to origin o_q, this one being relative to o = o_q + d: with y = p - o_q = y' + d,
+  // Q = y'^T A y' + 2 (b + A d).y' + (c + 2 b.d + d^T A d).
+  void add(const Quadric& q, const glm::dvec3& d) {
+    const double ad0 = q.a00 * d.x + q.a01 * d.y + q.a02 * d.z, ad1 = q.a01 * d.x + q.a11 * d.y + q.a12 * d.z,
+                 ad2 = q.a02 * d.x + q.a12 * d.y + q.a22 * d.z;
+    a00 += q.a00, a01 += q.a01, a02 += q.a02, a11 += q.a11, a12 += q.a12, a22 += q.a22;
+    b0 += q.b0 + ad0, b1 += q.b1 + ad1, b2 += q.b2 + ad2;
+    c += q.c + 2 * (double(q.b0) * d.x + double(q.b1) * d.y + double(q.b2) * d.z) + ad0 * d.x + ad1 * d.y +
+         ad2 * d.z;
   }
   // Subtracts G G^T / W, G D / W, D^2 / W for one attribute channel (the closed-form minimum over s).
   void eliminate(const glm::dvec3& g, double d, double w) {
@@ -86,5 +100,12 @@ struct Reduced {
     return t < 0 ? 0 : (t > 1 ? 1 : t);
   }
 };
+
+void Quadric::add_shifted(const Quadric& q, const glm::dvec3& d) {
+  Reduced r;
+  r.add(q, d);
+  a00 += float(r.a00), a01 += float(r.a01), a02 += float(r.a02), a11 += float(r.a11), a12 += float(r.a12);
+  a22 += float(r.a22), b0 += float(r.b0), b1 += float(r.b1), b2 += float(r.b2), c += float(r.c), w += q.w;
+}
 
 }  // namespace lodstream::simplify

@@ -119,12 +119,19 @@ TEST(EdgeCollapse, ParallelHalvesGiveOneResultAndKeepTheGuarantees) {
   EXPECT_TRUE(is_edge_manifold(r1.mesh));
   EXPECT_TRUE(boundary_edges(r1.mesh).empty());
   EXPECT_LE(sampled_hausdorff(in, r1.mesh), r1.error_bound);
-  Options serial = with_target(target);
-  serial.record_collapses = true;
-  auto rs = simplify_mesh(in, serial);
-  const float h1 = sampled_hausdorff(in, r1.mesh), hs = sampled_hausdorff(in, rs.mesh);
-  EXPECT_LE(h1, 1.25f * hs) << hs;
-  EXPECT_LE(r1.error_bound, 1.5 * rs.error_bound) << rs.error_bound;
+  // Quality against the serial order, over several meshes: on one mesh the sampled distance swings 0.9x to
+  // 1.5x and the tracked bound (a maximum of accumulated radii) 0.3x to 3.8x between the two orders.
+  double h_parallel = 0, h_serial = 0, bound_parallel = 0, bound_serial = 0;
+  for (unsigned seed = 5; seed <= 10; ++seed) {
+    Mesh m = lumpy(sphere(1.0f, 32, 64), seed);
+    Options o = with_target(m.triangle_count() / 10), serial = o;
+    serial.record_collapses = true;
+    auto rp = simplify_mesh(m, o), rs = simplify_mesh(m, serial);
+    h_parallel += sampled_hausdorff(m, rp.mesh), h_serial += sampled_hausdorff(m, rs.mesh);
+    bound_parallel += rp.error_bound, bound_serial += rs.error_bound;
+  }
+  EXPECT_LE(h_parallel, 1.25 * h_serial) << h_serial;
+  EXPECT_LE(bound_parallel, 1.5 * bound_serial) << bound_serial;
 }
 
 TEST(EdgeCollapse, NoTriangleFlips) {
