@@ -322,8 +322,10 @@ const bool registered = register_command(
        sub.add_option("--settle", opt->settle_s, "seconds to keep the last pose until converged (headless)")
            ->capture_default_str();
        sub.add_option("--cache", opt->cache_mb, "page cache budget, MB")->capture_default_str();
-       sub.add_option("--cache-dir", opt->cache_dir,
-                      "keep received pages in DIR/<package hash>/ and start from them (no page sent twice)");
+       sub.add_option(
+           "--cache-dir", opt->cache_dir,
+           "keep received pages in DIR/<package hash>/, start from them and read evicted pages back "
+           "from there when pulling (no page sent twice)");
        sub.add_option("--budget", opt->budget, "triangles drawn per frame at most (0: no limit)");
        sub.add_option("--order", opt->order,
                       "pull order: benefit (benefit per byte, predicted), sse, or full (the finest level's "

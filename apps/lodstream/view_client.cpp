@@ -79,6 +79,12 @@ ViewClient::ViewClient(const std::string& source, const ViewClientOptions& optio
     fetch.connections = 1;
     fetch.min_window_bytes = 8u << 20;
   }
+  if (disk_) {  // a page evicted from memory and needed again is read back from disk, not fetched twice
+    disk_pages_ = std::make_shared<runtime::DiskPages>(*disk_, client_.reader().root());
+    make_source = [inner = std::move(make_source), pages = disk_pages_] {
+      return std::make_shared<runtime::DiskFirstSource>(inner(), pages);
+    };
+  }
   if (options.order == "full" || options.window > 0) {
     if (options.window > 0) fetch.connections = options.window;
     baseline_ = std::make_unique<PullFetcher>(std::move(make_source), arrived_, fetch);
@@ -136,6 +142,10 @@ void ViewClient::request_baseline(std::span<const schedule::WeightedView> predic
 runtime::Frame ViewClient::frame(const schedule::ViewSample& now) {
   if (std::string error = arrived_.error(); !error.empty()) throw Error(error);
   for (ArrivedPage& a : arrived_.take()) {
+    if (disk_pages_ && disk_pages_->take_served(a.page)) {
+      client_.restore(a.page.kind, a.page.id, a.bytes);  // read back from disk: already stored there
+      continue;
+    }
     client_.install(a.page.kind, a.page.id, a.bytes);
     if (disk_) disk_->store(a.page.kind, a.page.id, a.bytes);
   }

@@ -23,6 +23,7 @@
 #include "net/pull_fetcher.hpp"
 #include "runtime/client_package.hpp"
 #include "runtime/disk_cache.hpp"
+#include "runtime/disk_first_source.hpp"
 #include "schedule/cut.hpp"
 #include "schedule/motion.hpp"
 
@@ -47,7 +48,9 @@ struct ViewClientOptions {
   int window = 0;
   int width = 1280, height = 720;  // the viewport a push server is told in the hello
   // Pages received are kept under DIR/<package content hash>/ (runtime::DiskCache) and restored from it at
-  // start: never fetched again, and listed in the push hello. Empty: the cache lives in memory only.
+  // start (as many as the memory cache holds): never fetched again, and listed in the push hello. A pulled
+  // page that is on disk is read from there (runtime::DiskFirstSource), also after the memory cache evicted
+  // it. Empty: the cache lives in memory only.
   std::filesystem::path cache_dir;
 };
 
@@ -92,6 +95,9 @@ class ViewClient {
   std::filesystem::path package_dir_;
   runtime::ClientPackage client_;
   std::optional<runtime::DiskCache> disk_;
+  // Pulled with a disk cache: which arrivals were read back from disk (the fetcher's sources are
+  // DiskFirstSources over it); null otherwise.
+  std::shared_ptr<runtime::DiskPages> disk_pages_;
   PageInbox arrived_;  // what the transport delivered, for the next frame
   std::unique_ptr<PullScheduler> puller_;
   // The baselines: a fetcher scheduled from the frame thread; `full_` for order full.

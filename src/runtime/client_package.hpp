@@ -33,8 +33,8 @@ class ClientPackage {
   // Installs an arrived page's stored bytes: an index page's records into the reader, a data page (checked
   // and decompressed) into the cache. Throws lodstream::Error when the bytes do not check out.
   void install(schedule::PageKind kind, uint32_t id, std::span<const uint8_t> stored);
-  // Installs a page's stored bytes kept from an earlier session (the DiskCache): checked like install, not
-  // counted as received (bytes_restored instead).
+  // Installs a page's stored bytes read from the DiskCache (kept from an earlier session, or read back after
+  // an eviction): checked like install, not counted as received (bytes_restored instead).
   void restore(schedule::PageKind kind, uint32_t id, std::span<const uint8_t> stored);
   // A page was requested (held by the scheduler until it arrives or the request is dropped).
   void requested(const schedule::PageRef& page);
@@ -54,7 +54,8 @@ class ClientPackage {
   const schedule::PageScheduler& scheduler() const { return scheduler_; }
   // The stored bytes installed so far (what the transport delivered).
   uint64_t bytes_received() const { return bytes_received_; }
-  // The stored bytes restored from an earlier session.
+  // The stored bytes restored from the DiskCache (an earlier session's pages, pages read back after
+  // eviction).
   uint64_t bytes_restored() const { return bytes_restored_; }
   size_t in_flight() const { return in_flight_.size(); }
   // The data pages the cache evicted since the last call (found in frame(), whether the eviction came from

@@ -59,6 +59,14 @@ void DiskCache::store(PageKind kind, uint32_t id, std::span<const uint8_t> store
   if (ec) throw Error(target.string() + ": cannot store a cached page: " + ec.message());
 }
 
+bool DiskCache::read_page(PageKind kind, uint32_t id, std::span<uint8_t> out) const {
+  std::ifstream in(file(kind, id), std::ios::binary | std::ios::ate);
+  if (!in || uint64_t(in.tellg()) != out.size()) return false;
+  in.seekg(0);
+  in.read(reinterpret_cast<char*>(out.data()), std::streamsize(out.size()));
+  return bool(in);
+}
+
 RestoredPages DiskCache::restore(ClientPackage& client, uint64_t budget_bytes) const {
   RestoredPages result;
   const package::RootIndex& root = client.reader().root();
@@ -106,9 +114,7 @@ RestoredPages DiskCache::restore(ClientPackage& client, uint64_t budget_bytes) c
     }
     if (data && client.cache().bytes() + range.raw_size > budget_bytes) continue;  // stays on disk
     std::vector<uint8_t> stored(range.size);
-    std::ifstream in(path, std::ios::binary);
-    in.read(reinterpret_cast<char*>(stored.data()), std::streamsize(stored.size()));
-    if (!in) {
+    if (!read_page(page.kind, page.id, stored)) {
       drop(path, "cannot be read");
       continue;
     }

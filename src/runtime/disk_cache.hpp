@@ -44,6 +44,11 @@ class DiskCache {
   // are deleted and reported. Cost: one read, checksum and decompression per page loaded.
   RestoredPages restore(ClientPackage& client, uint64_t budget_bytes) const;
 
+  // Reads page (kind, id)'s file into `out` when it exists and holds exactly out.size() bytes; false
+  // otherwise. Checks nothing else (the caller checks the checksum). Safe to call from several threads.
+  // Cost: one file read.
+  bool read_page(schedule::PageKind kind, uint32_t id, std::span<uint8_t> out) const;
+
   // The file that holds a page (whether or not it exists).
   std::filesystem::path file(schedule::PageKind kind, uint32_t id) const;
 

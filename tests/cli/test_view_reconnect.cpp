@@ -129,6 +129,28 @@ TEST(ViewReconnect, AServerRestartedMidPathIsReconnectedToAndNoPageArrivesTwice)
   }
 }
 
+TEST(ViewReconnect, APulledThinClientReadsEvictedPagesBackFromDiskNotFromTheNetwork) {
+  // A 0.3 MB memory cache on the 0.88 MB elephant and a camera that swings to the far side and back: pages
+  // are evicted and needed again. With --cache-dir every page crosses the network once; the pages needed
+  // again are read back from disk.
+  Server server;
+  const auto path = temp_dir() / "swing.json";
+  nlohmann::json keys = nlohmann::json::array();
+  for (const auto& [t, x] : {std::pair(0.0, 0.8), std::pair(2.0, -0.8), std::pair(4.0, 0.8)})
+    keys.push_back({{"t", t}, {"eye", {x, 0.2, x}}, {"target", {0, 0, 0}}, {"up", {0, 1, 0}}});
+  std::ofstream(path) << nlohmann::json{{"fov", 60}, {"size", {640, 480}}, {"keyframes", keys}}.dump();
+  const auto dir = temp_dir() / "cache";
+  const auto r = run_lodstream({"view", server.http(), "--headless", "--path", path.string(), "--out",
+                                (temp_dir() / "out").string(), "--settle", "2", "--cache", "0.3",
+                                "--cache-dir", dir.string(), "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = r.json();
+  EXPECT_GT(j["bytes"].get<uint64_t>(), 0u);
+  EXPECT_EQ(j["bytes"].get<uint64_t>(), stored_bytes(dir));  // no page came over the network twice
+  EXPECT_GT(j["bytes_restored"].get<uint64_t>(), 0u);        // evicted pages were read back from disk
+  EXPECT_GT(j["benefit_ratio"].get<double>(), 0.0);
+}
+
 TEST(ViewReconnect, ACacheDirThatCannotBeCreatedIsAOneLineError) {
   const auto file = temp_dir() / "a_file";
   std::ofstream(file) << "not a directory";
