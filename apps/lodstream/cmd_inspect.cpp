@@ -175,14 +175,14 @@ int run_inspect(const InspectArgs& args) {
   uint32_t levels = 0;
   for (const Representation& r : root.scene.representations) levels = std::max(levels, r.levels);
   struct Level {
-    size_t nodes = 0, triangles = 0;
+    size_t nodes = 0, triangles = 0, raw_bytes = 0;  // raw: node bytes before the pages' zstd
     float min_error = INFINITY, max_error = 0.0f;
   };
   std::map<uint32_t, Level> per_level;
   size_t stored_triangles = 0;
   for (const NodeRecord& n : nodes) {
     Level& l = per_level[n.level];
-    ++l.nodes, l.triangles += n.triangles, stored_triangles += n.triangles;
+    ++l.nodes, l.triangles += n.triangles, l.raw_bytes += n.size, stored_triangles += n.triangles;
     l.min_error = std::min(l.min_error, n.error), l.max_error = std::max(l.max_error, n.error);
   }
   const uint64_t bytes = reader.header().file_size;
@@ -291,6 +291,7 @@ int run_inspect(const InspectArgs& args) {
       level_json.push_back({{"level", l},
                             {"nodes", s.nodes},
                             {"triangles", s.triangles},
+                            {"raw_bytes", s.raw_bytes},
                             {"min_error", s.min_error},
                             {"max_error", s.max_error}});
     nlohmann::json out = {{"nodes", nodes.size()},

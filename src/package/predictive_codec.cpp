@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cstring>
+#include <iterator>
+#include <type_traits>
 
 #include "core/error.hpp"
 #include "package/bytes.hpp"
@@ -101,24 +103,34 @@ uint32_t for_each_prediction(std::span<const uint32_t> indices, uint32_t first_v
   return largest;
 }
 
-int64_t predict(const int64_t* c, uint32_t o1, uint32_t o2, uint32_t o, int a, int64_t cmin) {
-  if (o1 == kNone) return cmin;
-  if (o2 == kNone) return c[3 * size_t(o1) + a];
-  return c[3 * size_t(o1) + a] + c[3 * size_t(o2) + a] - c[3 * size_t(o) + a];
+// Rewrites for_each_prediction's predictors so that every case is the parallelogram c[o1] + c[o2] - c[o] over
+// coordinates with an extra entry V holding cmin: o2 = o = o1 for a single predictor, o1 = o2 = o = V for
+// none. Lets encoder and decoder predict with one branch-free formula.
+void parallelogram_form(uint32_t V, uint32_t& o1, uint32_t& o2, uint32_t& o) {
+  if (o1 == kNone) o1 = V;
+  if (o2 == kNone) o2 = o = o1;
 }
 
 // Area-weighted vertex normals of the node's own triangles (those whose corners are all in the node), over
-// `positions`: sum of cross(p1 - p0, p2 - p0). O(T + V).
-void predicted_normals(std::span<const uint32_t> indices, uint32_t first_vertex, const glm::vec3* positions,
-                       uint32_t V, std::vector<glm::vec3>& sum) {
+// `positions`: sum of cross(p1 - p0, p2 - p0). `index_end` bounds the indices (checked by the caller); when
+// it is first_vertex + V (every node but a progressive step) no corner lies outside and the loop tests none.
+// O(T + V).
+void predicted_normals(std::span<const uint32_t> indices, uint32_t first_vertex, uint32_t index_end,
+                       const glm::vec3* positions, uint32_t V, std::vector<glm::vec3>& sum) {
   sum.assign(V, glm::vec3(0.0f));
-  for (size_t i = 0; i + 2 < indices.size(); i += 3) {
-    const uint32_t a = indices[i] - first_vertex, b = indices[i + 1] - first_vertex,
-                   c = indices[i + 2] - first_vertex;
-    if (a >= V || b >= V || c >= V) continue;
-    const glm::vec3 n = glm::cross(positions[b] - positions[a], positions[c] - positions[a]);
-    sum[a] += n, sum[b] += n, sum[c] += n;
-  }
+  auto accumulate = [&](auto all_inside) {
+    for (size_t i = 0; i + 2 < indices.size(); i += 3) {
+      const uint32_t a = indices[i] - first_vertex, b = indices[i + 1] - first_vertex,
+                     c = indices[i + 2] - first_vertex;
+      if (!all_inside && (a >= V || b >= V || c >= V)) continue;
+      const glm::vec3 n = glm::cross(positions[b] - positions[a], positions[c] - positions[a]);
+      sum[a] += n, sum[b] += n, sum[c] += n;
+    }
+  };
+  if (first_vertex == 0 && index_end == V)
+    accumulate(std::true_type{});
+  else
+    accumulate(std::false_type{});
 }
 
 struct Parsed : NodeHeader {
@@ -155,24 +167,27 @@ Parsed parse(std::span<const uint8_t> bytes, const std::string& where) {
 }
 
 // Unzigzags `count` values of `components` components each, stored as `width` byte planes (byte b of
-// component a at plane b * components + a), into out[components * i + a]. Cost: O(count * components *
-// width), one pass per plane.
+// component a at plane b * components + a), into out[a * count + i] (one array per component, so each loop
+// is a plain pass the compiler can vectorize). Cost: O(count * components * width).
 template <typename T>
 void read_planes(const uint8_t* planes, size_t count, uint32_t components, uint32_t width, T* out) {
   for (uint32_t a = 0; a < components; ++a) {
     const uint8_t* low = planes + a * count;
+    T* o = out + a * count;
     if (width == 1) {
-      for (size_t i = 0; i < count; ++i) out[components * i + a] = T(unzigzag(low[i]));
+      for (size_t i = 0; i < count; ++i) o[i] = T(int32_t(low[i] >> 1) ^ -int32_t(low[i] & 1));
     } else if (width == 2) {
       const uint8_t* high = planes + (components + a) * count;
-      for (size_t i = 0; i < count; ++i)
-        out[components * i + a] = T(unzigzag(low[i] | uint64_t(high[i]) << 8));
+      for (size_t i = 0; i < count; ++i) {
+        const uint32_t z = low[i] | uint32_t(high[i]) << 8;
+        o[i] = T(int32_t(z >> 1) ^ -int32_t(z & 1));
+      }
     } else {
       for (size_t i = 0; i < count; ++i) {
         uint64_t value = 0;
         for (uint32_t b = 0; b < width; ++b)
           value |= uint64_t(planes[(b * components + a) * count + i]) << (8 * b);
-        out[components * i + a] = T(unzigzag(value));
+        o[i] = T(unzigzag(value));
       }
     }
   }
@@ -212,12 +227,16 @@ std::vector<uint8_t> PredictiveCodec::encode(const NodeGeometry& g, const Positi
     throw Error("node codec: index codec round trip failed");
 
   // Position residuals in vertex order.
+  std::vector<int64_t> c(n.c);
+  c.insert(c.end(), std::begin(n.cmin), std::end(n.cmin));
   std::vector<uint64_t> residuals(3 * size_t(V));
   std::vector<uint32_t> first;
   uint64_t largest = 0;
   for_each_prediction(seen, g.first_vertex, V, first, [&](uint32_t v, uint32_t o1, uint32_t o2, uint32_t o) {
+    parallelogram_form(V, o1, o2, o);
     for (int a = 0; a < 3; ++a) {
-      const uint64_t z = zigzag(n.c[3 * size_t(v) + a] - predict(n.c.data(), o1, o2, o, a, n.cmin[a]));
+      const int64_t predicted = c[3 * size_t(o1) + a] + c[3 * size_t(o2) + a] - c[3 * size_t(o) + a];
+      const uint64_t z = zigzag(c[3 * size_t(v) + a] - predicted);
       residuals[3 * size_t(v) + a] = z;
       largest = std::max(largest, z);
     }
@@ -231,7 +250,7 @@ std::vector<uint8_t> PredictiveCodec::encode(const NodeGeometry& g, const Positi
     const std::vector<uint8_t> locked = encode_locked_stream(n, k);
     std::vector<glm::vec3> decoded(V), sum;
     decode_positions(n.c, LockedStream::parse(locked, V, k, "node codec"), grid, decoded.data());
-    predicted_normals(seen, g.first_vertex, decoded.data(), V, sum);
+    predicted_normals(seen, g.first_vertex, n.index_end, decoded.data(), V, sum);
     normal_residuals.resize(2 * size_t(V));
     largest = 0;
     for (uint32_t v = 0; v < V; ++v) {
@@ -290,31 +309,29 @@ DecodedNode PredictiveCodec::decode(std::span<const uint8_t> bytes, const Positi
     throw Error(where + ": corrupted index stream");
   const LockedStream locked = LockedStream::parse(p.locked_stream, V, p.shift, where);
 
-  // Positions: the prediction of the header comment, in vertex order. The arithmetic wraps (unsigned), so
-  // hostile residuals cannot overflow; the results and the indices are range-checked afterwards.
+  // Positions: the prediction of the header comment, in vertex order, branch-free: every case is
+  // c[o1] + c[o2] - c[o], with o2 = o = o1 for a single predictor and o1 = o2 = o = V (an extra entry holding
+  // cmin) for none. The arithmetic wraps (unsigned), so hostile residuals cannot overflow; the results and
+  // the indices are range-checked afterwards.
   thread_local std::vector<uint32_t> first;
   thread_local std::vector<int64_t> residual, c;
-  residual.resize(3 * size_t(V)), c.resize(3 * size_t(V));
+  residual.resize(3 * size_t(V)), c.resize(3 * (size_t(V) + 1));
   read_planes(p.position_planes.data(), V, 3, p.position_bytes, residual.data());
-  const int64_t* r = residual.data();
+  const int64_t *rx = residual.data(), *ry = rx + V, *rz = ry + V;
   uint64_t* cu = reinterpret_cast<uint64_t*>(c.data());
-  const uint64_t cmin[3] = {uint64_t(p.cmin[0]), uint64_t(p.cmin[1]), uint64_t(p.cmin[2])};
-  bool out_of_range = false;
+  for (int a = 0; a < 3; ++a) cu[3 * size_t(V) + a] = uint64_t(p.cmin[a]);
   const uint32_t max_index = for_each_prediction(
       m.indices, p.first_vertex, V, first, [&](uint32_t v, uint32_t o1, uint32_t o2, uint32_t o) {
+        parallelogram_form(V, o1, o2, o);
+        const uint64_t *x = cu + 3 * size_t(o1), *y = cu + 3 * size_t(o2), *z = cu + 3 * size_t(o);
         uint64_t* out = cu + 3 * size_t(v);
-        if (o1 == kNone) {
-          for (int a = 0; a < 3; ++a) out[a] = cmin[a] + uint64_t(r[a]);
-        } else if (o2 == kNone) {
-          const uint64_t* from = cu + 3 * size_t(o1);
-          for (int a = 0; a < 3; ++a) out[a] = from[a] + uint64_t(r[a]);
-        } else {
-          const uint64_t *x = cu + 3 * size_t(o1), *y = cu + 3 * size_t(o2), *z = cu + 3 * size_t(o);
-          for (int a = 0; a < 3; ++a) out[a] = x[a] + y[a] - z[a] + uint64_t(r[a]);
-        }
-        for (int a = 0; a < 3; ++a) out_of_range |= out[a] + uint64_t(kMaxCoarse) > 2 * uint64_t(kMaxCoarse);
-        r += 3;
+        out[0] = x[0] + y[0] - z[0] + uint64_t(rx[v]);
+        out[1] = x[1] + y[1] - z[1] + uint64_t(ry[v]);
+        out[2] = x[2] + y[2] - z[2] + uint64_t(rz[v]);
       });
+  bool out_of_range = false;
+  for (size_t i = 0; i < 3 * size_t(V); ++i)
+    out_of_range |= cu[i] + uint64_t(kMaxCoarse) > 2 * uint64_t(kMaxCoarse);
   if (T > 0 && max_index >= p.index_end)
     throw Error(where + ": index " + std::to_string(max_index) + " out of range");
   if (out_of_range) throw Error(where + ": predicted position out of the grid's range");
@@ -324,7 +341,7 @@ DecodedNode PredictiveCodec::decode(std::span<const uint8_t> bytes, const Positi
   if (p.flags & kHasNormals) {
     thread_local std::vector<glm::vec3> sum;
     thread_local std::vector<int32_t> normal_residual;
-    predicted_normals(m.indices, p.first_vertex, m.positions.data(), V, sum);
+    predicted_normals(m.indices, p.first_vertex, p.index_end, m.positions.data(), V, sum);
     normal_residual.resize(2 * size_t(V));
     read_planes(p.normal_planes.data(), V, 2, p.normal_bytes, normal_residual.data());
     m.normals.resize(V);
@@ -333,8 +350,8 @@ DecodedNode PredictiveCodec::decode(std::span<const uint8_t> bytes, const Positi
     for (uint32_t v = 0; v < V; ++v) {
       const glm::ivec2 guess = oct_encode(sum[v], bits);
       // oct_decode clamps; residuals of a valid node are below 2^17, hostile ones are clamped first.
-      const int x = guess.x + std::clamp(normal_residual[2 * size_t(v)], -(1 << 18), 1 << 18);
-      const int y = guess.y + std::clamp(normal_residual[2 * size_t(v) + 1], -(1 << 18), 1 << 18);
+      const int x = guess.x + std::clamp(normal_residual[v], -(1 << 18), 1 << 18);
+      const int y = guess.y + std::clamp(normal_residual[size_t(V) + v], -(1 << 18), 1 << 18);
       m.normals[v] = oct_decode(x, y, inv_scale);
     }
   }
