@@ -10,24 +10,110 @@ namespace lodstream::hierarchy {
 
 namespace {
 
-// Meshlets of the triangles `indices` (a run of the spatial order) over `positions`, appended to `parts`.
-void build_meshlets(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
-                    size_t max_vertices, size_t max_triangles, std::vector<ClusterPart>& parts) {
-  const size_t bound = meshopt_buildMeshletsBound(indices.size(), max_vertices, max_triangles);
-  std::vector<meshopt_Meshlet> meshlets(bound);
-  std::vector<unsigned int> meshlet_vertices(bound * max_vertices);
-  std::vector<unsigned char> meshlet_triangles(bound * max_triangles * 3);
-  // cone_weight 0: clusters are grouped for simplification, not for backface culling.
-  const size_t count = meshopt_buildMeshlets(
-      meshlets.data(), meshlet_vertices.data(), meshlet_triangles.data(), indices.data(), indices.size(),
-      &positions[0].x, positions.size(), sizeof(glm::vec3), max_vertices, max_triangles, 0.0f);
-  for (size_t m = 0; m < count; ++m) {
-    const meshopt_Meshlet& ml = meshlets[m];
+// Greedy region growing over shared vertices (the rule of meshoptimizer's meshlet builder, without its
+// k-d tree and per-step rescan of the cluster's vertices): a cluster starts at the first unused triangle of
+// the spatial order and repeatedly takes, among the unused triangles touching its vertices (its frontier),
+// the one that adds the fewest new vertices, ties to the one nearest the cluster's centroid; it closes at
+// `max_triangles`, or when no frontier triangle fits `max_vertices`, and when its frontier runs dry (a
+// component used up) it continues from the next unused triangle of the spatial order, which is near.
+// `indices` are over `positions` (a run of the spatial order, compact vertex numbers); clusters are
+// appended to `parts`. Cost: O(T * frontier) with a frontier of a few dozen triangles; memory O(V + T).
+void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
+                   size_t max_vertices, size_t max_triangles, std::vector<ClusterPart>& parts) {
+  const size_t triangles = indices.size() / 3, vertices = positions.size();
+  // Vertex -> triangles (CSR).
+  std::vector<uint32_t> offsets(vertices + 1, 0), adjacent(indices.size());
+  for (uint32_t v : indices) ++offsets[v + 1];
+  for (size_t v = 0; v < vertices; ++v) offsets[v + 1] += offsets[v];
+  {
+    std::vector<uint32_t> fill(offsets.begin(), offsets.end() - 1);
+    for (size_t c = 0; c < indices.size(); ++c) adjacent[fill[indices[c]]++] = uint32_t(c / 3);
+  }
+  std::vector<glm::vec3> centroid(triangles);
+  for (size_t t = 0; t < triangles; ++t)
+    centroid[t] =
+        (positions[indices[3 * t]] + positions[indices[3 * t + 1]] + positions[indices[3 * t + 2]]) *
+        (1.0f / 3.0f);
+
+  constexpr uint32_t kUnset = UINT32_MAX;
+  std::vector<uint8_t> used(triangles, 0), shared(triangles, 0);  // shared: corners already in the cluster
+  std::vector<uint32_t> remaining(vertices, 0);                   // unused triangles at each vertex
+  for (uint32_t v : indices) ++remaining[v];
+  std::vector<uint32_t> local(vertices, kUnset);  // vertex -> cluster vertex number, current cluster only
+  std::vector<uint32_t> in_frontier(triangles, kUnset);  // the cluster that listed it
+  std::vector<uint32_t> frontier;
+  size_t cursor = 0;  // every triangle before it is used
+  for (uint32_t cluster = 0;; ++cluster) {
+    while (cursor < triangles && used[cursor]) ++cursor;
+    if (cursor == triangles) break;
     ClusterPart& part = parts.emplace_back();
-    part.vertices.assign(meshlet_vertices.begin() + ml.vertex_offset,
-                         meshlet_vertices.begin() + ml.vertex_offset + ml.vertex_count);
-    part.indices.assign(meshlet_triangles.begin() + ml.triangle_offset,
-                        meshlet_triangles.begin() + ml.triangle_offset + ml.triangle_count * 3);
+    frontier.clear();
+    glm::vec3 sum(0.0f);
+    auto new_vertices = [&](uint32_t t) {
+      const uint32_t* c = &indices[3 * size_t(t)];
+      return size_t(local[c[0]] == kUnset) + size_t(local[c[1]] == kUnset && c[1] != c[0]) +
+             size_t(local[c[2]] == kUnset && c[2] != c[0] && c[2] != c[1]);
+    };
+    auto add = [&](uint32_t t) {
+      used[t] = 1;
+      sum += centroid[t];
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t v = indices[3 * size_t(t) + k];
+        --remaining[v];
+        if (local[v] == kUnset) {
+          local[v] = uint32_t(part.vertices.size());
+          part.vertices.push_back(v);
+          for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) {
+            const uint32_t n = adjacent[s];
+            if (used[n]) continue;
+            if (in_frontier[n] != cluster) in_frontier[n] = cluster, shared[n] = 0, frontier.push_back(n);
+            ++shared[n];
+          }
+        }
+        part.indices.push_back(local[v]);
+      }
+    };
+    add(uint32_t(cursor));
+    while (part.indices.size() < 3 * max_triangles) {
+      const glm::vec3 center = sum / float(part.indices.size() / 3);
+      // Priority (lower first): adds no vertex; is the last unused triangle of one of its vertices (left out,
+      // it would start a ragged cluster later); adds 1, 2 vertices. Ties: nearest the centroid.
+      uint32_t best = kUnset, best_priority = UINT32_MAX;
+      float best_distance = 0.0f;
+      size_t kept = 0;
+      for (uint32_t t : frontier) {  // drops used entries while scanning
+        if (used[t]) continue;
+        frontier[kept++] = t;
+        const size_t added = new_vertices(t);
+        if (part.vertices.size() + added > max_vertices) continue;
+        const uint32_t* c = &indices[3 * size_t(t)];
+        const bool last = remaining[c[0]] == 1 || remaining[c[1]] == 1 || remaining[c[2]] == 1;
+        const uint32_t priority = added == 0 ? 0 : (last ? 1 : uint32_t(added) + 1);
+        if (priority > best_priority) continue;
+        const glm::vec3 d = centroid[t] - center;
+        const float distance = glm::dot(d, d);
+        if (priority < best_priority || distance < best_distance)
+          best = t, best_priority = priority, best_distance = distance;
+      }
+      frontier.resize(kept);
+      if (best == kUnset) {
+        if (!frontier.empty()) break;
+        // The component is used up: continue with the unused triangle nearest the centroid among the next
+        // kJumpWindow of the spatial order (which are near each other).
+        constexpr size_t kJumpWindow = 64;
+        while (cursor < triangles && used[cursor]) ++cursor;
+        for (size_t t = cursor, seen = 0; t < triangles && seen < kJumpWindow; ++t) {
+          if (used[t]) continue;
+          ++seen;
+          const glm::vec3 d = centroid[t] - center;
+          if (best == kUnset || glm::dot(d, d) < best_distance)
+            best = uint32_t(t), best_distance = glm::dot(d, d);
+        }
+        if (best == kUnset || part.vertices.size() + new_vertices(best) > max_vertices) break;
+      }
+      add(best);
+    }
+    for (uint32_t v : part.vertices) local[v] = kUnset;
   }
 }
 
@@ -41,7 +127,7 @@ std::vector<ClusterPart> clusterize(const Mesh& mesh, size_t max_vertices, size_
                                mesh.positions.size(), sizeof(glm::vec3));
   const size_t chunk_indices = 3 * kChunkClusters * max_triangles;
   if (sorted.size() <= chunk_indices) {
-    build_meshlets(mesh.positions, sorted, max_vertices, max_triangles, parts);
+    grow_clusters(mesh.positions, sorted, max_vertices, max_triangles, parts);
     return parts;
   }
   // Runs of the spatial order in parallel, each over its own compact vertex range (the meshlet builder's
@@ -64,7 +150,7 @@ std::vector<ClusterPart> clusterize(const Mesh& mesh, size_t max_vertices, size_
       positions[v] = mesh.positions[local_to_mesh[v]];
       local_of[local_to_mesh[v]] = UINT32_MAX;
     }
-    build_meshlets(positions, indices, max_vertices, max_triangles, chunk_parts[c]);
+    grow_clusters(positions, indices, max_vertices, max_triangles, chunk_parts[c]);
     for (ClusterPart& part : chunk_parts[c])
       for (uint32_t& v : part.vertices) v = local_to_mesh[v];
   });
