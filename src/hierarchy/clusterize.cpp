@@ -21,53 +21,66 @@ namespace {
 void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
                    size_t max_vertices, size_t max_triangles, std::vector<ClusterPart>& parts) {
   const size_t triangles = indices.size() / 3, vertices = positions.size();
-  // Vertex -> triangles (CSR).
-  std::vector<uint32_t> offsets(vertices + 1, 0), adjacent(indices.size());
-  for (uint32_t v : indices) ++offsets[v + 1];
+  // Corner k of triangle t counts unless it repeats an earlier corner (degenerate input).
+  auto distinct = [&](size_t t, int k) {
+    const uint32_t* c = &indices[3 * t];
+    return k == 0 || (c[k] != c[0] && (k == 1 || c[2] != c[1]));
+  };
+  // Vertex -> triangles (CSR), and per vertex its unused triangles.
+  std::vector<uint32_t> offsets(vertices + 1, 0), adjacent(indices.size()), remaining(vertices, 0);
+  for (size_t t = 0; t < triangles; ++t)
+    for (int k = 0; k < 3; ++k)
+      if (distinct(t, k)) ++offsets[indices[3 * t + k] + 1], ++remaining[indices[3 * t + k]];
   for (size_t v = 0; v < vertices; ++v) offsets[v + 1] += offsets[v];
   {
     std::vector<uint32_t> fill(offsets.begin(), offsets.end() - 1);
-    for (size_t c = 0; c < indices.size(); ++c) adjacent[fill[indices[c]]++] = uint32_t(c / 3);
+    for (size_t t = 0; t < triangles; ++t)
+      for (int k = 0; k < 3; ++k)
+        if (distinct(t, k)) adjacent[fill[indices[3 * t + k]]++] = uint32_t(t);
   }
+  // Per triangle: used, its distinct corners, corners already in the current cluster (valid while listed in
+  // its frontier), and whether it is the last unused triangle of one of its vertices.
+  struct State {
+    uint8_t used = 0, corners = 0, shared = 0, last = 0;
+  };
+  std::vector<State> state(triangles);
   std::vector<glm::vec3> centroid(triangles);
-  for (size_t t = 0; t < triangles; ++t)
-    centroid[t] =
-        (positions[indices[3 * t]] + positions[indices[3 * t + 1]] + positions[indices[3 * t + 2]]) *
-        (1.0f / 3.0f);
+  for (size_t t = 0; t < triangles; ++t) {
+    const uint32_t* c = &indices[3 * t];
+    centroid[t] = (positions[c[0]] + positions[c[1]] + positions[c[2]]) * (1.0f / 3.0f);
+    for (int k = 0; k < 3; ++k)
+      if (distinct(t, k)) ++state[t].corners, state[t].last |= remaining[c[k]] == 1;
+  }
 
   constexpr uint32_t kUnset = UINT32_MAX;
-  std::vector<uint8_t> used(triangles, 0), shared(triangles, 0);  // shared: corners already in the cluster
-  std::vector<uint32_t> remaining(vertices, 0);                   // unused triangles at each vertex
-  for (uint32_t v : indices) ++remaining[v];
   std::vector<uint32_t> local(vertices, kUnset);  // vertex -> cluster vertex number, current cluster only
   std::vector<uint32_t> in_frontier(triangles, kUnset);  // the cluster that listed it
   std::vector<uint32_t> frontier;
   size_t cursor = 0;  // every triangle before it is used
   for (uint32_t cluster = 0;; ++cluster) {
-    while (cursor < triangles && used[cursor]) ++cursor;
+    while (cursor < triangles && state[cursor].used) ++cursor;
     if (cursor == triangles) break;
     ClusterPart& part = parts.emplace_back();
     frontier.clear();
     glm::vec3 sum(0.0f);
-    auto new_vertices = [&](uint32_t t) {
-      const uint32_t* c = &indices[3 * size_t(t)];
-      return size_t(local[c[0]] == kUnset) + size_t(local[c[1]] == kUnset && c[1] != c[0]) +
-             size_t(local[c[2]] == kUnset && c[2] != c[0] && c[2] != c[1]);
-    };
     auto add = [&](uint32_t t) {
-      used[t] = 1;
+      state[t].used = 1;
       sum += centroid[t];
       for (int k = 0; k < 3; ++k) {
         const uint32_t v = indices[3 * size_t(t) + k];
-        --remaining[v];
-        if (local[v] == kUnset) {
-          local[v] = uint32_t(part.vertices.size());
-          part.vertices.push_back(v);
-          for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) {
-            const uint32_t n = adjacent[s];
-            if (used[n]) continue;
-            if (in_frontier[n] != cluster) in_frontier[n] = cluster, shared[n] = 0, frontier.push_back(n);
-            ++shared[n];
+        if (distinct(t, k)) {
+          if (--remaining[v] == 1)
+            for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) state[adjacent[s]].last = 1;
+          if (local[v] == kUnset) {
+            local[v] = uint32_t(part.vertices.size());
+            part.vertices.push_back(v);
+            for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) {
+              const uint32_t n = adjacent[s];
+              if (state[n].used) continue;
+              if (in_frontier[n] != cluster)
+                in_frontier[n] = cluster, state[n].shared = 0, frontier.push_back(n);
+              ++state[n].shared;
+            }
           }
         }
         part.indices.push_back(local[v]);
@@ -76,19 +89,25 @@ void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_
     add(uint32_t(cursor));
     while (part.indices.size() < 3 * max_triangles) {
       const glm::vec3 center = sum / float(part.indices.size() / 3);
-      // Priority (lower first): adds no vertex; is the last unused triangle of one of its vertices (left out,
+      // Priority (lower first): adds no vertex (the first such is taken: it lies within the cluster's
+      // vertices, so which one matters little); is the last unused triangle of one of its vertices (left out,
       // it would start a ragged cluster later); adds 1, 2 vertices. Ties: nearest the centroid.
       uint32_t best = kUnset, best_priority = UINT32_MAX;
       float best_distance = 0.0f;
       size_t kept = 0;
-      for (uint32_t t : frontier) {  // drops used entries while scanning
-        if (used[t]) continue;
+      for (size_t i = 0; i < frontier.size(); ++i) {  // drops used entries while scanning
+        const uint32_t t = frontier[i];
+        const State st = state[t];
+        if (st.used) continue;
         frontier[kept++] = t;
-        const size_t added = new_vertices(t);
+        const size_t added = size_t(st.corners - st.shared);
+        if (added == 0) {
+          best = t;
+          while (++i < frontier.size()) frontier[kept++] = frontier[i];
+          break;
+        }
         if (part.vertices.size() + added > max_vertices) continue;
-        const uint32_t* c = &indices[3 * size_t(t)];
-        const bool last = remaining[c[0]] == 1 || remaining[c[1]] == 1 || remaining[c[2]] == 1;
-        const uint32_t priority = added == 0 ? 0 : (last ? 1 : uint32_t(added) + 1);
+        const uint32_t priority = st.last ? 1 : uint32_t(added) + 1;
         if (priority > best_priority) continue;
         const glm::vec3 d = centroid[t] - center;
         const float distance = glm::dot(d, d);
@@ -98,18 +117,18 @@ void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_
       frontier.resize(kept);
       if (best == kUnset) {
         if (!frontier.empty()) break;
-        // The component is used up: continue with the unused triangle nearest the centroid among the next
-        // kJumpWindow of the spatial order (which are near each other).
+        // The component is used up (no unused triangle touches the cluster): continue with the unused
+        // triangle nearest the centroid among the next kJumpWindow of the spatial order (near each other).
         constexpr size_t kJumpWindow = 64;
-        while (cursor < triangles && used[cursor]) ++cursor;
+        while (cursor < triangles && state[cursor].used) ++cursor;
         for (size_t t = cursor, seen = 0; t < triangles && seen < kJumpWindow; ++t) {
-          if (used[t]) continue;
+          if (state[t].used) continue;
           ++seen;
           const glm::vec3 d = centroid[t] - center;
           if (best == kUnset || glm::dot(d, d) < best_distance)
             best = uint32_t(t), best_distance = glm::dot(d, d);
         }
-        if (best == kUnset || part.vertices.size() + new_vertices(best) > max_vertices) break;
+        if (best == kUnset || part.vertices.size() + state[best].corners > max_vertices) break;
       }
       add(best);
     }
