@@ -10,24 +10,129 @@ namespace lodstream::hierarchy {
 
 namespace {
 
-// Meshlets of the triangles `indices` (a run of the spatial order) over `positions`, appended to `parts`.
-void build_meshlets(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
-                    size_t max_vertices, size_t max_triangles, std::vector<ClusterPart>& parts) {
-  const size_t bound = meshopt_buildMeshletsBound(indices.size(), max_vertices, max_triangles);
-  std::vector<meshopt_Meshlet> meshlets(bound);
-  std::vector<unsigned int> meshlet_vertices(bound * max_vertices);
-  std::vector<unsigned char> meshlet_triangles(bound * max_triangles * 3);
-  // cone_weight 0: clusters are grouped for simplification, not for backface culling.
-  const size_t count = meshopt_buildMeshlets(
-      meshlets.data(), meshlet_vertices.data(), meshlet_triangles.data(), indices.data(), indices.size(),
-      &positions[0].x, positions.size(), sizeof(glm::vec3), max_vertices, max_triangles, 0.0f);
-  for (size_t m = 0; m < count; ++m) {
-    const meshopt_Meshlet& ml = meshlets[m];
+// Greedy region growing over shared vertices (the rule of meshoptimizer's meshlet builder, without its
+// k-d tree and per-step rescan of the cluster's vertices): a cluster starts at the first unused triangle of
+// the spatial order and repeatedly takes, among the unused triangles touching its vertices (its frontier),
+// the one that adds the fewest new vertices, ties to the one nearest the cluster's centroid; it closes at
+// `max_triangles`, or when no frontier triangle fits `max_vertices`, and when its frontier runs dry (a
+// component used up) it continues from the next unused triangle of the spatial order, which is near.
+// `indices` are over `positions` (a run of the spatial order, compact vertex numbers); clusters are
+// appended to `parts`. Cost: O(T * frontier) with a frontier of a few dozen triangles; memory O(V + T).
+void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
+                   size_t max_vertices, size_t max_triangles, std::vector<ClusterPart>& parts) {
+  const size_t triangles = indices.size() / 3, vertices = positions.size();
+  // Corner k of triangle t counts unless it repeats an earlier corner (degenerate input).
+  auto distinct = [&](size_t t, int k) {
+    const uint32_t* c = &indices[3 * t];
+    return k == 0 || (c[k] != c[0] && (k == 1 || c[2] != c[1]));
+  };
+  // Vertex -> triangles (CSR), and per vertex its unused triangles.
+  std::vector<uint32_t> offsets(vertices + 1, 0), adjacent(indices.size()), remaining(vertices, 0);
+  for (size_t t = 0; t < triangles; ++t)
+    for (int k = 0; k < 3; ++k)
+      if (distinct(t, k)) ++offsets[indices[3 * t + k] + 1], ++remaining[indices[3 * t + k]];
+  for (size_t v = 0; v < vertices; ++v) offsets[v + 1] += offsets[v];
+  {
+    std::vector<uint32_t> fill(offsets.begin(), offsets.end() - 1);
+    for (size_t t = 0; t < triangles; ++t)
+      for (int k = 0; k < 3; ++k)
+        if (distinct(t, k)) adjacent[fill[indices[3 * t + k]]++] = uint32_t(t);
+  }
+  // Per triangle: used, its distinct corners, corners already in the current cluster (valid while listed in
+  // its frontier), and whether it is the last unused triangle of one of its vertices.
+  struct State {
+    uint8_t used = 0, corners = 0, shared = 0, last = 0;
+  };
+  std::vector<State> state(triangles);
+  std::vector<glm::vec3> centroid(triangles);
+  for (size_t t = 0; t < triangles; ++t) {
+    const uint32_t* c = &indices[3 * t];
+    centroid[t] = (positions[c[0]] + positions[c[1]] + positions[c[2]]) * (1.0f / 3.0f);
+    for (int k = 0; k < 3; ++k)
+      if (distinct(t, k)) ++state[t].corners, state[t].last |= remaining[c[k]] == 1;
+  }
+
+  constexpr uint32_t kUnset = UINT32_MAX;
+  std::vector<uint32_t> local(vertices, kUnset);  // vertex -> cluster vertex number, current cluster only
+  std::vector<uint32_t> in_frontier(triangles, kUnset);  // the cluster that listed it
+  std::vector<uint32_t> frontier;
+  size_t cursor = 0;  // every triangle before it is used
+  for (uint32_t cluster = 0;; ++cluster) {
+    while (cursor < triangles && state[cursor].used) ++cursor;
+    if (cursor == triangles) break;
     ClusterPart& part = parts.emplace_back();
-    part.vertices.assign(meshlet_vertices.begin() + ml.vertex_offset,
-                         meshlet_vertices.begin() + ml.vertex_offset + ml.vertex_count);
-    part.indices.assign(meshlet_triangles.begin() + ml.triangle_offset,
-                        meshlet_triangles.begin() + ml.triangle_offset + ml.triangle_count * 3);
+    frontier.clear();
+    glm::vec3 sum(0.0f);
+    auto add = [&](uint32_t t) {
+      state[t].used = 1;
+      sum += centroid[t];
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t v = indices[3 * size_t(t) + k];
+        if (distinct(t, k)) {
+          if (--remaining[v] == 1)
+            for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) state[adjacent[s]].last = 1;
+          if (local[v] == kUnset) {
+            local[v] = uint32_t(part.vertices.size());
+            part.vertices.push_back(v);
+            for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) {
+              const uint32_t n = adjacent[s];
+              if (state[n].used) continue;
+              if (in_frontier[n] != cluster)
+                in_frontier[n] = cluster, state[n].shared = 0, frontier.push_back(n);
+              ++state[n].shared;
+            }
+          }
+        }
+        part.indices.push_back(local[v]);
+      }
+    };
+    add(uint32_t(cursor));
+    while (part.indices.size() < 3 * max_triangles) {
+      const glm::vec3 center = sum / float(part.indices.size() / 3);
+      // Priority (lower first): adds no vertex (the first such is taken: it lies within the cluster's
+      // vertices, so which one matters little); is the last unused triangle of one of its vertices (left out,
+      // it would start a ragged cluster later); adds 1, 2 vertices. Ties: nearest the centroid.
+      uint32_t best = kUnset, best_priority = UINT32_MAX;
+      float best_distance = 0.0f;
+      size_t kept = 0;
+      for (size_t i = 0; i < frontier.size(); ++i) {  // drops used entries while scanning
+        const uint32_t t = frontier[i];
+        const State st = state[t];
+        if (st.used) continue;
+        frontier[kept++] = t;
+        const size_t added = size_t(st.corners - st.shared);
+        if (added == 0) {
+          best = t;
+          while (++i < frontier.size()) frontier[kept++] = frontier[i];
+          break;
+        }
+        if (part.vertices.size() + added > max_vertices) continue;
+        const uint32_t priority = st.last ? 1 : uint32_t(added) + 1;
+        if (priority > best_priority) continue;
+        const glm::vec3 d = centroid[t] - center;
+        const float distance = glm::dot(d, d);
+        if (priority < best_priority || distance < best_distance)
+          best = t, best_priority = priority, best_distance = distance;
+      }
+      frontier.resize(kept);
+      if (best == kUnset) {
+        if (!frontier.empty()) break;
+        // The component is used up (no unused triangle touches the cluster): continue with the unused
+        // triangle nearest the centroid among the next kJumpWindow of the spatial order (near each other).
+        constexpr size_t kJumpWindow = 64;
+        while (cursor < triangles && state[cursor].used) ++cursor;
+        for (size_t t = cursor, seen = 0; t < triangles && seen < kJumpWindow; ++t) {
+          if (state[t].used) continue;
+          ++seen;
+          const glm::vec3 d = centroid[t] - center;
+          if (best == kUnset || glm::dot(d, d) < best_distance)
+            best = uint32_t(t), best_distance = glm::dot(d, d);
+        }
+        if (best == kUnset || part.vertices.size() + state[best].corners > max_vertices) break;
+      }
+      add(best);
+    }
+    for (uint32_t v : part.vertices) local[v] = kUnset;
   }
 }
 
@@ -41,7 +146,7 @@ std::vector<ClusterPart> clusterize(const Mesh& mesh, size_t max_vertices, size_
                                mesh.positions.size(), sizeof(glm::vec3));
   const size_t chunk_indices = 3 * kChunkClusters * max_triangles;
   if (sorted.size() <= chunk_indices) {
-    build_meshlets(mesh.positions, sorted, max_vertices, max_triangles, parts);
+    grow_clusters(mesh.positions, sorted, max_vertices, max_triangles, parts);
     return parts;
   }
   // Runs of the spatial order in parallel, each over its own compact vertex range (the meshlet builder's
@@ -64,7 +169,7 @@ std::vector<ClusterPart> clusterize(const Mesh& mesh, size_t max_vertices, size_
       positions[v] = mesh.positions[local_to_mesh[v]];
       local_of[local_to_mesh[v]] = UINT32_MAX;
     }
-    build_meshlets(positions, indices, max_vertices, max_triangles, chunk_parts[c]);
+    grow_clusters(positions, indices, max_vertices, max_triangles, chunk_parts[c]);
     for (ClusterPart& part : chunk_parts[c])
       for (uint32_t& v : part.vertices) v = local_to_mesh[v];
   });

@@ -1,5 +1,6 @@
 #include "package/writer.hpp"
 
+#include <tbb/parallel_for.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -57,7 +58,8 @@ void PackageWriter::place(size_t first, size_t end) {
   for (size_t i = first; i < end; ++i) {
     const Entry& e = group_[i];
     if (!page_.empty() && page_.size() + e.size > options_.page_bytes) flush_page();
-    locations_[e.id] = {uint32_t(pages_.size()), uint32_t(page_.size()), uint32_t(e.size), true};
+    locations_[e.id] = {uint32_t(pages_.size() + pending_.size()), uint32_t(page_.size()), uint32_t(e.size),
+                        true};
     page_.insert(page_.end(), group_bytes_.begin() + e.offset, group_bytes_.begin() + e.offset + e.size);
   }
 }
@@ -75,10 +77,20 @@ void PackageWriter::end_group() {
 
 void PackageWriter::flush_page() {
   if (page_.empty()) return;
-  std::vector<uint8_t> stored = zstd_compress(page_, options_.zstd_level);
-  pages_.push_back(write_stored(stored, uint32_t(page_.size())));
-  page_bytes_ += stored.size();
-  page_.clear();
+  pending_.push_back(std::move(page_));
+  page_ = {};
+  if (pending_.size() >= kPendingPages) write_pending();
+}
+
+void PackageWriter::write_pending() {
+  std::vector<std::vector<uint8_t>> stored(pending_.size());
+  tbb::parallel_for(size_t(0), pending_.size(),
+                    [&](size_t i) { stored[i] = zstd_compress(pending_[i], options_.zstd_level); });
+  for (size_t i = 0; i < pending_.size(); ++i) {
+    pages_.push_back(write_stored(stored[i], uint32_t(pending_[i].size())));
+    page_bytes_ += stored[i].size();
+  }
+  pending_.clear();
 }
 
 uint32_t PackageWriter::add_blob(std::span<const uint8_t> bytes) {
@@ -90,6 +102,7 @@ WrittenPackage PackageWriter::finish(PackageScene scene, std::vector<NodeRecord>
   if (!out_) throw Error(file_.string() + ": package already finished");
   end_group();
   flush_page();
+  write_pending();
   const std::string name = file_.string();
   if (nodes.size() > UINT32_MAX - 1) throw Error(name + ": too many nodes");
   if (locations_.size() > nodes.size()) {

@@ -1,11 +1,12 @@
 // PackageWriter: streams nodes' encoded bytes into zstd-compressed data pages of a new .lods file, then
-// writes the index pages, the root index and the header, and renames the file into place. Until finish()
-// returns, only a temporary file next to the target exists (removed by the destructor if finish() was not
-// reached), so an interrupted bake never leaves a broken package.
+// writes the index pages, the root index and the header, and renames the file into place. Pages are
+// compressed 16 at a time in parallel (TBB). Until finish() returns, only a temporary file next to the target
+// exists (removed by the destructor if finish() was not reached), so an interrupted bake never leaves a
+// broken package.
 //
 // Page packing follows the caller: nodes added between two end_group() calls form a group (a DAG group's
 // clusters, a subtree's coarse levels); groups are appended in call order and a page is closed before a group
-// that would overflow it, so a group is split only when it alone exceeds the page size. Memory: one page and
+// that would overflow it, so a group is split only when it alone exceeds the page size. Memory: 17 pages and
 // one group of encoded bytes, plus the node records given to finish() — never the whole geometry.
 //
 // Typical use (encoding may run in parallel; adding is serial):
@@ -71,7 +72,8 @@ class PackageWriter {
 
  private:
   void place(size_t first, size_t end);  // moves group entries [first, end) into the current page
-  void flush_page();
+  void flush_page();                     // closes the current page: queued, compressed with the next ones
+  void write_pending();                  // compresses the queued pages in parallel and writes them in order
   Range write_stored(std::span<const uint8_t> bytes, uint32_t raw_size);
   void write(std::span<const uint8_t> bytes, bool hashed);
 
@@ -92,6 +94,10 @@ class PackageWriter {
   std::vector<uint8_t> group_bytes_;
   std::vector<Entry> group_;
   std::vector<uint8_t> page_;
+  // Closed pages not yet compressed: kPendingPages at a time are compressed on every core (zstd was a serial
+  // 3 % of an elephant_1m bake), then written in page order, so the bytes do not depend on thread timing.
+  static constexpr size_t kPendingPages = 16;
+  std::vector<std::vector<uint8_t>> pending_;
   std::vector<Location> locations_;  // by node id
   std::vector<Range> pages_, blobs_;
   uint64_t page_bytes_ = 0;
