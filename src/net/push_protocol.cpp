@@ -97,6 +97,7 @@ std::optional<wire::Message> PushProtocol::on_message(const wire::Message& messa
 }
 
 uint64_t PushProtocol::window_bytes() const {
+  if (!link_.measured()) return std::max(options_.initial_window_bytes, options_.min_window_bytes);
   return uint64_t(std::max(options_.window_bdp * link_.bdp_bytes(), double(options_.min_window_bytes)));
 }
 
@@ -116,7 +117,10 @@ void PushProtocol::plan(double now_s, uint64_t bytes) {
                             {options_.tau, bytes, SIZE_MAX, triangle_budget_});
     planned_view_s_ = view_->time_s;
   }
-  if (pages.empty() && options_.fill_when_idle) {
+  // No fill before the first view: the view follows the hello within a message, and a window filled in file
+  // order before it delays the view's pages by a round trip (motorBike, 10 Mbit/s: 80 KB of index pages that
+  // the view's cut needs only part of went first).
+  if (pages.empty() && options_.fill_when_idle && view_) {
     // The rest in file order, index pages first, while the client's cache has room for the data pages
     // (decompressed, as it holds them; index pages are not in its cache), never a page it released.
     uint64_t room = cache_budget_ > held_bytes_ ? cache_budget_ - held_bytes_ : 0;

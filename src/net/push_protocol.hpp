@@ -11,12 +11,13 @@
 // (Hello's held runs, when its hash is this package's) or was sent and not released since (a Released
 // message: the client's cache evicted it). At most `window_bdp` estimated
 // bandwidth-delay products (schedule::LinkEstimator, fed by the acknowledgements) are in flight, at least
-// `min_window_bytes`; so what waits, waits here, where a new view re-orders it: the plan is dropped on a
-// ViewUpdate at least `replan_interval_s` (client time) after the view it was made from, and re-made from the
-// new prediction. A plan covers `plan_windows` windows, so that acknowledgements do not each cost a plan (one
-// cut per predicted view: on a 5.7M-triangle package through a 10 Mbit/s link, a plan per acknowledgement and
-// per view update kept the server's core busy and the link a fifth used). When the scheduler has nothing to
-// send (no view yet, or every predicted view's ideal cut sent) and `fill_when_idle` is set, the rest of the
+// `min_window_bytes` (`initial_window_bytes` before the first acknowledgement); so what waits, waits here,
+// where a new view re-orders it: the plan is dropped on a ViewUpdate at least `replan_interval_s` (client
+// time) after the view it was made from, and re-made from the new prediction. A plan covers `plan_windows`
+// windows, so that acknowledgements do not each cost a plan (one cut per predicted view: on a 5.7M-triangle
+// package through a 10 Mbit/s link, a plan per acknowledgement and per view update kept the server's core
+// busy and the link a fifth used). Nothing is sent before the first ViewUpdate. When the scheduler has
+// nothing to send (every predicted view's ideal cut sent) and `fill_when_idle` is set, the rest of the
 // package follows in file order (index pages first), up to the client's cache budget: seed 003's "coffee
 // break". The planned cuts keep to the triangles the client's cache budget affords
 // (schedule/cache_budget.hpp). Pages the client released are sent again only when the scheduler picks them
@@ -55,9 +56,15 @@ struct PushPackage {
 
 struct PushProtocolOptions {
   double ack_timeout_s = 30.0;          // pages in flight and nothing acknowledged for this long: the end
-  size_t min_window_bytes = 64 * 1024;  // in flight at least this much (before the first estimates)
-  double window_bdp = 2.0;              // in flight at most this many bandwidth-delay products
-  double tau = 1.0;                     // target pixel error of the client's cut
+  size_t min_window_bytes = 64 * 1024;  // in flight at least this much
+  // In flight at most this much until the first acknowledgement measures the link (then window_bdp
+  // estimated bandwidth-delay products, which about double per round trip while the window is the limit, as
+  // TCP's slow start). Measured on motorBike, gen:fly: at 10 Mbit/s 80 ms (2 BDP = 200 KB) 64 KiB left push
+  // 120 KB behind the oracle at 1 s (to 0.95 in 1.67 s, AUC 0.952), 128 KiB 1.63 s / 0.954, 192 KiB 1.60 s /
+  // 0.955; at 2 Mbit/s 150 ms (2 BDP = 75 KB) AUC 0.769 / 0.770 / 0.770: the first window only delays.
+  size_t initial_window_bytes = 192 * 1024;
+  double window_bdp = 2.0;  // in flight at most this many bandwidth-delay products
+  double tau = 1.0;         // target pixel error of the client's cut
   schedule::PredictionHorizons horizons;
   bool fill_when_idle = true;
   double replan_interval_s = 0.1;  // a new view drops the plan when its sample is at least this much newer

@@ -38,6 +38,9 @@ class LinkEstimator {
   // Unknown or already acknowledged sequences are ignored.
   void on_ack(uint32_t sequence, double now_s);
 
+  // Whether an acknowledgement has given a bandwidth sample yet (before it, bandwidth_bps() is the initial
+  // guess).
+  bool measured() const { return !bandwidth_samples_.empty(); }
   double bandwidth_bps() const;  // bits per second
   double rtt_s() const;
   // Bandwidth-delay product in bytes: what should be in flight to keep the path busy and no more.

@@ -94,12 +94,25 @@ wire::Hello hello(const std::string& name) {
   return h;
 }
 
+// A view update (the server sends nothing before the first one): the idle fill then sends the rest.
+wire::ViewUpdate a_view() {
+  wire::ViewUpdate v;
+  v.eye = {0.0f, 0.0f, 5.0f};
+  v.forward = {0.0f, 0.0f, -1.0f};
+  v.up = {0.0f, 1.0f, 0.0f};
+  v.fov_y_radians = 1.0f;
+  v.viewport_width = 640;
+  v.viewport_height = 480;
+  return v;
+}
+
 TEST(PushSession, SendsEveryPageOnceWithTheStoredBytes) {
   PushServer s;
   const uint32_t page_count = uint32_t(s.reader->root().pages.size());
   ASSERT_GT(page_count, 5u);
   PushClient client(s.server.port(), "/scene");
   client.send(hello("scene"));
+  client.send(a_view());
   wire::Message m = client.receive();
   auto* welcome = std::get_if<wire::Welcome>(&m);
   ASSERT_NE(welcome, nullptr) << wire::type_name(m);
@@ -120,6 +133,7 @@ TEST(PushSession, NeverSendsWhatTheClientHolds) {
   h.cached_hash = s.written.content_hash;
   h.held = {{0, 2}, {4, 1}};  // pages 0, 1 and 4
   client.send(h);
+  client.send(a_view());
   ASSERT_TRUE(std::holds_alternative<wire::Welcome>(client.receive()));
   auto pages = client.receive_pages(page_count - 3);
   EXPECT_EQ(pages.count(0) + pages.count(1) + pages.count(4), 0u);
@@ -135,6 +149,7 @@ TEST(PushSession, HeldPagesOfAnotherPackageVersionAreIgnored) {
   h.cached_hash = {1, 2};  // not this package
   h.held = {{0, page_count}};
   client.send(h);
+  client.send(a_view());
   ASSERT_TRUE(std::holds_alternative<wire::Welcome>(client.receive()));
   EXPECT_EQ(client.receive_pages(page_count).size(), page_count);
   client.close();
@@ -145,6 +160,7 @@ TEST(PushSession, AMalformedMessageEndsOnlyThatSession) {
   const uint32_t page_count = uint32_t(s.reader->root().pages.size());
   PushClient good(s.server.port(), "/scene");
   good.send(hello("scene"));
+  good.send(a_view());
   ASSERT_TRUE(std::holds_alternative<wire::Welcome>(good.receive()));
   auto first = good.receive_pages(2);
 

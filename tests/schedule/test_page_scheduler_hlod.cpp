@@ -117,3 +117,49 @@ TEST(PageSchedulerHlod, ALeafsObjectsRootsAreSentTogether) {
   EXPECT_EQ(cut.drawn.size(), 4u);
   for (const DrawnNode& d : cut.drawn) EXPECT_NE(d.object, package::kNone);
 }
+
+// An object covered by HLOD is drawn only once its leaf proxy is refined, which needs the roots of every
+// object of the leaf (cut.hpp). So the finer levels of an object whose root the client holds wait until its
+// leaf's other roots are sent: before, they went first (they were cheap), and the client could draw none of
+// them (motorBike: 1 MB of objects' finer levels while the leaves waited for a few root pages).
+TEST(PageSchedulerHlod, AnObjectsFinerLevelsWaitForItsLeafsOtherRoots) {
+  HlodPackage h;
+  constexpr uint32_t kRoot0 = 3, kRoot1 = 4, kFine0 = 7;  // object 0's root is refined by kFine0, kFine0 + 1
+  h.records[kRoot0].error = 0.5f;
+  h.records[kRoot0].children = {kFine0, kFine0 + 1};
+  for (uint32_t i = 0; i < 2; ++i) {
+    package::NodeRecord r;
+    r.representation = 0;
+    r.triangles = 50;
+    r.error = 0.001f;
+    r.sphere = {glm::vec3(0.0f, i ? 0.4f : -0.4f, 0.0f), 0.5f};
+    r.parents = {kRoot0};
+    r.parent_error = h.records[kRoot0].error;
+    r.parent_sphere = h.records[kRoot0].sphere;
+    h.records.push_back(r);
+  }
+  // Object 1's root is expensive, object 0's finer levels cheap.
+  auto reader = test::write_package("hlod_fine.lods", h.records, h.scene, uint32_t(h.records.size()),
+                                    [](uint32_t i) { return i == kRoot1 ? 20000 : 100; });
+  PackageRecords all(reader);
+  PageScheduler s(reader.root());
+  for (uint32_t held : {kRoot, kLeafA, kLeafB, kRoot0}) s.set_held(PageKind::data, all.record(held)->page);
+  const View view = look({1.0f, 0.0f, 4.0f}, {1.0f, 0.0f, 0.0f});
+  const WeightedView views[] = {{view, 1.0, 0.0}};
+  std::vector<uint32_t> order;
+  for (int round = 0; round < 100; ++round) {
+    const auto pages = s.next(reader.scene(), all, views, {1.0, UINT64_MAX, 1});
+    if (pages.empty()) break;
+    for (const PageRef& p : pages) {
+      s.set_held(p.kind, p.id);
+      if (p.kind == PageKind::data) order.push_back(p.id);
+    }
+  }
+  auto at = [&](uint32_t node) {
+    return size_t(std::find(order.begin(), order.end(), all.record(node)->page) - order.begin());
+  };
+  ASSERT_LT(at(kRoot1), order.size());
+  ASSERT_LT(at(kFine0), order.size()) << "the view's ideal cut refines object 0";
+  EXPECT_LT(at(kRoot1), at(kFine0));
+  EXPECT_LT(at(kRoot1), at(kFine0 + 1));
+}
