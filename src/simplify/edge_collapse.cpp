@@ -210,6 +210,7 @@ class Simplifier {
       } while (w != first);
       weld_remap_[v] = same_attributes(source_[w], v) ? w : add_vertex(v, first);
     }
+    renumber_spatially();
     const size_t m = source_.size();
     kind_.assign(m, kManifold);
     touched_.assign(m, 1);  // every cost is evaluated in the first pass
@@ -228,6 +229,54 @@ class Simplifier {
       indices_.insert(indices_.end(), {a, b, c});
     }
     alive_triangles_ = indices_.size() / 3;
+    sort_faces();
+  }
+
+  // Renumbers the welded vertices in Morton (Z-curve) order of their positions, so that a collapse's
+  // neighbourhood lies in a few cache lines of every per-vertex array: the collapses come in cost order,
+  // which is random in space, and on a large mesh in input order most of their time went to cache misses
+  // (elephant_1m: 17-20 s -> 13.5 s, the same collapses up to ties). O(V log V).
+  void renumber_spatially() {
+    const size_t m = source_.size();
+    auto spread = [](uint64_t x) {  // bit i of x to bit 3i (21 bits)
+      x &= 0x1fffff;
+      x = (x | x << 32) & 0x1f00000000ffffull, x = (x | x << 16) & 0x1f0000ff0000ffull;
+      x = (x | x << 8) & 0x100f00f00f00f00full, x = (x | x << 4) & 0x10c30c30c30c30c3ull;
+      return (x | x << 2) & 0x1249249249249249ull;
+    };
+    std::vector<std::pair<uint64_t, uint32_t>> code(m);
+    for (uint32_t v = 0; v < m; ++v) {
+      const glm::vec3 q = glm::clamp(pos_[v], 0.0f, 1.0f) * 2097151.0f;  // pos_ is in [0, 1]^3
+      code[v] = {spread(uint64_t(q.x)) | spread(uint64_t(q.y)) << 1 | spread(uint64_t(q.z)) << 2, v};
+    }
+    std::sort(code.begin(), code.end());  // ties (wedges share a position) by old number
+    std::vector<uint32_t> renumbered(m);
+    for (uint32_t i = 0; i < m; ++i) renumbered[code[i].second] = i;
+    auto permute = [&](auto& values) {
+      if (values.size() != m) return;
+      auto old = values;
+      for (uint32_t i = 0; i < m; ++i) values[i] = old[code[i].second];
+    };
+    permute(source_), permute(pos_), permute(nrm_), permute(uv_), permute(col_), permute(wedge_),
+        permute(pid_);
+    for (uint32_t& v : wedge_) v = renumbered[v];
+    for (uint32_t& v : pid_) v = renumbered[v];
+    for (uint32_t& v : weld_remap_) v = renumbered[v];
+  }
+
+  // Orders the faces by their smallest vertex (counting sort, stable), for the same locality as
+  // renumber_spatially. O(V + T).
+  void sort_faces() {
+    const size_t m = source_.size(), n = indices_.size() / 3;
+    std::vector<uint32_t> start(m + 1, 0);
+    auto first = [&](size_t f) {
+      return std::min({indices_[3 * f], indices_[3 * f + 1], indices_[3 * f + 2]});
+    };
+    for (size_t f = 0; f < n; ++f) ++start[first(f) + 1];
+    for (size_t v = 0; v < m; ++v) start[v + 1] += start[v];
+    std::vector<uint32_t> sorted(indices_.size());
+    for (size_t f = 0; f < n; ++f) std::copy_n(&indices_[3 * f], 3, &sorted[3 * size_t(start[first(f)]++)]);
+    indices_.swap(sorted);
   }
 
   uint32_t add_vertex(uint32_t input, uint32_t ring) {
@@ -444,12 +493,24 @@ class Simplifier {
       for (int i = 0; i < 4; ++i) s[j++] = col_[v][i] * opt_.color_weight;
   }
 
-  // The origin of v's quadric and attribute terms: its input position (normalized), the same for all its
-  // wedges. Quadrics relative to a nearby origin keep their float terms small: relative to the model's
-  // corner, A, b and c are about W and cancel to W dist^2, which float rounding (1e-7 W) drowned at the
-  // fine levels (distances up to 3e-4 of the extent, the Hausdorff distances being compared).
-  glm::dvec3 origin_of(uint32_t v) const {
-    return glm::dvec3((in_.positions[source_[v]] - origin_) / scale_);
+  // The origin of v's quadric and attribute terms: its current position, the same for all its wedges (a
+  // collapse that moves b re-bases b's wedges onto x, rebase). Quadrics relative to a nearby origin keep
+  // their float terms small: relative to the model's corner, A, b and c are about W and cancel to W dist^2,
+  // which float rounding (1e-7 W) drowned at the fine levels (distances up to 3e-4 of the extent, the
+  // Hausdorff distances being compared). The position itself, not the input position, so that no collapse
+  // reads the input mesh (in input order, a cache miss per read: 60 % of `place` on elephant_1m).
+  glm::dvec3 origin_of(uint32_t v) const { return glm::dvec3(pos_[v]); }
+
+  // Moves v's quadric and attribute terms to an origin `d` further (Reduced::add: Q(y' + d); an attribute
+  // g.y + d_s becomes g.y' + d_s + g.d).
+  void rebase(uint32_t v, const glm::dvec3& d) {
+    Quadric moved;
+    moved.add_shifted(quadric_[v], d);
+    quadric_[v] = moved;
+    for (int j = 0; j < channels_; ++j) {
+      AttributeTerm& t = attr_[v * size_t(channels_) + j];
+      t.d += float(glm::dot(glm::dvec3(t.g), d));
+    }
   }
 
   // ---- planning ----------------------------------------------------------------------------------------
@@ -869,10 +930,11 @@ class Simplifier {
     s.removed_triangles += s.removed.size();
     merge(p.a, p.b, p);
     if (p.a2 != kNone) merge(p.a2, p.b2, p);
+    const glm::dvec3 to_x = glm::dvec3(x) - origin_of(p.b);
     uint32_t v = p.b;
     do {
       radius_[v] = float(r_new);
-      if (p.move) pos_[v] = x, moved_[v] = 1;
+      if (p.move) rebase(v, to_x), pos_[v] = x, moved_[v] = 1;
       touched_[v] = 1;
       v = wedge_[v];
     } while (v != p.b);
