@@ -164,8 +164,9 @@ class Simplifier {
   std::vector<uint8_t> vertex_mark_;
   // Two spatial halves of the vertices (split at the median along one axis, the next axis each time, so
   // that no band of the mesh is always left to the serial part) for the parallel part of the collapse loop;
-  // pending_: per order_ entry, left by its half's thread for the serial part.
-  std::vector<uint8_t> region_, pending_;
+  // side_ and pending_: per order_ entry, its half (kAnyRegion when it crosses) and whether its half's thread
+  // left it for the serial part.
+  std::vector<uint8_t> region_, side_, pending_;
   glm::vec3 split_{0.0f};
   int split_axis_ = 0;
   std::array<Scratch, 2> scratch_;
@@ -714,6 +715,15 @@ class Simplifier {
       tbb::parallel_for(tbb::blocked_range<size_t>(0, region_.size(), 4096), [&](const auto& r) {
         for (size_t v = r.begin(); v < r.end(); ++v) region_[v] = pos_[v][axis] < split_[axis] ? 0 : 1;
       });
+      // Each candidate's half (kAnyRegion: its ends lie in both), once: the threads then read only their
+      // own candidates' slots (in cost order, random in memory).
+      side_.resize(order_.size());
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, order_.size(), 4096), [&](const auto& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+          const Candidate& c = slots_[order_[i].slot];
+          side_[i] = region_[c.a] == region_[c.b] ? region_[c.a] : kAnyRegion;
+        }
+      });
       pending_.assign(order_.size(), 0);
       std::array<size_t, 2> count{0, 0};
       auto half = [&](uint8_t r) {
@@ -722,8 +732,8 @@ class Simplifier {
         size_t i = 0;
         for (; i < order_.size(); ++i) {
           if (order_[i].cost > limit || s.removed_triangles + 2 > quota) break;
+          if (side_[i] != r) continue;
           const Candidate& c = slots_[order_[i].slot];
-          if (region_[c.a] != r || region_[c.b] != r) continue;
           Plan p;
           if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
           p.slot = order_[i].slot;
@@ -749,8 +759,8 @@ class Simplifier {
     s.region = kAnyRegion;
     for (size_t i = 0; i < order_.size(); ++i) {
       if (order_[i].cost > limit || alive_triangles_ - s.removed_triangles <= target) break;
+      if (parallel && side_[i] != kAnyRegion && !pending_[i] && i < stop[side_[i]]) continue;
       const Candidate& c = slots_[order_[i].slot];
-      if (parallel && region_[c.a] == region_[c.b] && !pending_[i] && i < stop[region_[c.a]]) continue;
       Plan p;
       if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
       p.slot = order_[i].slot;
