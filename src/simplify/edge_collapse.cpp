@@ -732,6 +732,7 @@ class Simplifier {
         size_t i = 0;
         for (; i < order_.size(); ++i) {
           if (order_[i].cost > limit || s.removed_triangles + 2 > quota) break;
+          prefetch(i, r);
           if (side_[i] != r) continue;
           const Candidate& c = slots_[order_[i].slot];
           Plan p;
@@ -769,6 +770,22 @@ class Simplifier {
     }
     gather(s);
     return collapsed;
+  }
+
+  // Candidates come in cost order, random in memory, so each try starts with cache misses: this loads the
+  // slot of the candidate kSlotAhead places on, and the per-vertex data of the ends of the one kEndAhead on
+  // (its slot loaded earlier), if they belong to half r, so that their misses overlap the tries between.
+  void prefetch(size_t i, uint8_t r) const {
+    constexpr size_t kSlotAhead = 16, kEndAhead = 8;
+    if (i + kSlotAhead < order_.size() && side_[i + kSlotAhead] == r)
+      __builtin_prefetch(&slots_[order_[i + kSlotAhead].slot]);
+    if (i + kEndAhead < order_.size() && side_[i + kEndAhead] == r) {
+      const Candidate& c = slots_[order_[i + kEndAhead].slot];
+      for (uint32_t v : {c.a, c.b}) {
+        __builtin_prefetch(&touched_[v]), __builtin_prefetch(&offsets_[v]), __builtin_prefetch(&pos_[v]);
+        __builtin_prefetch(&quadric_[v]), __builtin_prefetch(&radius_[v]), __builtin_prefetch(&pid_[v]);
+      }
+    }
   }
 
   // Adds a thread's changes to the mesh's totals and clears them.
