@@ -52,11 +52,12 @@ class Clusterer {
       glm::dvec3 nn = glm::cross(pos_[b] - pos_[a], pos_[c] - pos_[a]);
       double len = glm::length(nn);
       normals.push_back(len > 0 ? nn / len : glm::dvec3(0.0));
-      if (len > 0) {
-        Quadric q;
-        glm::vec3 un(nn / len);
-        q.add_plane(un, -float(glm::dot(nn / len, pos_[a])), float(0.5 * len));
-        for (uint32_t v : {a, b, c}) quadric_[v].add(q), mean[v] += nn;
+      if (len > 0) {  // each corner's plane relative to its own position (quadric_)
+        const glm::dvec3 un = nn / len;
+        for (uint32_t v : {a, b, c}) {
+          quadric_[v].add_plane(glm::vec3(un), -float(glm::dot(un, pos_[a] - pos_[v])), float(0.5 * len));
+          mean[v] += nn;
+        }
       }
     }
     referenced_.assign(n, 0);
@@ -111,15 +112,16 @@ class Clusterer {
             }
           }
     }
-    // Representatives: the quadric optimum of the members, if within rho of the leader.
+    // Representatives: the quadric optimum of the members, if within rho of the leader. Each member's
+    // quadric is shifted to the leader's position, so x is relative to it.
     const size_t nc = o.leader.size();
     std::vector<Reduced> q(nc);
-    for (uint32_t v : order_) q[o.cluster[v]].add(quadric_[v]);
+    for (uint32_t v : order_) q[o.cluster[v]].add(quadric_[v], pos_[o.leader[o.cluster[v]]] - pos_[v]);
     o.rep.resize(nc);
     for (size_t c = 0; c < nc; ++c) {
       const glm::dvec3 lp = pos_[o.leader[c]];
       glm::dvec3 x;
-      o.rep[c] = !locked_[o.leader[c]] && q[c].solve(x) && glm::distance(x, lp) <= rho ? x : lp;
+      o.rep[c] = !locked_[o.leader[c]] && q[c].solve(x) && glm::length(x) <= rho ? lp + x : lp;
     }
     // Triangles mapped to clusters: drop repeated clusters and duplicates (same cyclic order).
     const size_t T = tris_.size() / 3;
@@ -217,6 +219,8 @@ class Clusterer {
   double scale_ = 1.0;  // bounding-box diagonal: positions are normalized by it
   std::vector<glm::dvec3> pos_;
   std::vector<uint8_t> locked_, referenced_;
+  // Per vertex, its faces' planes relative to its own position: relative to the model's corner the float
+  // terms are about W and cancel to W dist^2, which rounding (1e-7 W) drowns at fine cell sizes.
   std::vector<Quadric> quadric_;
   std::vector<uint32_t> tris_, order_;
 };
