@@ -288,12 +288,13 @@ Cut select_cut(const package::PackageScene& scene, const NodeSource& nodes, cons
   const HlodCover hlod = hlod_cover(scene, nodes);
   bool hlod_available = true;
   for (uint32_t root : hlod.roots) {
-    if (nodes.available(root)) continue;
-    hlod_available = false;
     const package::NodeRecord& r = *nodes.record(root);
-    if (in_frustum(proxy_sphere(r), view))
-      missing_roots.push_back(
-          {package::kNone, root, screen_error(double(r.error), proxy_sphere(r), view), INFINITY, true});
+    // A root out of view covers only objects out of view (its sphere contains theirs): it neither blocks
+    // the others nor is asked for.
+    if (nodes.available(root) || !in_frustum(proxy_sphere(r), view)) continue;
+    hlod_available = false;
+    missing_roots.push_back(
+        {package::kNone, root, screen_error(double(r.error), proxy_sphere(r), view), INFINITY, true});
   }
   for (uint32_t o = 0; o < scene.objects.size(); ++o) {
     const package::ObjectRecord& object = scene.objects[o];

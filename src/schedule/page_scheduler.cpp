@@ -94,7 +94,7 @@ struct Plan {
 
 // Sets each exchange's gate (Exchange::gate): the pages of the nodes that must be available, besides P, for
 // P to be drawn at all (cut.hpp). An object's nodes are drawn only when all its roots are; an object covered
-// by HLOD only when its leaf proxy L is drawn and refined: the HLOD's roots, the children of each of L's
+// by HLOD only when its leaf proxy L is drawn and refined: L's HLOD root, the children of each of L's
 // ancestors (an exchange replaces a proxy by all its children), L, and the G of L's exchange (the roots of
 // its objects in the views). A proxy's exchange is gated by the same chain above it. Without the gate an
 // object's refinements were eligible as soon as their own P was chosen, and planned while the object was not
@@ -122,9 +122,19 @@ void drawable_gates(const package::PackageScene& scene, const NodeSource& record
     if (const package::NodeRecord* r = records.record(node))
       if (std::find(pages.begin(), pages.end(), r->page) == pages.end()) pages.push_back(r->page);
   };
-  // The pages for proxy `p` to be drawn: the HLOD's roots and the children of each of its ancestors.
+  // The pages for proxy `p` to be drawn: its HLOD root (the cut asks only for roots in view; every root
+  // when the chain up from p is not known yet) and the children of each of its ancestors.
   auto proxy_chain = [&](uint32_t p, std::vector<uint32_t>& pages) {
-    for (uint32_t root : hlod_roots) add(pages, root);
+    uint32_t top = p;
+    const package::NodeRecord* up = records.record(p);
+    while (up && !up->parents.empty()) {
+      top = up->parents[0];
+      up = records.record(top);
+    }
+    if (up)
+      add(pages, top);
+    else
+      for (uint32_t root : hlod_roots) add(pages, root);
     for (const package::NodeRecord* r = records.record(p); r && !r->parents.empty();) {
       const package::NodeRecord* parent = records.record(r->parents[0]);
       if (!parent) break;

@@ -174,4 +174,25 @@ TEST(CutHlod, NothingOfCoveredObjectsBeforeTheHlodRootArrives) {
   EXPECT_EQ(cut.missing[0].object, package::kNone);
 }
 
+TEST(CutHlod, AnHlodRootOutOfViewNeitherBlocksTheOthersNorIsAskedFor) {
+  // The same quadtree with its four quadrants as roots; the far quadrant's root has not arrived and lies
+  // behind a camera that looks at the near one.
+  HlodScene s = make_scene();
+  std::vector<uint32_t> quadrants;
+  for (uint32_t id : s.proxies)
+    if (s.dag.records[id].objects.size() == 64) quadrants.push_back(id);
+  ASSERT_EQ(quadrants.size(), 4u);
+  s.with_hlod.representations.back().roots = quadrants;
+  TestNodes nodes(s.dag);
+  const uint32_t far_root = quadrants.back();  // objects 8..15 x 8..15, centre (230, 0, 230)
+  nodes.unavailable.insert(far_root);
+  const View view = view_from({70.0f, 30.0f, 60.0f}, {70.0f, 0.0f, -100.0f});
+  const Sphere& far = s.dag.records[far_root].sphere;
+  ASSERT_FALSE(in_frustum({glm::dvec3(far.center), double(far.radius)}, view));
+  const Cut cut = select_cut(s.with_hlod, nodes, view, {1.0});
+  EXPECT_FALSE(cut.drawn.empty());
+  for (const MissingNode& m : cut.missing) EXPECT_NE(m.node, far_root);
+  for (uint32_t o = 0; o < cut.objects.size(); ++o) EXPECT_NE(cut.objects[o], ObjectState::incomplete) << o;
+}
+
 }  // namespace
