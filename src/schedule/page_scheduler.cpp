@@ -126,21 +126,16 @@ void drawable_gates(const package::PackageScene& scene, const NodeSource& record
   // when the chain up from p is not known yet) and the children of each of its ancestors.
   auto proxy_chain = [&](uint32_t p, std::vector<uint32_t>& pages) {
     uint32_t top = p;
-    const package::NodeRecord* up = records.record(p);
-    while (up && !up->parents.empty()) {
-      top = up->parents[0];
-      up = records.record(top);
+    const package::NodeRecord* r = records.record(p);
+    while (r && !r->parents.empty()) {
+      top = r->parents[0];
+      if ((r = records.record(top)))
+        for (uint32_t c : r->children) add(pages, c);
     }
-    if (up)
+    if (r)
       add(pages, top);
     else
       for (uint32_t root : hlod_roots) add(pages, root);
-    for (const package::NodeRecord* r = records.record(p); r && !r->parents.empty();) {
-      const package::NodeRecord* parent = records.record(r->parents[0]);
-      if (!parent) break;
-      for (uint32_t c : parent->children) add(pages, c);
-      r = parent;
-    }
   };
   for (auto& [key, e] : exchanges) {
     const uint32_t low = uint32_t(key);

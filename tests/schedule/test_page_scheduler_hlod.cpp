@@ -76,6 +76,22 @@ View look(glm::vec3 eye, glm::vec3 target) {
   return View::of(c);
 }
 
+// The data pages `s` sends for `views`, in order, asked for one page at a time (each held once chosen) until
+// it has nothing more (at most 100 calls).
+std::vector<uint32_t> send_one_by_one(PageScheduler& s, const package::PackageReader& reader,
+                                      const PackageRecords& all, std::span<const WeightedView> views) {
+  std::vector<uint32_t> order;
+  for (int round = 0; round < 100; ++round) {
+    const auto pages = s.next(reader.scene(), all, views, {1.0, UINT64_MAX, 1});
+    if (pages.empty()) break;
+    for (const PageRef& p : pages) {
+      s.set_held(p.kind, p.id);
+      if (p.kind == PageKind::data) order.push_back(p.id);
+    }
+  }
+  return order;
+}
+
 }  // namespace
 
 TEST(PageSchedulerHlod, ALeafsObjectsRootsAreSentTogether) {
@@ -89,15 +105,7 @@ TEST(PageSchedulerHlod, ALeafsObjectsRootsAreSentTogether) {
   PageScheduler s(reader.root());
   const View view = look({6.0f, 0.0f, 30.0f}, {6.0f, 0.0f, 0.0f});
   const WeightedView views[] = {{view, 1.0, 0.0}};
-  std::vector<uint32_t> order;  // data pages as sent, one call of one page at a time
-  for (int round = 0; round < 100; ++round) {
-    const auto pages = s.next(reader.scene(), all, views, {1.0, UINT64_MAX, 1});
-    if (pages.empty()) break;
-    for (const PageRef& p : pages) {
-      s.set_held(p.kind, p.id);
-      if (p.kind == PageKind::data) order.push_back(p.id);
-    }
-  }
+  const std::vector<uint32_t> order = send_one_by_one(s, reader, all, views);
   // Everything the view needs arrives: the proxies, then every object's root.
   ASSERT_EQ(order.size(), h.records.size());
   auto at = [&](uint32_t node) {
@@ -146,15 +154,7 @@ TEST(PageSchedulerHlod, AnObjectsFinerLevelsWaitForItsLeafsOtherRoots) {
   for (uint32_t held : {kRoot, kLeafA, kLeafB, kRoot0}) s.set_held(PageKind::data, all.record(held)->page);
   const View view = look({1.0f, 0.0f, 4.0f}, {1.0f, 0.0f, 0.0f});
   const WeightedView views[] = {{view, 1.0, 0.0}};
-  std::vector<uint32_t> order;
-  for (int round = 0; round < 100; ++round) {
-    const auto pages = s.next(reader.scene(), all, views, {1.0, UINT64_MAX, 1});
-    if (pages.empty()) break;
-    for (const PageRef& p : pages) {
-      s.set_held(p.kind, p.id);
-      if (p.kind == PageKind::data) order.push_back(p.id);
-    }
-  }
+  const std::vector<uint32_t> order = send_one_by_one(s, reader, all, views);
   auto at = [&](uint32_t node) {
     return size_t(std::find(order.begin(), order.end(), all.record(node)->page) - order.begin());
   };
