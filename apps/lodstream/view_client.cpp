@@ -50,10 +50,13 @@ ViewClient::ViewClient(const std::string& source, const ViewClientOptions& optio
   cut_options_.triangle_budget =
       std::min<uint64_t>(options.budget ? options.budget : UINT64_MAX,
                          schedule::affordable_triangles(client_.reader().root(), cache_bytes(options)));
+  std::vector<uint32_t> left_on_disk;  // data pages the memory budget left on disk
   if (!options.cache_dir.empty()) {
     disk_.emplace(options.cache_dir, client_.reader().header().content_hash);
-    for (const std::string& w : disk_->restore(client_, cache_bytes(options)).warnings)
+    runtime::RestoredPages restored = disk_->restore(client_, cache_bytes(options));
+    for (const std::string& w : restored.warnings)
       std::fprintf(stderr, "lodstream: warning: %s\n", w.c_str());
+    left_on_disk = std::move(restored.on_disk);
   }
 
   if (mode_ == Mode::push) {
@@ -62,6 +65,7 @@ ViewClient::ViewClient(const std::string& source, const ViewClientOptions& optio
     hello.cached_hash = client_.reader().header().content_hash;
     hello.held = wire::page_runs(client_.held(schedule::PageKind::data));
     hello.held_index = wire::page_runs(client_.held(schedule::PageKind::index));
+    hello.on_disk = wire::page_runs(left_on_disk);
     hello.cache_budget_bytes = cache_bytes(options);
     hello.triangles_per_frame =
         uint32_t(std::min<uint64_t>(options.budget ? options.budget : UINT32_MAX, UINT32_MAX));
@@ -142,6 +146,16 @@ void ViewClient::request_baseline(std::span<const schedule::WeightedView> predic
 runtime::Frame ViewClient::frame(const schedule::ViewSample& now) {
   if (std::string error = arrived_.error(); !error.empty()) throw Error(error);
   for (ArrivedPage& a : arrived_.take()) {
+    if (a.from_disk) {  // the push server's Restore of a page the disk cache keeps
+      const std::string why = disk_ ? disk_->restore_page(client_, a.page.id) : "no --cache-dir";
+      if (!why.empty()) {
+        std::fprintf(stderr, "lodstream: warning: a restore asked of the disk cache failed: %s\n",
+                     why.c_str());
+        const uint32_t lost = a.page.id;
+        pusher_->released({&lost, 1}, false);  // the server sends its bytes instead
+      }
+      continue;
+    }
     if (disk_pages_ && disk_pages_->take_served(a.page)) {
       client_.restore(a.page.kind, a.page.id, a.bytes);  // read back from disk: already stored there
       continue;
@@ -162,7 +176,7 @@ runtime::Frame ViewClient::frame(const schedule::ViewSample& now) {
   runtime::Frame f = client_.frame(predicted[0].view, ahead, cut_options_);
   const std::vector<uint32_t> evicted = client_.take_evicted();
   if (puller_) puller_->evicted(evicted);
-  if (pusher_) pusher_->released(evicted);
+  if (pusher_) pusher_->released(evicted, disk_.has_value());  // every page that arrived is on disk
   return f;
 }
 

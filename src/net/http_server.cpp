@@ -50,7 +50,8 @@ struct Piece {
 std::string session_line(const std::string& name, const PushStats& stats) {
   const PushCounters& c = stats.counters;
   return "push session for " + name + ": " + std::to_string(c.pages_sent) + " pages (" +
-         std::to_string(c.index_pages_sent) + " index), " + std::to_string(c.bytes_sent) + " bytes, " +
+         std::to_string(c.index_pages_sent) + " index, " + std::to_string(c.restores) +
+         " restored from the client's disk), " + std::to_string(c.bytes_sent) + " bytes, " +
          std::to_string(c.views) + " views, " + std::to_string(c.acks) + " acks; " + stats.end_reason;
 }
 

@@ -18,6 +18,7 @@ namespace lodstream {
 struct ArrivedPage {
   schedule::PageRef page;
   std::vector<uint8_t> bytes;  // as stored in the package
+  bool from_disk = false;      // a push server's Restore: no bytes, load the page from the disk cache
 };
 
 class PageInbox {

@@ -34,14 +34,21 @@ struct PushClient::Impl {
   // Owned by the strand:
   std::optional<wire::ViewUpdate> view;
   std::optional<wire::Ack> ack;
-  std::set<uint32_t> release;  // data pages evicted and not yet said (over the current connection)
+  // Data pages evicted and not yet said (over the current connection), by whether the disk keeps them.
+  std::set<uint32_t> release, release_kept;
   bool open = false, closing = false, done = false;
   bool welcomed_now = false;      // the current connection was welcomed
   uint64_t connection = 0;        // the current connection's number; a writer of an older one stops
   uint64_t received = 0;          // page bytes over the current connection
   std::set<uint32_t> arrived[2];  // pages received over any connection and not evicted since, by kind
   std::set<uint32_t> evicted;     // data pages evicted since the start and not received again
+  std::set<uint32_t> on_disk;     // data pages not held in memory that the disk cache keeps
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+
+  // Data page `id` is held again (its bytes or a Restore arrived): nothing to say about it any more.
+  void held_again(uint32_t id) {
+    evicted.erase(id), release.erase(id), release_kept.erase(id), on_disk.erase(id);
+  }
 
   double now() const {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -67,6 +74,8 @@ struct PushClient::Impl {
     };
     h.held = held(hello.held, arrived[size_t(schedule::PageKind::data)], evicted);
     h.held_index = held(hello.held_index, arrived[size_t(schedule::PageKind::index)], {});
+    const std::vector<uint32_t> kept(on_disk.begin(), on_disk.end());
+    h.on_disk = wire::page_runs(kept);
     return h;
   }
 
@@ -80,11 +89,13 @@ struct PushClient::Impl {
         } else if (view) {
           const wire::Message m = *std::exchange(view, std::nullopt);
           co_await send(*ws, m);
-        } else if (!release.empty()) {
-          const std::vector<uint32_t> pages(release.begin(), release.end());
-          release.clear();
+        } else if (!release.empty() || !release_kept.empty()) {
+          const bool kept = release.empty();
+          std::set<uint32_t>& said = kept ? release_kept : release;
+          const std::vector<uint32_t> pages(said.begin(), said.end());
+          said.clear();
           // Named, not a temporary in the co_await (GCC 12 destroys such temporaries twice).
-          const wire::Message m = wire::Released{wire::page_runs(pages)};
+          const wire::Message m = wire::Released{wire::page_runs(pages), kept};
           co_await send(*ws, m);
         } else if (closing) {
           open = false;
@@ -106,7 +117,7 @@ struct PushClient::Impl {
     auto ws = std::make_shared<WebSocket>(strand);
     const uint64_t number = ++connection;
     ack.reset();
-    release.clear();  // the new Hello leaves them out
+    release.clear(), release_kept.clear();  // the new Hello says them
     received = 0;
     welcomed_now = false;
     std::string lost;
@@ -132,17 +143,24 @@ struct PushClient::Impl {
         if (auto* page = std::get_if<wire::Page>(&m)) {
           received += page->bytes.size();
           ack = wire::Ack{page->sequence, received, now(), page->server_time_s};
+          if (page->kind == schedule::PageKind::data) held_again(page->page_id);
           arrived[size_t(page->kind)].insert(page->page_id);
-          if (page->kind == schedule::PageKind::data)
-            evicted.erase(page->page_id), release.erase(page->page_id);
           inbox->put({{page->kind, page->page_id, uint32_t(page->bytes.size())}, std::move(page->bytes)});
           ++owner->pages_;
+          wake.cancel();
+        } else if (auto* restore = std::get_if<wire::Restore>(&m)) {
+          ack = wire::Ack{restore->sequence, received, now(), restore->server_time_s};
+          held_again(restore->page_id);
+          arrived[size_t(schedule::PageKind::data)].insert(restore->page_id);
+          inbox->put({{schedule::PageKind::data, restore->page_id, 0}, {}, true});
+          ++owner->restores_;
           wake.cancel();
         } else if (auto* welcome = std::get_if<wire::Welcome>(&m)) {
           if (welcome->package_hash != hello.cached_hash) {  // what the client held is of another package
             hello.cached_hash = welcome->package_hash;
             hello.held.clear(), hello.held_index.clear();
-            arrived[0].clear(), arrived[1].clear(), evicted.clear(), release.clear();
+            arrived[0].clear(), arrived[1].clear(), evicted.clear(), release.clear(), release_kept.clear();
+            on_disk.clear();
           }
           if (owner->welcomed_) ++owner->reconnects_;
           owner->welcomed_ = true;
@@ -193,6 +211,8 @@ struct PushClient::Impl {
 PushClient::PushClient(const std::string& url, wire::Hello hello, PageInbox& inbox, PushReconnect reconnect)
     : impl_(std::make_unique<Impl>()) {
   impl_->url = split_url(url, "ws://");
+  for (const wire::PageRun& run : hello.on_disk)
+    for (uint64_t p = run.first; p < uint64_t(run.first) + run.count; ++p) impl_->on_disk.insert(uint32_t(p));
   impl_->hello = std::move(hello);
   impl_->inbox = &inbox;
   impl_->owner = this;
@@ -223,16 +243,22 @@ void PushClient::send_view(const wire::ViewUpdate& view) {
   });
 }
 
-void PushClient::released(std::span<const uint32_t> pages) {
+void PushClient::released(std::span<const uint32_t> pages, bool on_disk) {
   if (pages.empty()) return;
-  asio::post(impl_->strand, [m = impl_.get(), pages = std::vector<uint32_t>(pages.begin(), pages.end())] {
-    for (uint32_t p : pages) {
-      m->arrived[size_t(schedule::PageKind::data)].erase(p);
-      m->evicted.insert(p);
-      if (m->open) m->release.insert(p);
-    }
-    m->wake.cancel();
-  });
+  asio::post(impl_->strand,
+             [m = impl_.get(), on_disk, pages = std::vector<uint32_t>(pages.begin(), pages.end())] {
+               for (uint32_t p : pages) {
+                 m->arrived[size_t(schedule::PageKind::data)].erase(p);
+                 m->evicted.insert(p);
+                 m->release.erase(p), m->release_kept.erase(p);
+                 if (on_disk)
+                   m->on_disk.insert(p);
+                 else
+                   m->on_disk.erase(p);
+                 if (m->open) (on_disk ? m->release_kept : m->release).insert(p);
+               }
+               m->wake.cancel();
+             });
 }
 
 }  // namespace lodstream

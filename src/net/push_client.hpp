@@ -5,8 +5,10 @@
 // not yet sent). A connection lost after a Welcome (the server restarted) is opened again with back-off,
 // its Hello listing the pages held at the start plus every page received since, so that the server sends
 // none of them again (issue 5); meanwhile the frame loop keeps drawing what it holds. Pages the client's
-// cache evicts are said to the server (released()), which may then send them again. A Bye from the server,
-// a malformed message, or a first connection that fails is reported through the inbox.
+// cache evicts are said to the server (released()), which may then send them again, or, when the client keeps
+// them on disk, send a Restore (left in the inbox as an ArrivedPage with from_disk and no bytes: the frame
+// loop loads the page from its disk cache, and says released(page, false) when it cannot). A Bye from the
+// server, a malformed message, or a first connection that fails is reported through the inbox.
 #pragma once
 
 #include <atomic>
@@ -37,11 +39,14 @@ class PushClient {
   PushClient& operator=(const PushClient&) = delete;
 
   void send_view(const wire::ViewUpdate& view);
-  // Data pages the client's cache evicted: said to the server (a Released message) so that it may send them
-  // again, and left out of a reconnection's Hello.
-  void released(std::span<const uint32_t> pages);
+  // Data pages the client's memory cache evicted: said to the server (a Released message) so that it may send
+  // them again, and left out of a reconnection's Hello. `on_disk`: the client's disk cache keeps them (the
+  // server may send a Restore instead of the bytes; a reconnection's Hello lists them as on disk); without
+  // it they are gone (also what a Restore that could not be loaded is said with).
+  void released(std::span<const uint32_t> pages, bool on_disk = false);
   bool welcomed() const { return welcomed_; }
   uint64_t pages_received() const { return pages_; }
+  uint64_t restores_received() const { return restores_; }
   // Connections opened again (and welcomed) after one was lost.
   uint64_t reconnects() const { return reconnects_; }
 
@@ -49,7 +54,7 @@ class PushClient {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::atomic<bool> welcomed_{false};
-  std::atomic<uint64_t> pages_{0}, reconnects_{0};
+  std::atomic<uint64_t> pages_{0}, restores_{0}, reconnects_{0};
   std::thread thread_;
 };
 

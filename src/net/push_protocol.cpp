@@ -18,6 +18,7 @@ PushProtocol::PushProtocol(std::shared_ptr<const PushPackage> package, PushProto
       options_(options),
       scheduler_(package_->reader->root()),
       released_(package_->reader->root().pages.size(), false),
+      on_disk_(package_->reader->root().pages.size(), false),
       remaining_(package_->reader->root().pages.size() + package_->reader->root().index_pages.size()) {}
 
 std::optional<wire::Message> PushProtocol::on_message(const wire::Message& message, double now_s) {
@@ -38,6 +39,9 @@ std::optional<wire::Message> PushProtocol::on_message(const wire::Message& messa
       };
       hold(hello->held, PageKind::data, reader.root().pages.size());
       hold(hello->held_index, PageKind::index, reader.root().index_pages.size());
+      for (const auto& run : hello->on_disk)
+        for (uint64_t p = run.first; p < uint64_t(run.first) + run.count && p < on_disk_.size(); ++p)
+          on_disk_[p] = true;
     }
     cache_budget_ = hello->cache_budget_bytes;
     triangle_budget_ = schedule::affordable_triangles(reader.root(), cache_budget_);
@@ -80,12 +84,19 @@ std::optional<wire::Message> PushProtocol::on_message(const wire::Message& messa
         throw wire::WireError("wire: released message: pages " + std::to_string(run.first) + ".." +
                               std::to_string(uint64_t(run.first) + run.count - 1) + " but the package has " +
                               std::to_string(count));
-      for (uint32_t p = run.first; p < run.first + run.count; ++p)
-        if (scheduler_.held(PageKind::data, p) && !released_[p]) {
-          held_bytes_ -= reader().root().pages[p].raw_size;
-          released_[p] = true;
+      for (uint32_t p = run.first; p < run.first + run.count; ++p) {
+        const bool restore_failed = on_disk_[p] && !released->on_disk;
+        on_disk_[p] = released->on_disk;
+        if (!scheduler_.held(PageKind::data, p) || released_[p]) continue;
+        held_bytes_ -= reader().root().pages[p].raw_size;
+        released_[p] = true;
+        if (restore_failed) {  // what the view needed is not there: due again at once, as bytes
+          scheduler_.set_held(PageKind::data, p, false);
+          ++remaining_;
+        } else {
           backoff_.released(p, now_s);
         }
+      }
     }
   } else if (std::holds_alternative<wire::Bye>(message)) {
     ended_ = true;
@@ -154,12 +165,15 @@ std::optional<PageToSend> PushProtocol::next_page(double now_s) {
   planned_.pop_front();
   if (in_flight == 0) last_progress_s_ = now_s;  // the acknowledgement clock starts with the first page out
   ++sequence_;
-  link_.on_send(sequence_, page.bytes, now_s, planned_.empty());
+  const bool restore = page.kind == PageKind::data && on_disk_[page.id];
+  static const uint64_t restore_bytes = wire::encode(wire::Restore{}).size();
+  link_.on_send(sequence_, restore ? restore_bytes : page.bytes, now_s, planned_.empty());
   mark_sent(page);
   ++counters_.pages_sent;
-  counters_.bytes_sent += page.bytes;
+  counters_.bytes_sent += restore ? 0 : page.bytes;
+  counters_.restores += restore;
   counters_.index_pages_sent += page.kind == PageKind::index;
-  return PageToSend{sequence_, page, now_s};
+  return PageToSend{sequence_, page, now_s, restore};
 }
 
 void PushProtocol::mark_sent(const PageRef& page) {

@@ -22,6 +22,9 @@
 // break". The planned cuts keep to the triangles the client's cache budget affords
 // (schedule/cache_budget.hpp). Pages the client released are sent again only when the scheduler picks them
 // for a view, after a hold-off that doubles with each release of the page (schedule/release_backoff.hpp).
+// A page the client keeps on disk (Hello's on_disk, a Released with on_disk) goes out as a Restore, a
+// 24-byte message that has the client load it from its disk, instead of its bytes; a Released without
+// on_disk for such a page (the client could not load it) makes it due again at once, as bytes.
 //
 // Time is the caller's (seconds on any monotonic clock). Cost: a plan is one PageScheduler::next (one cut per
 // predicted view) for a window's worth of pages.
@@ -72,15 +75,18 @@ struct PushProtocolOptions {
 };
 
 // A page the shell is to send now: read `page`'s stored bytes and send them as wire::Page{sequence,
-// page.id, server_time_s, bytes, page.kind}.
+// page.id, server_time_s, bytes, page.kind}; or, with `restore`, send wire::Restore{sequence, page.id,
+// server_time_s} (a data page the client keeps on disk).
 struct PageToSend {
   uint32_t sequence = 0;
   schedule::PageRef page;
   double server_time_s = 0.0;
+  bool restore = false;
 };
 
 struct PushCounters {
-  uint64_t pages_sent = 0, bytes_sent = 0, index_pages_sent = 0, views = 0, acks = 0;
+  // pages_sent counts restores too; bytes_sent is page bytes only (what crossed the link as pages).
+  uint64_t pages_sent = 0, bytes_sent = 0, index_pages_sent = 0, restores = 0, views = 0, acks = 0;
 };
 
 class PushProtocol {
@@ -127,6 +133,7 @@ class PushProtocol {
   // released): what its cache budget is spent on.
   uint64_t held_bytes_ = 0;
   std::vector<bool> released_;        // data pages the client let go: never sent again by the idle fill
+  std::vector<bool> on_disk_;         // data pages the client keeps on disk: sent as a Restore
   schedule::ReleaseBackoff backoff_;  // when a released page may be planned again
   size_t remaining_ = 0;              // pages neither held nor sent
   std::optional<schedule::ViewSample> view_;

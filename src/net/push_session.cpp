@@ -113,6 +113,11 @@ awaitable<PushStats> run_push_session(WebSocket& ws, std::shared_ptr<const PushP
       while (s->reader_running) {
         auto next = s->protocol.next_page(s->now());
         if (!next) break;
+        if (next->restore) {  // the client loads it from its disk
+          const wire::Message restore = wire::Restore{next->sequence, next->page.id, next->server_time_s};
+          co_await send(ws, restore);
+          continue;
+        }
         const auto& root = reader.root();
         const package::Range& range = next->page.kind == schedule::PageKind::data
                                           ? root.pages[next->page.id]

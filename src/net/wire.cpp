@@ -14,7 +14,8 @@ enum class Type : uint16_t {
   kWelcome = 4,
   kPage = 5,
   kBye = 6,
-  kReleased = 7
+  kReleased = 7,
+  kRestore = 8
 };
 
 class Writer {
@@ -110,6 +111,7 @@ void encode_payload(Writer& w, const Hello& m) {
   w.put(m.cached_hash.low), w.put(m.cached_hash.high);
   put_runs(w, m.held);
   put_runs(w, m.held_index);
+  put_runs(w, m.on_disk);
   w.put(m.cache_budget_bytes), w.put(m.triangles_per_frame), w.put(m.viewport_width),
       w.put(m.viewport_height);
 }
@@ -134,6 +136,10 @@ void encode_payload(Writer& w, const Bye& m) {
 }
 void encode_payload(Writer& w, const Released& m) {
   put_runs(w, m.pages);
+  w.put(uint8_t(m.on_disk));
+}
+void encode_payload(Writer& w, const Restore& m) {
+  w.put(m.sequence), w.put(m.page_id), w.put(m.server_time_s);
 }
 
 constexpr Type type_of(const Message& m) {
@@ -167,7 +173,7 @@ std::vector<PageRun> page_runs(std::span<const uint32_t> sorted_pages) {
 }
 
 const char* type_name(const Message& message) {
-  static const char* names[] = {"hello", "view", "ack", "welcome", "page", "bye", "released"};
+  static const char* names[] = {"hello", "view", "ack", "welcome", "page", "bye", "released", "restore"};
   return names[message.index()];
 }
 
@@ -206,6 +212,7 @@ Message decode(std::span<const uint8_t> frame) {
       m.cached_hash = hash(r, "cached hash");
       m.held = get_runs(r, "held runs");
       m.held_index = get_runs(r, "held index runs");
+      m.on_disk = get_runs(r, "on-disk runs");
       m.cache_budget_bytes = r.get<uint64_t>("cache budget");
       m.triangles_per_frame = r.get<uint32_t>("triangles per frame");
       viewport(r, m.viewport_width, m.viewport_height);
@@ -268,6 +275,18 @@ Message decode(std::span<const uint8_t> frame) {
       Reader r(body, "released");
       Released m{get_runs(r, "released runs")};
       if (m.pages.empty()) r.fail("released runs", "are empty");
+      const uint8_t on_disk = r.get<uint8_t>("on-disk flag");
+      if (on_disk > 1) r.fail("on-disk flag", std::to_string(on_disk) + " is neither 0 nor 1");
+      m.on_disk = on_disk == 1;
+      r.done();
+      return m;
+    }
+    case Type::kRestore: {
+      Reader r(body, "restore");
+      Restore m;
+      m.sequence = r.get<uint32_t>("sequence");
+      m.page_id = r.get<uint32_t>("page id");
+      m.server_time_s = r.get<double>("server time");
       r.done();
       return m;
     }

@@ -21,7 +21,9 @@ namespace lodstream::wire {
 
 // 2: pages carry their kind (data or index page), hello lists held index pages too.
 // 3: the client says which data pages its cache let go (Released).
-constexpr uint16_t kProtocolVersion = 3;
+// 4: a client with a disk cache says which pages it keeps there (Hello's on_disk, Released's on_disk), and
+//    the server tells it to load such a page from its disk (Restore) instead of sending the bytes again.
+constexpr uint16_t kProtocolVersion = 4;
 constexpr size_t kHeaderBytes = 8;
 constexpr size_t kMaxMessageBytes = 16u << 20;  // larger frames are refused before they are read
 constexpr size_t kMaxNameBytes = 256;
@@ -49,6 +51,9 @@ struct Hello {
   ContentHash cached_hash{};  // content hash of the package the held pages came from (zero: nothing cached)
   std::vector<PageRun> held;  // data pages the client already holds (ignored when the hash differs)
   std::vector<PageRun> held_index;  // index pages it holds (likewise)
+  // Data pages it does not hold in memory but keeps on disk, whole and checked (likewise): the server sends
+  // a Restore for them instead of their bytes.
+  std::vector<PageRun> on_disk;
   uint64_t cache_budget_bytes = 0;
   uint32_t triangles_per_frame = 0;
   uint16_t viewport_width = 0, viewport_height = 0;
@@ -100,11 +105,23 @@ struct Bye {
 // Client → server: data pages the client's cache evicted. It no longer holds them, so the server may send
 // them again when a view needs them (without this, a client whose cache is smaller than what its path
 // needs would never get an evicted page back).
+// With `on_disk`, the client still keeps them on disk (its --cache-dir): the server may send a Restore for
+// one instead of its bytes. Without it, they are gone, also from disk (a Restore of one failed).
 struct Released {
   std::vector<PageRun> pages;
+  bool on_disk = false;
 };
 
-using Message = std::variant<Hello, ViewUpdate, Ack, Welcome, Page, Bye, Released>;
+// Server → client: load data page `page_id` from your disk cache (a page you said you keep there); it counts
+// as sent with `sequence`, and is acknowledged like a Page. When the page cannot be loaded, the client says
+// so with a Released without on_disk, and the server sends the bytes.
+struct Restore {
+  uint32_t sequence = 0;
+  uint32_t page_id = 0;
+  double server_time_s = 0;
+};
+
+using Message = std::variant<Hello, ViewUpdate, Ack, Welcome, Page, Bye, Released, Restore>;
 
 std::vector<uint8_t> encode(const Message& message);
 

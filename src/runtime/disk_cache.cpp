@@ -112,22 +112,42 @@ RestoredPages DiskCache::restore(ClientPackage& client, uint64_t budget_bytes) c
       drop(path, std::to_string(size) + " bytes where the package's page has " + std::to_string(range.size));
       continue;
     }
-    if (data && client.cache().bytes() + range.raw_size > budget_bytes) continue;  // stays on disk
-    std::vector<uint8_t> stored(range.size);
-    if (!read_page(page.kind, page.id, stored)) {
-      drop(path, "cannot be read");
+    if (data && client.cache().bytes() + range.raw_size > budget_bytes) {
+      result.on_disk.push_back(page.id);
       continue;
     }
-    try {
-      client.restore(page.kind, page.id, stored);
-    } catch (const Error& e) {
-      drop(path, e.what());
+    if (const std::string why = load(client, page.kind, page.id, range.size); !why.empty()) {
+      drop(path, why);
       continue;
     }
     ++result.pages;
-    result.stored_bytes += stored.size();
+    result.stored_bytes += range.size;
   }
   return result;
+}
+
+std::string DiskCache::load(ClientPackage& client, PageKind kind, uint32_t id, uint64_t size) const {
+  std::vector<uint8_t> stored(size);
+  if (!read_page(kind, id, stored)) return "cannot be read as a page of " + std::to_string(size) + " bytes";
+  try {
+    client.restore(kind, id, stored);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string DiskCache::restore_page(ClientPackage& client, uint32_t id) const {
+  const package::RootIndex& root = client.reader().root();
+  if (id >= root.pages.size())
+    return "data page " + std::to_string(id) + ": the package has " + std::to_string(root.pages.size());
+  const std::string why = load(client, PageKind::data, id, root.pages[id].size);
+  if (!why.empty()) {
+    std::error_code ec;
+    std::filesystem::remove(file(PageKind::data, id), ec);
+    return file(PageKind::data, id).string() + ": " + why;
+  }
+  return "";
 }
 
 }  // namespace lodstream::runtime

@@ -24,6 +24,7 @@ struct RestoredPages {
   uint64_t pages = 0;                 // pages installed from disk
   uint64_t stored_bytes = 0;          // their stored (compressed) bytes
   std::vector<std::string> warnings;  // one line per file dropped or ignored, naming it and why
+  std::vector<uint32_t> on_disk;      // data pages left on disk (the budget was spent), ascending
 };
 
 class DiskCache {
@@ -44,6 +45,11 @@ class DiskCache {
   // are deleted and reported. Cost: one read, checksum and decompression per page loaded.
   RestoredPages restore(ClientPackage& client, uint64_t budget_bytes) const;
 
+  // Installs data page `id` from its file into `client` (a push server's Restore, or a page read back after
+  // an eviction). Returns "" on success; otherwise why not (no such page or file, wrong size, checksum or
+  // contents), after deleting a file that failed. Cost: one read, checksum and decompression.
+  std::string restore_page(ClientPackage& client, uint32_t id) const;
+
   // Reads page (kind, id)'s file into `out` when it exists and holds exactly out.size() bytes; false
   // otherwise. Checks nothing else (the caller checks the checksum). Safe to call from several threads.
   // Cost: one file read.
@@ -53,6 +59,9 @@ class DiskCache {
   std::filesystem::path file(schedule::PageKind kind, uint32_t id) const;
 
  private:
+  // Reads page (kind, id) of `size` stored bytes and installs it into `client`: "" or why it failed.
+  std::string load(ClientPackage& client, schedule::PageKind kind, uint32_t id, uint64_t size) const;
+
   std::filesystem::path directory_;
 };
 

@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <thread>
 
@@ -30,6 +31,24 @@ uint64_t stored_bytes(const std::filesystem::path& dir) {
 
 uint64_t bytes(const ViewRun& v, const char* key) {
   return v.result.json()[key].get<uint64_t>();
+}
+
+// A camera path that swings from one side of the elephant to the other and back in 4 s.
+std::filesystem::path swing_path() {
+  const auto path = temp_dir() / "swing.json";
+  nlohmann::json keys = nlohmann::json::array();
+  for (const auto& [t, x] : {std::pair(0.0, 0.8), std::pair(2.0, -0.8), std::pair(4.0, 0.8)})
+    keys.push_back({{"t", t}, {"eye", {x, 0.2, x}}, {"target", {0, 0, 0}}, {"up", {0, 1, 0}}});
+  std::ofstream(path) << nlohmann::json{{"fov", 60}, {"size", {640, 480}}, {"keyframes", keys}}.dump();
+  return path;
+}
+
+// `lodstream view SOURCE` along `path` as a thin client: a 0.3 MB memory cache, pages kept under `dir`.
+RunResult thin_view(const std::string& source, const std::filesystem::path& path,
+                    const std::filesystem::path& dir) {
+  return run_lodstream({"view", source, "--headless", "--path", path.string(), "--out",
+                        (temp_dir() / "out").string(), "--settle", "2", "--cache", "0.3", "--cache-dir",
+                        dir.string(), "--json"});
 }
 
 }  // namespace
@@ -135,21 +154,60 @@ TEST(ViewReconnect, APulledThinClientReadsEvictedPagesBackFromDiskNotFromTheNetw
   // are evicted and needed again. With --cache-dir every page crosses the network once; the pages needed
   // again are read back from disk.
   Server server;
-  const auto path = temp_dir() / "swing.json";
-  nlohmann::json keys = nlohmann::json::array();
-  for (const auto& [t, x] : {std::pair(0.0, 0.8), std::pair(2.0, -0.8), std::pair(4.0, 0.8)})
-    keys.push_back({{"t", t}, {"eye", {x, 0.2, x}}, {"target", {0, 0, 0}}, {"up", {0, 1, 0}}});
-  std::ofstream(path) << nlohmann::json{{"fov", 60}, {"size", {640, 480}}, {"keyframes", keys}}.dump();
+  const auto path = swing_path();
   const auto dir = temp_dir() / "cache";
-  const auto r = run_lodstream({"view", server.http(), "--headless", "--path", path.string(), "--out",
-                                (temp_dir() / "out").string(), "--settle", "2", "--cache", "0.3",
-                                "--cache-dir", dir.string(), "--json"});
+  const auto r = thin_view(server.http(), path, dir);
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = r.json();
   EXPECT_GT(j["bytes"].get<uint64_t>(), 0u);
   EXPECT_EQ(j["bytes"].get<uint64_t>(), stored_bytes(dir));  // no page came over the network twice
   EXPECT_GT(j["bytes_restored"].get<uint64_t>(), 0u);        // evicted pages were read back from disk
   EXPECT_GT(j["benefit_ratio"].get<double>(), 0.0);
+}
+
+TEST(ViewReconnect, APushedThinClientIsToldToRestoreEvictedPagesFromDiskNotSentThemAgain) {
+  // As above, pushed: the client says which evicted pages its disk keeps, and the server sends a Restore
+  // instead of their bytes. A second run of the path starts from the disk, its Hello listing the pages the
+  // memory budget left there: still no page crosses the network twice over both runs. A third, after the
+  // upper half of the data page files was corrupted (pages restored at start-up go in page order until the
+  // budget is spent, so those stay on disk, listed in the Hello): Restores fail their checksum, and the
+  // server sends the bytes instead.
+  Server server;
+  const auto path = swing_path();
+  const auto dir = temp_dir() / "cache";
+  auto run = [&](bool corrupt) {
+    const auto r = thin_view(server.ws(), path, dir);
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.err.find("restore asked of the disk cache failed") != std::string::npos, corrupt) << r.err;
+    return r.json();
+  };
+  const auto first = run(false);
+  EXPECT_GT(first["bytes"].get<uint64_t>(), 0u);
+  EXPECT_EQ(first["bytes"].get<uint64_t>(), stored_bytes(dir));  // no page came over the network twice
+  EXPECT_GT(first["bytes_restored"].get<uint64_t>(), 0u);        // evicted pages were restored from disk
+  EXPECT_GT(first["benefit_ratio"].get<double>(), 0.0);
+  const auto second = run(false);
+  EXPECT_GT(second["bytes_restored"].get<uint64_t>(), 0u);
+  EXPECT_EQ(stored_bytes(dir), first["bytes"].get<uint64_t>() + second["bytes"].get<uint64_t>());
+  EXPECT_GT(second["benefit_ratio"].get<double>(), 0.0);
+
+  std::map<int, std::filesystem::path> data_pages;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(dir))
+    if (e.is_regular_file() && e.path().filename().string().starts_with("d"))
+      data_pages[std::stoi(e.path().filename().string().substr(1))] = e.path();
+  ASSERT_GE(data_pages.size(), 4u);
+  size_t i = 0;
+  for (const auto& [id, file] : data_pages)
+    if (i++ >= data_pages.size() / 2) {
+      std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+      f.seekg(std::streamoff(std::filesystem::file_size(file) / 2));
+      const char c = char(f.get());
+      f.seekp(std::streamoff(std::filesystem::file_size(file) / 2));
+      f.put(char(c ^ 0x5a));  // same size, wrong checksum
+    }
+  const auto third = run(true);
+  EXPECT_GT(third["bytes"].get<uint64_t>(), 0u);  // what could not be restored came as bytes
+  EXPECT_GT(third["benefit_ratio"].get<double>(), 0.0);
 }
 
 TEST(ViewReconnect, ACacheDirThatCannotBeCreatedIsAOneLineError) {

@@ -44,16 +44,23 @@ schedule::View view_of(const wire::ViewUpdate& v) {
 }
 
 // Takes what `p` sends from `t` on, acknowledging every 50 ms of virtual time, until a round sends nothing;
-// the pages in the order sent.
-std::vector<schedule::PageRef> drain(PushProtocol& p, double& t) {
-  std::vector<schedule::PageRef> pages;
+// what was sent, in order.
+std::vector<PageToSend> drain_sent(PushProtocol& p, double& t) {
+  std::vector<PageToSend> sent;
   for (int round = 0; round < 100; ++round) {
     uint32_t last = 0;
-    while (auto page = p.next_page(t)) last = page->sequence, pages.push_back(page->page);
+    while (auto page = p.next_page(t)) last = page->sequence, sent.push_back(*page);
     t += 0.05;
     if (!last) break;
     p.on_message(wire::Ack{last, 0, t, 0}, t);
   }
+  return sent;
+}
+
+// The pages drain_sent sent, in order.
+std::vector<schedule::PageRef> drain(PushProtocol& p, double& t) {
+  std::vector<schedule::PageRef> pages;
+  for (const PageToSend& s : drain_sent(p, t)) pages.push_back(s.page);
   return pages;
 }
 
@@ -199,6 +206,62 @@ TEST(PushProtocol, AReleasedPageIsSentAgainWhenTheViewNeedsIt) {
   EXPECT_EQ(data(), std::vector<uint32_t>{released});
   const auto pages = uint32_t(f.dag.reader.root().pages.size());
   EXPECT_THROW(p.on_message(wire::Released{{{pages - 1, 2}}}, t), wire::WireError);
+}
+
+// A page the client keeps on disk goes out as a Restore (no page bytes on the link): one the Hello lists as
+// on disk, and one released with on_disk when the view needs it again; a Restore the client could not load (a
+// Released without on_disk) is followed at once by the page's bytes.
+TEST(PushProtocol, APageTheClientKeepsOnDiskIsRestoredNotSentAgain) {
+  Fixture f;
+  PushProtocolOptions options;
+  options.fill_when_idle = false;
+  const wire::ViewUpdate v = view({2, 0, 3}, {0, 0, -1});
+  std::vector<PageToSend> baseline;
+  {
+    PushProtocol p(f.package, options);
+    p.on_message(hello(), 0.0);
+    p.on_message(v, 0.0);
+    double t = 0.0;
+    baseline = drain_sent(p, t);
+  }
+  std::vector<uint32_t> data;
+  for (const PageToSend& s : baseline)
+    if (s.page.kind == PageKind::data) data.push_back(s.page.id);
+  ASSERT_GE(data.size(), 2u);
+  const uint32_t kept = data.front();
+
+  PushProtocol p(f.package, options);
+  wire::Hello h = hello();
+  h.cached_hash = f.dag.reader.header().content_hash;
+  h.on_disk = {{kept, 1}};
+  p.on_message(h, 0.0);
+  p.on_message(v, 0.0);
+  double t = 0.0;
+  const std::vector<PageToSend> sent = drain_sent(p, t);
+  ASSERT_EQ(sent.size(), baseline.size());  // the same pages, the one on disk as a Restore
+  uint64_t page_bytes = 0;
+  for (const PageToSend& s : sent) {
+    EXPECT_EQ(s.restore, s.page.kind == PageKind::data && s.page.id == kept) << s.page.id;
+    if (!s.restore) page_bytes += s.page.bytes;
+  }
+  EXPECT_EQ(p.counters().restores, 1u);
+  EXPECT_EQ(p.counters().bytes_sent, page_bytes);
+
+  // Released and kept on disk: when it is due again, a Restore.
+  const uint32_t other = data.back();
+  p.on_message(wire::Released{{{other, 1}}, true}, t);
+  t += 0.3;
+  std::vector<PageToSend> again = drain_sent(p, t);
+  ASSERT_EQ(again.size(), 1u);
+  EXPECT_EQ(again[0].page.id, other);
+  EXPECT_TRUE(again[0].restore);
+  // The client could not load it: the bytes follow without a hold-off.
+  p.on_message(wire::Released{{{other, 1}}, false}, t);
+  again = drain_sent(p, t);
+  ASSERT_EQ(again.size(), 1u);
+  EXPECT_EQ(again[0].page.id, other);
+  EXPECT_FALSE(again[0].restore);
+  EXPECT_EQ(p.counters().restores, 2u);
 }
 
 // A client whose cache is smaller than the view's cut needs is sent a coarser cut that its cache affords,

@@ -14,6 +14,7 @@ Hello hello() {
   h.package = "city";
   h.cached_hash.low = 7;
   h.held = {{0, 10}, {12, 1}, {100, 50}};
+  h.on_disk = {{10, 2}, {13, 4}};
   h.cache_budget_bytes = 256u << 20;
   h.triangles_per_frame = 2'000'000;
   h.viewport_width = 1280, h.viewport_height = 720;
@@ -38,7 +39,9 @@ TEST(Wire, EveryMessageRoundTrips) {
                                 Welcome{{1, 2}, 99999, 17},
                                 Page{5, 9, 1.5, {1, 2, 3, 4, 5}},
                                 Bye{"cache full"},
-                                Released{{{3, 2}, {9, 1}}}};
+                                Released{{{3, 2}, {9, 1}}},
+                                Released{{{4, 1}}, true},
+                                Restore{6, 11, 2.75}};
   for (const auto& m : messages) {
     auto frame = encode(m);
     Message back = decode(frame);
@@ -49,12 +52,18 @@ TEST(Wire, EveryMessageRoundTrips) {
   EXPECT_EQ(h.package, "city");
   EXPECT_EQ(h.held.size(), 3u);
   EXPECT_EQ(h.held[2].count, 50u);
+  ASSERT_EQ(h.on_disk.size(), 2u);
+  EXPECT_EQ(h.on_disk[1].first, 13u);
+  EXPECT_TRUE(std::get<Released>(decode(encode(Released{{{4, 1}}, true}))).on_disk);
+  EXPECT_FALSE(std::get<Released>(decode(encode(Released{{{4, 1}}, false}))).on_disk);
+  EXPECT_EQ(std::get<Restore>(decode(encode(Restore{6, 11, 2.75}))).page_id, 11u);
   EXPECT_EQ(std::get<Page>(decode(encode(Page{5, 9, 1.5, {1, 2, 3}}))).bytes,
             (std::vector<uint8_t>{1, 2, 3}));
 }
 
 TEST(Wire, EveryTruncationIsAnError) {
-  for (const auto& m : std::vector<Message>{hello(), view(), Page{1, 2, 3.0, std::vector<uint8_t>(100, 9)}}) {
+  for (const auto& m : std::vector<Message>{hello(), view(), Page{1, 2, 3.0, std::vector<uint8_t>(100, 9)},
+                                            Released{{{1, 2}}, true}, Restore{1, 2, 3.0}}) {
     auto frame = encode(m);
     for (size_t n = 0; n < frame.size(); ++n) {
       // Fix up the length field so the payload parser, not only the length check, sees the cut.
@@ -108,6 +117,12 @@ TEST(Wire, InvalidFieldsAreNamed) {
   expect_error(frame, "held runs count");
   expect_error(encode(Released{}), "released runs");                  // nothing released
   expect_error(encode(Released{{{4, 2}, {5, 1}}}), "released runs");  // overlapping
+  frame = encode(Released{{{4, 2}}, true});
+  frame.back() = 2;
+  expect_error(frame, "on-disk flag");
+  h = hello();
+  h.on_disk = {{3, 0}};
+  expect_error(encode(h), "on-disk runs");  // an empty run
 }
 
 TEST(Wire, RandomBytesNeverCrash) {
