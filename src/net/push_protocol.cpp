@@ -41,7 +41,7 @@ std::optional<wire::Message> PushProtocol::on_message(const wire::Message& messa
       hold(hello->held_index, PageKind::index, reader.root().index_pages.size());
       for (const auto& run : hello->on_disk)
         for (uint64_t p = run.first; p < uint64_t(run.first) + run.count && p < on_disk_.size(); ++p)
-          on_disk_[p] = true;
+          set_on_disk(uint32_t(p), true);
     }
     cache_budget_ = hello->cache_budget_bytes;
     triangle_budget_ = schedule::affordable_triangles(reader.root(), cache_budget_);
@@ -86,7 +86,7 @@ std::optional<wire::Message> PushProtocol::on_message(const wire::Message& messa
                               std::to_string(count));
       for (uint32_t p = run.first; p < run.first + run.count; ++p) {
         const bool restore_failed = on_disk_[p] && !released->on_disk;
-        on_disk_[p] = released->on_disk;
+        set_on_disk(p, released->on_disk);
         if (!scheduler_.held(PageKind::data, p) || released_[p]) continue;
         held_bytes_ -= reader().root().pages[p].raw_size;
         released_[p] = true;
@@ -161,19 +161,24 @@ std::optional<PageToSend> PushProtocol::next_page(double now_s) {
   if (planned_.empty() || backoff_.due_by(now_s))
     plan(now_s, uint64_t(options_.plan_windows * double(window)));
   if (planned_.empty()) return std::nullopt;
-  const PageRef page = planned_.front();
+  const PageRef page = scheduler_.page(planned_.front().kind, planned_.front().id);  // priced as of now
   planned_.pop_front();
   if (in_flight == 0) last_progress_s_ = now_s;  // the acknowledgement clock starts with the first page out
   ++sequence_;
   const bool restore = page.kind == PageKind::data && on_disk_[page.id];
-  static const uint64_t restore_bytes = wire::encode(wire::Restore{}).size();
-  link_.on_send(sequence_, restore ? restore_bytes : page.bytes, now_s, planned_.empty());
+  link_.on_send(sequence_, page.bytes, now_s, planned_.empty());  // a restore's cost is its message
   mark_sent(page);
   ++counters_.pages_sent;
   counters_.bytes_sent += restore ? 0 : page.bytes;
   counters_.restores += restore;
   counters_.index_pages_sent += page.kind == PageKind::index;
   return PageToSend{sequence_, page, now_s, restore};
+}
+
+void PushProtocol::set_on_disk(uint32_t page, bool on_disk) {
+  static const uint32_t restore_bytes = uint32_t(wire::encode(wire::Restore{}).size());
+  on_disk_[page] = on_disk;
+  scheduler_.set_cost(page, on_disk ? restore_bytes : reader().root().pages[page].size);
 }
 
 void PushProtocol::mark_sent(const PageRef& page) {

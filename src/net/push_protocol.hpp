@@ -23,7 +23,8 @@
 // (schedule/cache_budget.hpp). Pages the client released are sent again only when the scheduler picks them
 // for a view, after a hold-off that doubles with each release of the page (schedule/release_backoff.hpp).
 // A page the client keeps on disk (Hello's on_disk, a Released with on_disk) goes out as a Restore, a
-// 24-byte message that has the client load it from its disk, instead of its bytes; a Released without
+// 24-byte message that has the client load it from its disk, instead of its bytes, and the plan prices it so
+// (benefit per byte: a view coming back gets what the disk holds first); a Released without
 // on_disk for such a page (the client could not load it) makes it due again at once, as bytes.
 //
 // Time is the caller's (seconds on any monotonic clock). Cost: a plan is one PageScheduler::next (one cut per
@@ -120,6 +121,8 @@ class PushProtocol {
  private:
   void plan(double now_s, uint64_t bytes);
   void mark_sent(const schedule::PageRef& page);
+  // Page `page` is (or is no longer) on the client's disk: sent as a Restore, priced as one by the plan.
+  void set_on_disk(uint32_t page, bool on_disk);
   const package::PackageReader& reader() const { return *package_->reader; }
 
   std::shared_ptr<const PushPackage> package_;

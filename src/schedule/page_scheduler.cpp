@@ -289,7 +289,16 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
 }  // namespace
 
 PageScheduler::PageScheduler(const package::RootIndex& root)
-    : root_(&root), data_held_(root.pages.size(), false), index_held_(root.index_pages.size(), false) {}
+    : root_(&root), data_held_(root.pages.size(), false), index_held_(root.index_pages.size(), false) {
+  for (const package::Range& page : root.pages) data_cost_.push_back(page.size);
+}
+
+void PageScheduler::set_cost(uint32_t id, uint32_t bytes) {
+  if (id >= data_cost_.size())
+    throw Error("data page " + std::to_string(id) + " does not exist (" + std::to_string(data_cost_.size()) +
+                " pages)");
+  data_cost_[id] = bytes;
+}
 
 void PageScheduler::set_held(PageKind kind, uint32_t id, bool held) {
   std::vector<bool>& set = kind == PageKind::data ? data_held_ : index_held_;
@@ -310,7 +319,7 @@ bool PageScheduler::record_held(uint32_t id) const {
 }
 
 PageRef PageScheduler::page(PageKind kind, uint32_t id) const {
-  return {kind, id, kind == PageKind::data ? root_->pages[id].size : root_->index_pages[id].range.size};
+  return {kind, id, kind == PageKind::data ? data_cost_[id] : root_->index_pages[id].range.size};
 }
 
 uint32_t PageScheduler::index_page_of(uint32_t id) const {

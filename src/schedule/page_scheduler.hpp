@@ -81,7 +81,12 @@ class PageScheduler {
   bool record_held(uint32_t id) const;
   // Whether node `id`'s data page is held.
   bool node_held(const package::NodeRecord& record) const { return held(PageKind::data, record.page); }
+  // A page with its byte cost: its stored size, unless set_cost said otherwise.
   PageRef page(PageKind kind, uint32_t id) const;
+  // The bytes data page `id` costs to bring to the client (what next() ranks benefit per byte by and fills
+  // max_bytes with): a push server prices a page the client keeps on disk at the message that restores it.
+  // Throws lodstream::Error for a page the package does not have. Cost: O(1).
+  void set_cost(uint32_t id, uint32_t bytes);
   // The index page that holds node `id`'s record, or package::kNone for the root index.
   uint32_t index_page_of(uint32_t id) const;
 
@@ -102,6 +107,7 @@ class PageScheduler {
  private:
   const package::RootIndex* root_;
   std::vector<bool> data_held_, index_held_;
+  std::vector<uint32_t> data_cost_;
 };
 
 }  // namespace lodstream::schedule
