@@ -37,6 +37,25 @@ uint64_t cache_bytes(const ViewClientOptions& o) {
   return uint64_t(o.cache_mb * 1024 * 1024);
 }
 
+// The push hello's fields that do not depend on the package (no hash, nothing held).
+wire::Hello push_hello(const std::string& source, const ViewClientOptions& options) {
+  wire::Hello hello;
+  hello.package = split_url(source, "ws://").target.substr(1);
+  hello.cache_budget_bytes = cache_bytes(options);
+  hello.triangles_per_frame =
+      uint32_t(std::min<uint64_t>(options.budget ? options.budget : UINT32_MAX, UINT32_MAX));
+  hello.viewport_width = uint16_t(options.width);
+  hello.viewport_height = uint16_t(options.height);
+  return hello;
+}
+
+// The push session opened before the root index is read (nothing cached can be listed then), or null.
+std::unique_ptr<PushClient> early_push(const std::string& source, const ViewClientOptions& options,
+                                       PageInbox& inbox) {
+  if (!starts_with(source, "ws://") || !options.cache_dir.empty()) return nullptr;
+  return std::make_unique<PushClient>(source, push_hello(source, options), inbox);
+}
+
 }  // namespace
 
 ViewClient::ViewClient(const std::string& source, const ViewClientOptions& options)
@@ -45,6 +64,7 @@ ViewClient::ViewClient(const std::string& source, const ViewClientOptions& optio
                                              : Mode::file),
       package_dir_(mode_ == Mode::file ? std::filesystem::path(source).parent_path()
                                        : std::filesystem::path()),
+      pusher_(early_push(source, options, arrived_)),
       client_(package::PackageReader(open_source(source, mode_ != Mode::file)), cache_bytes(options)) {
   cut_options_.tau = options.pixel_error;
   cut_options_.triangle_budget =
@@ -60,17 +80,12 @@ ViewClient::ViewClient(const std::string& source, const ViewClientOptions& optio
   }
 
   if (mode_ == Mode::push) {
-    wire::Hello hello;
-    hello.package = split_url(source, "ws://").target.substr(1);
+    if (pusher_) return;
+    wire::Hello hello = push_hello(source, options);
     hello.cached_hash = client_.reader().header().content_hash;
     hello.held = wire::page_runs(client_.held(schedule::PageKind::data));
     hello.held_index = wire::page_runs(client_.held(schedule::PageKind::index));
     hello.on_disk = wire::page_runs(left_on_disk);
-    hello.cache_budget_bytes = cache_bytes(options);
-    hello.triangles_per_frame =
-        uint32_t(std::min<uint64_t>(options.budget ? options.budget : UINT32_MAX, UINT32_MAX));
-    hello.viewport_width = uint16_t(options.width);
-    hello.viewport_height = uint16_t(options.height);
     pusher_ = std::make_unique<PushClient>(source, hello, arrived_);
     return;
   }

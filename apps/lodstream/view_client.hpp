@@ -93,12 +93,16 @@ class ViewClient {
   Mode mode_;
   schedule::CutOptions cut_options_;
   std::filesystem::path package_dir_;
+  PageInbox arrived_;  // what the transport delivered, for the next frame
+  // Push: the WebSocket session. Without a cache directory it is opened before the root index is read, so
+  // that its handshake and hello overlap that read (as bench stream's simulation has it): the hello names no
+  // package hash then, and nothing is held yet.
+  std::unique_ptr<PushClient> pusher_;
   runtime::ClientPackage client_;
   std::optional<runtime::DiskCache> disk_;
   // Pulled with a disk cache: which arrivals were read back from disk (the fetcher's sources are
   // DiskFirstSources over it); null otherwise.
   std::shared_ptr<runtime::DiskPages> disk_pages_;
-  PageInbox arrived_;  // what the transport delivered, for the next frame
   std::unique_ptr<PullScheduler> puller_;
   // The baselines: a fetcher scheduled from the frame thread; `full_` for order full.
   std::unique_ptr<PullFetcher> baseline_;
@@ -106,7 +110,6 @@ class ViewClient {
   int window_ = 0;
   bool sse_ = false;
   double tau_ = 1.0;
-  std::unique_ptr<PushClient> pusher_;
 };
 
 }  // namespace lodstream::cli
