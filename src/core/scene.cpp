@@ -28,7 +28,9 @@ Bounds Scene::bounds() const {
 
 Scene make_scene(Mesh mesh, std::string name) {
   Scene scene;
-  scene.materials.push_back(Material{"default", glm::vec4(0.8f, 0.8f, 0.8f, 1.0f), ""});
+  Material material;
+  material.name = "default";  // base colour: the default grey
+  scene.materials.push_back(std::move(material));
   mesh.material = 0;
   scene.meshes.push_back(std::move(mesh));
   scene.objects.push_back(Object{std::move(name), glm::mat4(1.0f), 0});
