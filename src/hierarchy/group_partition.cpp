@@ -30,6 +30,8 @@ uint32_t morton(const glm::vec3& p, const glm::vec3& lo, const glm::vec3& extent
 
 // Up to this many clusters are grouped along the Morton curve instead of by METIS.
 constexpr size_t kMortonGroupingMax = 32;
+// Above this many clusters METIS bisects recursively instead of k-way (cost, below).
+constexpr size_t kRecursiveMin = 256;
 
 }  // namespace
 
@@ -117,12 +119,18 @@ std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> 
   std::vector<idx_t> part(n, 0);
   // METIS keeps its random generator in process-wide state (GKlib), so calls from meshes baked in parallel
   // reseeded and drew from one another's sequence: the same input gave different groupings from run to run.
-  // One call at a time keeps every partition a function of its graph (METIS is ~8 % of a bake).
+  // One call at a time keeps every partition a function of its graph.
   static std::mutex metis_mutex;
   std::lock_guard lock(metis_mutex);
-  const int status =
-      METIS_PartGraphKway(&nvtxs, &ncon, xadj.data(), adjncy.data(), vwgt.data(), nullptr, adjwgt.data(),
-                          &nparts, nullptr, nullptr, options, &objval, part.data());
+  // Above kRecursiveMin clusters, recursive bisection instead of k-way: with about n / 8 parts, k-way does
+  // not coarsen (it stops at 30 vertices per part), bisects recursively for its initial partition anyway,
+  // then refines with per-part work that dominates. Measured on triangulated grids into n / 8 parts: 1,024
+  // vertices 0.088 s k-way against 0.020 s recursive, 11,025 vertices 0.49 s against 0.076 s (recursive's
+  // edge cut 4-6 % lower). Small graphs keep k-way, whose less regular groups give a uniform mesh levels of
+  // more varied error (a 64 x 64 grid: 405 of 2,000 random cuts mix levels, 92 with recursive bisection).
+  const auto partition = n > kRecursiveMin ? METIS_PartGraphRecursive : METIS_PartGraphKway;
+  const int status = partition(&nvtxs, &ncon, xadj.data(), adjncy.data(), vwgt.data(), nullptr, adjwgt.data(),
+                               &nparts, nullptr, nullptr, options, &objval, part.data());
   if (status != METIS_OK) throw Error("cluster grouping: METIS failed with status " + std::to_string(status));
 
   groups.resize(size_t(nparts));
