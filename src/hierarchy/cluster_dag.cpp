@@ -1,6 +1,7 @@
 #include "hierarchy/cluster_dag.hpp"
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cmath>
@@ -93,7 +94,7 @@ void build_level0(Builder& b, Mesh mesh) {
 // Marks the positions of edges that no other cluster shares (the mesh's open boundary).
 void mark_open_boundary(Builder& b, std::vector<ClusterEdge>& edges) {
   b.open_boundary.assign(b.next_position_id, 0);
-  std::sort(edges.begin(), edges.end());
+  tbb::parallel_sort(edges.begin(), edges.end());
   for (size_t i = 0; i < edges.size();) {
     size_t j = i;
     while (j < edges.size() && edges[j].first == edges[i].first) ++j;

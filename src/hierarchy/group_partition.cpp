@@ -1,6 +1,7 @@
 #include "hierarchy/group_partition.hpp"
 
 #include <metis.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <mutex>
@@ -64,7 +65,7 @@ std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> 
   }
 
   // Cluster pairs sharing an edge: runs of equal edge keys.
-  std::sort(edges.begin(), edges.end());
+  tbb::parallel_sort(edges.begin(), edges.end());  // total order: the result does not depend on timing
   std::vector<std::pair<uint32_t, uint32_t>> pairs;
   for (size_t i = 0; i < edges.size();) {
     size_t j = i;
@@ -96,7 +97,7 @@ std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> 
       }
     }
   }
-  std::sort(pairs.begin(), pairs.end());
+  tbb::parallel_sort(pairs.begin(), pairs.end());
 
   // CSR graph with multiplicities as edge weights.
   std::vector<idx_t> xadj(n + 1, 0), adjncy, adjwgt, vwgt(n);

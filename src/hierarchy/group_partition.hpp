@@ -20,8 +20,8 @@ namespace lodstream::hierarchy {
 using ClusterEdge = std::pair<uint64_t, uint32_t>;
 
 // Groups of cluster numbers (0 .. triangles.size()-1), each cluster in exactly one group, no group empty.
-// `edges` is reordered. Cost: O(E log E) for the adjacency plus METIS (O(n log(n / group_clusters))), one
-// core.
+// `edges` is reordered. Cost: O(E log E) for the adjacency (sorts on every core) plus METIS
+// (O(n log(n / group_clusters)), one core, one call at a time in the process).
 std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> triangles,
                                                       std::span<const glm::vec3> centroids,
                                                       std::vector<ClusterEdge>& edges, size_t group_clusters);
