@@ -32,7 +32,7 @@ uint32_t morton(const glm::vec3& p, const glm::vec3& lo, const glm::vec3& extent
 // Up to this many clusters are grouped along the Morton curve instead of by METIS.
 constexpr size_t kMortonGroupingMax = 32;
 // Above this many clusters METIS bisects recursively instead of k-way (cost, below).
-constexpr size_t kRecursiveMin = 256;
+constexpr size_t kRecursiveMin = 64;
 
 }  // namespace
 
@@ -125,10 +125,11 @@ std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> 
   std::lock_guard lock(metis_mutex);
   // Above kRecursiveMin clusters, recursive bisection instead of k-way: with about n / 8 parts, k-way does
   // not coarsen (it stops at 30 vertices per part), bisects recursively for its initial partition anyway,
-  // then refines with per-part work that dominates. Measured on triangulated grids into n / 8 parts: 1,024
-  // vertices 0.088 s k-way against 0.020 s recursive, 11,025 vertices 0.49 s against 0.076 s (recursive's
-  // edge cut 4-6 % lower). Small graphs keep k-way, whose less regular groups give a uniform mesh levels of
-  // more varied error (a 64 x 64 grid: 405 of 2,000 random cuts mix levels, 92 with recursive bisection).
+  // then refines with per-part work that dominates. Instructions per call (callgrind, triangulated grids into
+  // n / 8 parts, k-way / recursive): 256 vertices 23 M / 5.6 M, 1,024 108 M / 27 M (11,025: 0.49 s against
+  // 0.076 s); recursive's edge cut is within 2 % or lower. Up to 64 clusters (8 groups, 4.4 M / 0.6 M) k-way
+  // stays: its less regular groups give a uniform mesh levels of more varied error (a 64-cluster grid: 405
+  // of 2,000 random cuts mix levels, 92 with recursive bisection).
   const auto partition = n > kRecursiveMin ? METIS_PartGraphRecursive : METIS_PartGraphKway;
   const int status = partition(&nvtxs, &ncon, xadj.data(), adjncy.data(), vwgt.data(), nullptr, adjwgt.data(),
                                &nparts, nullptr, nullptr, options, &objval, part.data());

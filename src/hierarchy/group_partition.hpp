@@ -1,6 +1,6 @@
 // Grouping clusters for simplification (Nanite's cluster groups): a graph with one node per cluster (weighted
 // by its triangles) and one edge per pair of clusters that share boundary edges (weighted by how many), cut
-// by METIS (recursive bisection; k-way up to 256 clusters) into parts of about `group_clusters` clusters, so
+// by METIS (recursive bisection; k-way up to 64 clusters) into parts of about `group_clusters` clusters, so
 // that a group is compact and its outer border (what stays locked) short. Clusters that share no edge with
 // any other (tiny components) are linked to their neighbours along a Morton curve over cluster centroids, so
 // that they are grouped with what is near them. Up to 32 clusters are grouped as balanced runs of the Morton
