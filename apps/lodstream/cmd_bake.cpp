@@ -34,6 +34,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <memory>
 #include <mutex>
@@ -184,6 +185,16 @@ int run_bake(const BakeArgs& args) {
   auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
+  // Wall and CPU (all threads) seconds per phase, for --json: a phase whose CPU is near its wall time ran on
+  // one core.
+  nlohmann::json phases;
+  double phase_wall = 0.0, phase_cpu = 0.0;
+  auto end_phase = [&](const char* name) {
+    const double wall = elapsed(), cpu = double(std::clock()) / CLOCKS_PER_SEC;
+    phases[name] = {{"wall_s", wall - phase_wall}, {"cpu_s", cpu - phase_cpu}};
+    phase_wall = wall, phase_cpu = cpu;
+  };
+  phase_cpu = double(std::clock()) / CLOCKS_PER_SEC;
   if (args.normal_bits < 4 || args.normal_bits > 16) throw Error("--normal-bits: must be in 4..16");
   if (args.max_grid_bits < 14 || args.max_grid_bits > 20) throw Error("--max-grid-bits: must be in 14..20");
   if (args.codec != MeshoptCodec::kId && args.codec != PredictiveCodec::kId)
@@ -191,6 +202,7 @@ int run_bake(const BakeArgs& args) {
   if (args.pm_max_triangles > kMaxPmTriangles)
     throw Error("--pm-max-triangles: must be in 0.." + std::to_string(kMaxPmTriangles));
   Scene scene = import_all(args.models);
+  end_phase("import");
   const uint64_t input_triangles = scene.triangle_count();
   const size_t unique_triangles = scene.unique_triangle_count();
   std::fprintf(stderr, "bake: %zu objects, %zu meshes, %llu triangles imported in %.2f s\n",
@@ -240,6 +252,8 @@ int run_bake(const BakeArgs& args) {
   });
   std::fprintf(stderr, "\n");
 
+  end_phase("hierarchy");
+
   // HLOD over the objects (none for a single object).
   const double hlod_start = elapsed();
   hierarchy::Hlod hlod;
@@ -278,6 +292,7 @@ int run_bake(const BakeArgs& args) {
     }
   }
   const double hlod_time = elapsed() - hlod_start;
+  end_phase("hlod");
 
   // Representations, and the node order: HLOD top levels and roots, then the other HLOD nodes, then each
   // group's input clusters, coarse levels first.
@@ -517,6 +532,7 @@ int run_bake(const BakeArgs& args) {
   EmbeddedTextures textures = embed_textures(scene.materials, writer);
   ps.materials = std::move(textures.materials);
   const WrittenPackage written = writer.finish(std::move(ps), std::move(records), root_nodes);
+  end_phase("encode_write");  // node records, encoding, pages, index, textures
   const double time_s = elapsed();
   const uint64_t rss = peak_rss_bytes();
   const double per_triangle = double(written.bytes) / double(std::max<uint64_t>(1, input_triangles));
@@ -557,6 +573,7 @@ int run_bake(const BakeArgs& args) {
                   {"abandoned", abandoned},
                   {"stalled_meshes", stalled}}},
                 {"time_s", time_s},
+                {"phases", phases},
                 {"triangles_per_s", double(input_triangles) / time_s},
                 {"peak_rss_bytes", rss}});
   } else {
@@ -608,7 +625,7 @@ const bool registered = register_command(
            "by default for a scene of two or more objects, --no-hlod turns it off");
        sub.add_flag("--json", args->json,
                     "print one JSON object: input_triangles, objects, nodes, pages, levels, bytes, time_s, "
-                    "peak_rss_bytes");
+                    "peak_rss_bytes, phases (wall and CPU seconds of import, hierarchy, hlod, encode_write)");
        return [args] { return run_bake(*args); };
      }});
 

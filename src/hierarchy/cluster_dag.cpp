@@ -1,6 +1,8 @@
 #include "hierarchy/cluster_dag.hpp"
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cmath>
@@ -69,15 +71,16 @@ void build_level0(Builder& b, Mesh mesh) {
   b.dag.input_triangles = mesh.triangle_count();
   if (mesh.indices.empty()) return;
 
+  // Welding (one core) runs beside the clusterizer, whose spatial sort is on one core too.
   std::vector<uint32_t> vertex_id(mesh.positions.size());
-  {
-    PositionIndex index(mesh.positions.size());
-    for (size_t v = 0; v < mesh.positions.size(); ++v) vertex_id[v] = index.insert(mesh.positions[v]);
-    b.next_position_id = uint32_t(index.size());
-  }
-
-  std::vector<ClusterPart> parts =
-      clusterize(mesh, b.options.max_cluster_vertices, b.options.max_cluster_triangles);
+  std::vector<ClusterPart> parts;
+  tbb::parallel_invoke(
+      [&] {
+        PositionIndex index(mesh.positions.size());
+        for (size_t v = 0; v < mesh.positions.size(); ++v) vertex_id[v] = index.insert(mesh.positions[v]);
+        b.next_position_id = uint32_t(index.size());
+      },
+      [&] { parts = clusterize(mesh, b.options.max_cluster_vertices, b.options.max_cluster_triangles); });
   b.dag.clusters.resize(parts.size());
   b.position_ids.resize(parts.size());
   tbb::parallel_for(size_t(0), parts.size(), [&](size_t c) {
@@ -93,7 +96,7 @@ void build_level0(Builder& b, Mesh mesh) {
 // Marks the positions of edges that no other cluster shares (the mesh's open boundary).
 void mark_open_boundary(Builder& b, std::vector<ClusterEdge>& edges) {
   b.open_boundary.assign(b.next_position_id, 0);
-  std::sort(edges.begin(), edges.end());
+  tbb::parallel_sort(edges.begin(), edges.end());
   for (size_t i = 0; i < edges.size();) {
     size_t j = i;
     while (j < edges.size() && edges[j].first == edges[i].first) ++j;

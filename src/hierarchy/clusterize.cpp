@@ -55,13 +55,15 @@ void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_
   constexpr uint32_t kUnset = UINT32_MAX;
   std::vector<uint32_t> local(vertices, kUnset);  // vertex -> cluster vertex number, current cluster only
   std::vector<uint32_t> in_frontier(triangles, kUnset);  // the cluster that listed it
-  std::vector<uint32_t> frontier;
-  size_t cursor = 0;  // every triangle before it is used
+  std::vector<uint32_t> frontier, ready;  // ready: frontier triangles whose corners are all in the cluster
+  size_t cursor = 0;                      // every triangle before it is used
   for (uint32_t cluster = 0;; ++cluster) {
     while (cursor < triangles && state[cursor].used) ++cursor;
     if (cursor == triangles) break;
     ClusterPart& part = parts.emplace_back();
     frontier.clear();
+    ready.clear();
+    size_t next_ready = 0;
     glm::vec3 sum(0.0f);
     auto add = [&](uint32_t t) {
       state[t].used = 1;
@@ -79,7 +81,7 @@ void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_
               if (state[n].used) continue;
               if (in_frontier[n] != cluster)
                 in_frontier[n] = cluster, state[n].shared = 0, frontier.push_back(n);
-              ++state[n].shared;
+              if (++state[n].shared == state[n].corners) ready.push_back(n);
             }
           }
         }
@@ -88,10 +90,16 @@ void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_
     };
     add(uint32_t(cursor));
     while (part.indices.size() < 3 * max_triangles) {
+      // A triangle that adds no vertex is taken first, in the order they became so (no frontier scan).
+      while (next_ready < ready.size() && state[ready[next_ready]].used) ++next_ready;
+      if (next_ready < ready.size()) {
+        add(ready[next_ready++]);
+        continue;
+      }
       const glm::vec3 center = sum / float(part.indices.size() / 3);
-      // Priority (lower first): adds no vertex (the first such is taken: it lies within the cluster's
-      // vertices, so which one matters little); is the last unused triangle of one of its vertices (left out,
-      // it would start a ragged cluster later); adds 1, 2 vertices. Ties: nearest the centroid.
+      // Priority (lower first): is the last unused triangle of one of its vertices (left out, it would start
+      // a ragged cluster later); adds 1, 2 vertices. Ties: nearest the centroid. (Adding none came first,
+      // above: such a triangle lies within the cluster's vertices, so which one matters little.)
       uint32_t best = kUnset, best_priority = UINT32_MAX;
       float best_distance = 0.0f;
       size_t kept = 0;
@@ -101,11 +109,6 @@ void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_
         if (st.used) continue;
         frontier[kept++] = t;
         const size_t added = size_t(st.corners - st.shared);
-        if (added == 0) {
-          best = t;
-          while (++i < frontier.size()) frontier[kept++] = frontier[i];
-          break;
-        }
         if (part.vertices.size() + added > max_vertices) continue;
         const uint32_t priority = st.last ? 1 : uint32_t(added) + 1;
         if (priority > best_priority) continue;

@@ -1,6 +1,7 @@
 #include "hierarchy/group_partition.hpp"
 
 #include <metis.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <mutex>
@@ -30,6 +31,8 @@ uint32_t morton(const glm::vec3& p, const glm::vec3& lo, const glm::vec3& extent
 
 // Up to this many clusters are grouped along the Morton curve instead of by METIS.
 constexpr size_t kMortonGroupingMax = 32;
+// Above this many clusters METIS bisects recursively instead of k-way (cost, below).
+constexpr size_t kRecursiveMin = 64;
 
 }  // namespace
 
@@ -62,7 +65,7 @@ std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> 
   }
 
   // Cluster pairs sharing an edge: runs of equal edge keys.
-  std::sort(edges.begin(), edges.end());
+  tbb::parallel_sort(edges.begin(), edges.end());  // total order: the result does not depend on timing
   std::vector<std::pair<uint32_t, uint32_t>> pairs;
   for (size_t i = 0; i < edges.size();) {
     size_t j = i;
@@ -94,7 +97,7 @@ std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> 
       }
     }
   }
-  std::sort(pairs.begin(), pairs.end());
+  tbb::parallel_sort(pairs.begin(), pairs.end());
 
   // CSR graph with multiplicities as edge weights.
   std::vector<idx_t> xadj(n + 1, 0), adjncy, adjwgt, vwgt(n);
@@ -117,12 +120,19 @@ std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> 
   std::vector<idx_t> part(n, 0);
   // METIS keeps its random generator in process-wide state (GKlib), so calls from meshes baked in parallel
   // reseeded and drew from one another's sequence: the same input gave different groupings from run to run.
-  // One call at a time keeps every partition a function of its graph (METIS is ~8 % of a bake).
+  // One call at a time keeps every partition a function of its graph.
   static std::mutex metis_mutex;
   std::lock_guard lock(metis_mutex);
-  const int status =
-      METIS_PartGraphKway(&nvtxs, &ncon, xadj.data(), adjncy.data(), vwgt.data(), nullptr, adjwgt.data(),
-                          &nparts, nullptr, nullptr, options, &objval, part.data());
+  // Above kRecursiveMin clusters, recursive bisection instead of k-way: with about n / 8 parts, k-way does
+  // not coarsen (it stops at 30 vertices per part), bisects recursively for its initial partition anyway,
+  // then refines with per-part work that dominates. Instructions per call (callgrind, triangulated grids into
+  // n / 8 parts, k-way / recursive): 256 vertices 23 M / 5.6 M, 1,024 108 M / 27 M (11,025: 0.49 s against
+  // 0.076 s); recursive's edge cut is within 2 % or lower. Up to 64 clusters (8 groups, 4.4 M / 0.6 M) k-way
+  // stays: its less regular groups give a uniform mesh levels of more varied error (a 64-cluster grid: 405
+  // of 2,000 random cuts mix levels, 92 with recursive bisection).
+  const auto partition = n > kRecursiveMin ? METIS_PartGraphRecursive : METIS_PartGraphKway;
+  const int status = partition(&nvtxs, &ncon, xadj.data(), adjncy.data(), vwgt.data(), nullptr, adjwgt.data(),
+                               &nparts, nullptr, nullptr, options, &objval, part.data());
   if (status != METIS_OK) throw Error("cluster grouping: METIS failed with status " + std::to_string(status));
 
   groups.resize(size_t(nparts));

@@ -1,10 +1,11 @@
 // Grouping clusters for simplification (Nanite's cluster groups): a graph with one node per cluster (weighted
 // by its triangles) and one edge per pair of clusters that share boundary edges (weighted by how many), cut
-// by METIS's k-way partitioning into parts of about `group_clusters` clusters, so that a group is compact and
-// its outer border (what stays locked) short. Clusters that share no edge with any other (tiny components)
-// are linked to their neighbours along a Morton curve over cluster centroids, so that they are grouped with
-// what is near them. Up to 32 clusters are grouped as balanced runs of the Morton order of their centroids
-// instead (METIS holds process-wide random state, so its calls are serialised; small graphs are most calls).
+// by METIS (recursive bisection; k-way up to 64 clusters) into parts of about `group_clusters` clusters, so
+// that a group is compact and its outer border (what stays locked) short. Clusters that share no edge with
+// any other (tiny components) are linked to their neighbours along a Morton curve over cluster centroids, so
+// that they are grouped with what is near them. Up to 32 clusters are grouped as balanced runs of the Morton
+// order of their centroids instead (METIS holds process-wide random state, so its calls are serialised; small
+// graphs are most calls).
 #pragma once
 
 #include <cstdint>
@@ -19,7 +20,8 @@ namespace lodstream::hierarchy {
 using ClusterEdge = std::pair<uint64_t, uint32_t>;
 
 // Groups of cluster numbers (0 .. triangles.size()-1), each cluster in exactly one group, no group empty.
-// `edges` is reordered. Cost: O(E log E) for the adjacency plus METIS (about linear), one core.
+// `edges` is reordered. Cost: O(E log E) for the adjacency (sorts on every core) plus METIS
+// (O(n log(n / group_clusters)), one core, one call at a time in the process).
 std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> triangles,
                                                       std::span<const glm::vec3> centroids,
                                                       std::vector<ClusterEdge>& edges, size_t group_clusters);

@@ -125,16 +125,28 @@ WrittenPackage PackageWriter::finish(PackageScene scene, std::vector<NodeRecord>
   root.blobs = std::move(blobs_);
   root.node_count = uint32_t(nodes.size());
   WrittenPackage written;
-  for (uint32_t first = root_nodes; first < nodes.size(); first += options_.nodes_per_index_page) {
-    uint32_t count = std::min<uint32_t>(options_.nodes_per_index_page, uint32_t(nodes.size()) - first);
-    std::vector<uint8_t> raw = serialize_nodes(std::span(nodes).subspan(first, count), first);
-    if (raw.size() > kMaxIndexPageRawBytes)
+  // Index pages: serialized, checked by the reader's parser and compressed on every core, written in order.
+  const uint32_t per_page = options_.nodes_per_index_page;
+  const size_t index_pages = (nodes.size() - root_nodes + per_page - 1) / per_page;
+  std::vector<std::vector<uint8_t>> raw(index_pages), stored(index_pages);
+  auto page_first = [&](size_t k) { return root_nodes + uint32_t(k) * per_page; };
+  auto page_count = [&](size_t k) {
+    return std::min<uint32_t>(per_page, uint32_t(nodes.size()) - page_first(k));
+  };
+  tbb::parallel_for(size_t(0), index_pages, [&](size_t k) {
+    raw[k] = serialize_nodes(std::span(nodes).subspan(page_first(k), page_count(k)), page_first(k));
+    if (raw[k].size() > kMaxIndexPageRawBytes)
       throw Error(name + ": index page too large; use fewer nodes per page");
-    parse_nodes(raw, root, first, count, name + ": index page as written");  // the reader's validation
-    std::vector<uint8_t> stored = zstd_compress(raw, options_.zstd_level);
-    root.index_pages.push_back({write_stored(stored, uint32_t(raw.size())), first, count});
-    written.index_bytes += stored.size();
+    parse_nodes(raw[k], root, page_first(k), page_count(k), name + ": index page as written");
+    stored[k] = zstd_compress(raw[k], options_.zstd_level);
+  });
+  for (size_t k = 0; k < index_pages; ++k) {
+    root.index_pages.push_back(
+        {write_stored(stored[k], uint32_t(raw[k].size())), page_first(k), page_count(k)});
+    written.index_bytes += stored[k].size();
   }
+  raw = {};
+  stored = {};
   nodes.resize(root_nodes);
   root.root_nodes = std::move(nodes);
   std::vector<uint8_t> raw_root = serialize_root(root);

@@ -1,13 +1,14 @@
 // PackageWriter: streams nodes' encoded bytes into zstd-compressed data pages of a new .lods file, then
-// writes the index pages, the root index and the header, and renames the file into place. Pages are
-// compressed 16 at a time in parallel (TBB). Until finish() returns, only a temporary file next to the target
-// exists (removed by the destructor if finish() was not reached), so an interrupted bake never leaves a
-// broken package.
+// writes the index pages, the root index and the header, and renames the file into place. Data pages are
+// compressed 16 at a time in parallel (TBB), index pages all at once. Until finish() returns, only a
+// temporary file next to the target exists (removed by the destructor if finish() was not reached), so an
+// interrupted bake never leaves a broken package.
 //
 // Page packing follows the caller: nodes added between two end_group() calls form a group (a DAG group's
 // clusters, a subtree's coarse levels); groups are appended in call order and a page is closed before a group
 // that would overflow it, so a group is split only when it alone exceeds the page size. Memory: 17 pages and
-// one group of encoded bytes, plus the node records given to finish() — never the whole geometry.
+// one group of encoded bytes, plus the node records given to finish() and their index pages — never the
+// whole geometry.
 //
 // Typical use (encoding may run in parallel; adding is serial):
 //   PackageWriter w("scene.lods");

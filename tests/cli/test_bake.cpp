@@ -49,6 +49,15 @@ TEST(CliBake, ElephantBuildsAVerifiedHierarchy) {
   EXPECT_EQ(j["objects"].get<size_t>(), 1u);
   EXPECT_GE(j["levels"].get<int>(), 3);
   EXPECT_GT(j["nodes"].get<int>(), 44);  // more than the full-resolution clusters alone
+  // The phases split the whole bake: their wall times add up to time_s.
+  double wall = 0.0;
+  for (const char* phase : {"import", "hierarchy", "hlod", "encode_write"}) {
+    ASSERT_TRUE(j["phases"].contains(phase)) << phase;
+    EXPECT_GE(j["phases"][phase]["wall_s"].get<double>(), 0.0) << phase;
+    EXPECT_GE(j["phases"][phase]["cpu_s"].get<double>(), 0.0) << phase;
+    wall += j["phases"][phase]["wall_s"].get<double>();
+  }
+  EXPECT_NEAR(wall, j["time_s"].get<double>(), 0.01);
 }
 
 TEST(CliBake, BothNodeCodecsVerifyAndCodecTwoIsSmaller) {
