@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstring>
 #include <map>
+#include <numeric>
 #include <set>
 
 #include "core/error.hpp"
@@ -67,7 +68,7 @@ struct Run {
   uint32_t face;
   uint32_t key;
   size_t triangles = 0;  // counted after triangulation
-  size_t offset = 0;     // first triangle in the key's mesh
+  size_t corner = 0;     // its first corner in the chunk's triangles
 };
 
 // One output mesh: the faces of one shape (an `o` / `g` section) that use one material.
@@ -76,6 +77,7 @@ struct Key {
   int material;  // -1: none
   std::string name;
   size_t triangles = 0;
+  std::vector<std::pair<uint32_t, uint32_t>> runs;  // (chunk, run) in file order
 };
 
 // The reader's state between faces, advanced over the events of every chunk in file order: what tinyobjloader
@@ -243,8 +245,10 @@ Scene read_obj(const std::filesystem::path& path, size_t chunk_bytes) {
   // 1. Parse the chunks in parallel.
   const auto pieces = cut(map.data(), map.size(), chunk_bytes);
   std::vector<ObjChunk> chunks(pieces.size());
-  tbb::parallel_for(size_t(0), pieces.size(),
-                    [&](size_t c) { chunks[c] = parse_obj_chunk(pieces[c].first, pieces[c].second); });
+  tbb::parallel_for(size_t(0), pieces.size(), [&](size_t c) {
+    chunks[c] = parse_obj_chunk(pieces[c].first, pieces[c].second);
+    map.release(pieces[c].first, pieces[c].second);  // the file would double the memory
+  });
 
   // 2. In file order: line numbers, the first error, vertex numbering, and the state between faces.
   const size_t n = chunks.size();
@@ -350,13 +354,18 @@ Scene read_obj(const std::filesystem::path& path, size_t chunk_bytes) {
           std::to_string(first_line[c] + obj_face_line(pieces[c].first, pieces[c].second, error_face[c])) +
           ": " + errors[c]);
 
-  // 4. Meshes: one per key that has triangles, in order of first use; each run's place in its mesh.
+  // 4. Meshes: one per key that has triangles, in order of first use.
   std::vector<Key>& keys = stitcher.keys();
-  for (auto& r : runs)
-    for (Run& run : r) {
-      run.offset = keys[run.key].triangles;
+  for (size_t c = 0; c < n; ++c) {
+    size_t corner = 0;
+    for (size_t r = 0; r < runs[c].size(); ++r) {
+      Run& run = runs[c][r];
+      run.corner = corner;
+      corner += 3 * run.triangles;
       keys[run.key].triangles += run.triangles;
+      keys[run.key].runs.emplace_back(static_cast<uint32_t>(c), static_cast<uint32_t>(r));
     }
+  }
   const auto& materials = stitcher.materials();
   Scene scene;
   for (const auto& m : materials) {
@@ -368,7 +377,7 @@ Scene read_obj(const std::filesystem::path& path, size_t chunk_bytes) {
   }
   const uint32_t default_material = static_cast<uint32_t>(scene.materials.size());
   bool default_used = false;
-  std::vector<uint32_t> mesh_of_key(keys.size(), UINT32_MAX);
+  std::vector<const Key*> mesh_keys;
   for (size_t i = 0; i < keys.size(); ++i) {
     const Key& key = keys[i];
     if (key.triangles == 0) continue;
@@ -379,61 +388,54 @@ Scene read_obj(const std::filesystem::path& path, size_t chunk_bytes) {
     std::string name = key.name.empty() ? path.stem().string() : key.name;
     if (in_shape > 0)
       name += "/" + (key.material < 0 ? std::string("default") : materials[key.material].name);
-    mesh_of_key[i] = static_cast<uint32_t>(scene.meshes.size());
-    scene.objects.push_back(Object{std::move(name), glm::mat4(1.0f), mesh_of_key[i]});
-    Mesh& mesh = scene.meshes.emplace_back();
-    const size_t corners = 3 * key.triangles;
-    mesh.positions.resize(corners);
-    if (nvn > 0) mesh.normals.resize(corners);
-    if (nvt > 0) mesh.uvs.resize(corners);
-    if (colors) mesh.colors.resize(corners);
-    mesh.indices.resize(corners);
-    mesh.material = key.material < 0 ? default_material : static_cast<uint32_t>(key.material);
+    scene.objects.push_back(
+        Object{std::move(name), glm::mat4(1.0f), static_cast<uint32_t>(mesh_keys.size())});
+    mesh_keys.push_back(&key);
     default_used |= key.material < 0;
   }
   if (default_used) scene.materials.emplace_back().name = "default";  // base colour 0.8 grey
 
-  // 5. Fill the meshes, each run its own range, per chunk in parallel. A normal or UV is kept per corner; a
+  // 5. Fill the meshes in parallel, each from its runs in file order. A normal or UV is kept per corner; a
   // mesh where some corner lacks one loses that attribute.
-  std::vector<uint8_t> missing_normal(scene.meshes.size(), 0), missing_uv(scene.meshes.size(), 0);
-  tbb::parallel_for(size_t(0), n, [&](size_t c) {
-    const std::vector<ObjCorner>& k = chunks[c].corners;
-    size_t corner = 0;
-    for (const Run& run : runs[c]) {
-      Mesh& mesh = scene.meshes[mesh_of_key[run.key]];
-      bool no_normal = false, no_uv = false;
-      for (size_t t = 0; t < 3 * run.triangles; ++t, ++corner) {
-        const ObjCorner& x = k[corner];
-        const size_t out = 3 * run.offset + t;
-        mesh.positions[out] = glm::vec3(positions[3 * size_t(x.v)], positions[3 * size_t(x.v) + 1],
-                                        positions[3 * size_t(x.v) + 2]);
-        if (nvn > 0) {
-          no_normal |= x.vn < 0;
-          if (x.vn >= 0)
-            mesh.normals[out] = glm::vec3(normals[3 * size_t(x.vn)], normals[3 * size_t(x.vn) + 1],
-                                          normals[3 * size_t(x.vn) + 2]);
+  scene.meshes.resize(mesh_keys.size());
+  tbb::parallel_for(size_t(0), mesh_keys.size(), [&](size_t m) {
+    const Key& key = *mesh_keys[m];
+    Mesh& mesh = scene.meshes[m];
+    mesh.material = key.material < 0 ? default_material : static_cast<uint32_t>(key.material);
+    const size_t corners = 3 * key.triangles;
+    mesh.positions.reserve(corners);
+    mesh.indices.resize(corners);
+    std::iota(mesh.indices.begin(), mesh.indices.end(), 0u);
+    bool keep_normals = nvn > 0, keep_uvs = nvt > 0;
+    if (keep_normals) mesh.normals.reserve(corners);
+    if (keep_uvs) mesh.uvs.reserve(corners);
+    if (colors) mesh.colors.reserve(corners);
+    for (auto [c, r] : key.runs) {
+      const Run& run = runs[c][r];
+      const ObjCorner* x = chunks[c].corners.data() + run.corner;
+      const ObjCorner* end = x + 3 * run.triangles;
+      for (; x != end; ++x) {
+        const float* p = &positions[3 * size_t(x->v)];
+        mesh.positions.emplace_back(p[0], p[1], p[2]);
+        if (keep_normals) {
+          keep_normals = x->vn >= 0;
+          const float* q = &normals[3 * size_t(std::max(x->vn, 0))];
+          mesh.normals.emplace_back(q[0], q[1], q[2]);
         }
-        if (nvt > 0) {
-          no_uv |= x.vt < 0;
-          if (x.vt >= 0)
-            mesh.uvs[out] = glm::vec2(texcoords[2 * size_t(x.vt)], texcoords[2 * size_t(x.vt) + 1]);
+        if (keep_uvs) {
+          keep_uvs = x->vt >= 0;
+          const float* t = &texcoords[2 * size_t(std::max(x->vt, 0))];
+          mesh.uvs.emplace_back(t[0], t[1]);
         }
         if (colors) {
-          const float* rgb = &vertex_colors[3 * size_t(x.v)];
-          mesh.colors[out] = glm::vec4(rgb[0], rgb[1], rgb[2], 1.0f);
+          const float* rgb = &vertex_colors[3 * size_t(x->v)];
+          mesh.colors.emplace_back(rgb[0], rgb[1], rgb[2], 1.0f);
         }
-        mesh.indices[out] = static_cast<uint32_t>(out);
       }
-      // Distinct runs of one mesh may set these at once: relaxed byte stores of the same value.
-      if (no_normal) __atomic_store_n(&missing_normal[mesh_of_key[run.key]], 1, __ATOMIC_RELAXED);
-      if (no_uv) __atomic_store_n(&missing_uv[mesh_of_key[run.key]], 1, __ATOMIC_RELAXED);
     }
-    chunks[c].corners = {};
+    if (!keep_normals) mesh.normals = {};
+    if (!keep_uvs) mesh.uvs = {};
   });
-  for (size_t m = 0; m < scene.meshes.size(); ++m) {
-    if (missing_normal[m]) scene.meshes[m].normals = {};
-    if (missing_uv[m]) scene.meshes[m].uvs = {};
-  }
   return scene;
 }
 
