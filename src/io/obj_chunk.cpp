@@ -188,8 +188,15 @@ std::pair<const char*, const char*> line_end(const char* p, const char* end) {
 
 }  // namespace
 
-ObjChunk parse_obj_chunk(const char* begin, const char* end) {
-  ObjChunk chunk;
+void parse_obj_chunk(const char* begin, const char* end, ObjChunk& chunk) {
+  for (auto* v : {&chunk.positions, &chunk.colors, &chunk.texcoords, &chunk.normals}) v->clear();
+  chunk.corners.clear();
+  chunk.polygons.clear();
+  chunk.relative.clear();
+  chunk.events.clear();
+  chunk.faces = chunk.lines = chunk.error_line = chunk.warning_line = 0;
+  chunk.error.clear();
+  chunk.warning.clear();
   ChunkParser parser(chunk);
   try {
     for (const char* p = begin; p < end;) {
@@ -203,7 +210,6 @@ ObjChunk parse_obj_chunk(const char* begin, const char* end) {
     chunk.error = e.reason;
     chunk.error_line = chunk.lines;
   }
-  return chunk;
 }
 
 uint32_t obj_face_line(const char* begin, const char* end, uint32_t face) {

@@ -48,8 +48,9 @@ struct ObjChunk {
 // Parses the whole lines in [begin, end) the way the OBJ format (and tinyobjloader before this reader) reads
 // them: `v` (with optional r g b), `vt` (v defaults to 0), `vn`, `f` with `i`, `i/j`, `i//k` or `i/j/k`
 // corners (negative: relative to the vertices read so far), `o`, `g`, `usemtl`, `mtllib`; `#` lines,
-// `l`, `p`, `s` and unknown keywords are ignored. A bad number or index sets `error`. Cost: O(end - begin).
-ObjChunk parse_obj_chunk(const char* begin, const char* end);
+// `l`, `p`, `s` and unknown keywords are ignored. A bad number or index sets `error`. `chunk` is cleared
+// first, keeping its arrays' capacity. Cost: O(end - begin).
+void parse_obj_chunk(const char* begin, const char* end, ObjChunk& chunk);
 
 // The line (within the chunk [begin, end), which parsed without error) of its face number `face`.
 // Cost: O(end - begin).
