@@ -38,6 +38,14 @@ void expect_same_scene(const Scene& a, const Scene& b, size_t chunk_bytes) {
   }
 }
 
+// An attribute per corner, through the mesh's indices.
+template <class T>
+std::vector<T> at_corners(const Mesh& mesh, const std::vector<T>& attribute) {
+  std::vector<T> out;
+  for (uint32_t i : mesh.indices) out.push_back(attribute.at(i));
+  return out;
+}
+
 // Reads `file` with chunks of every size from 1 byte to the whole file: all must equal the one-chunk read,
 // which is returned.
 Scene read_with_every_chunk_size(const std::filesystem::path& file) {
@@ -94,24 +102,28 @@ TEST(ObjReader, ObjectsMaterialsRelativeIndicesAndQuadsAcrossChunkBorders) {
   const Mesh& wall_red = s.meshes[s.objects[0].mesh];
   EXPECT_EQ(wall_red.material, 0u);
   const std::vector<glm::vec3> quad = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 0, 0}, {3, 1, 0}, {0, 1, 0}};
-  EXPECT_EQ(wall_red.positions, quad);
-  EXPECT_EQ(wall_red.uvs, (std::vector<glm::vec2>{{0, 0}, {1, 0}, {0, 0}, {1, 0}, {1, 1}, {0, 0}}));
-  EXPECT_EQ(wall_red.normals, std::vector<glm::vec3>(6, glm::vec3(0, 0, 1)));
-  EXPECT_EQ(wall_red.indices, (std::vector<uint32_t>{0, 1, 2, 3, 4, 5}));
+  EXPECT_EQ(at_corners(wall_red, wall_red.positions), quad);
+  EXPECT_EQ(at_corners(wall_red, wall_red.uvs),
+            (std::vector<glm::vec2>{{0, 0}, {1, 0}, {0, 0}, {1, 0}, {1, 1}, {0, 0}}));
+  EXPECT_EQ(at_corners(wall_red, wall_red.normals), std::vector<glm::vec3>(6, glm::vec3(0, 0, 1)));
+  // One vertex per distinct corner, in order of first use.
+  EXPECT_EQ(wall_red.indices, (std::vector<uint32_t>{0, 1, 2, 1, 3, 2}));
 
   const Mesh& wall_blue = s.meshes[s.objects[1].mesh];
   EXPECT_EQ(wall_blue.material, 1u);
-  EXPECT_EQ(wall_blue.positions, (std::vector<glm::vec3>{{0, 0, 0}, {1, 0, 0}, {3, 1, 0}}));
-  EXPECT_EQ(wall_blue.uvs, (std::vector<glm::vec2>{{0, 0}, {1, 0}, {1, 1}}));
+  EXPECT_EQ(at_corners(wall_blue, wall_blue.positions),
+            (std::vector<glm::vec3>{{0, 0, 0}, {1, 0, 0}, {3, 1, 0}}));
+  EXPECT_EQ(at_corners(wall_blue, wall_blue.uvs), (std::vector<glm::vec2>{{0, 0}, {1, 0}, {1, 1}}));
 
   const Mesh& floor_blue = s.meshes[s.objects[2].mesh];
-  EXPECT_EQ(floor_blue.positions,
+  EXPECT_EQ(at_corners(floor_blue, floor_blue.positions),
             (std::vector<glm::vec3>{{0, 0, 2}, {3, 0, 2}, {1, 1, 2}, {0, 0, 2}, {1, 1, 2}, {0, 1, 2}}));
+  EXPECT_EQ(floor_blue.positions.size(), 4u);
   EXPECT_TRUE(floor_blue.normals.empty());  // no corner has one
   EXPECT_TRUE(floor_blue.uvs.empty());
 
   const Mesh& floor_red = s.meshes[s.objects[3].mesh];  // -1 -2 -3 after 8 vertices, then `f 1 2 4`
-  EXPECT_EQ(floor_red.positions,
+  EXPECT_EQ(at_corners(floor_red, floor_red.positions),
             (std::vector<glm::vec3>{{0, 1, 2}, {1, 1, 2}, {3, 0, 2}, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
 }
 
@@ -128,20 +140,20 @@ TEST(ObjReader, ColoursGroupNamesAndPolygons) {
   const Mesh& m = s.meshes[0];
   ASSERT_EQ(m.indices.size(), 12u);  // the pentagon in 3 triangles, then one
   // The pentagon's triangles cover it: their areas sum to its area, 8 (shoelace formula).
+  const std::vector<glm::vec3> p = at_corners(m, m.positions);
   float area = 0;
   for (size_t t = 0; t < 3; ++t) {
-    const glm::vec3 e1 = m.positions[3 * t + 1] - m.positions[3 * t],
-                    e2 = m.positions[3 * t + 2] - m.positions[3 * t];
+    const glm::vec3 e1 = p[3 * t + 1] - p[3 * t], e2 = p[3 * t + 2] - p[3 * t];
     area += 0.5f * std::abs(e1.x * e2.y - e1.y * e2.x);
   }
   EXPECT_FLOAT_EQ(area, 8.0f);
-  ASSERT_EQ(m.colors.size(), 12u);  // a vertex without colour is white
-  EXPECT_EQ(m.colors[9], glm::vec4(1, 0, 0, 1));
-  EXPECT_EQ(m.colors[10], glm::vec4(0, 1, 0, 1));
-  EXPECT_EQ(m.colors[11], glm::vec4(0, 0, 1, 1));
+  EXPECT_EQ(m.positions.size(), 5u);  // the triangle reuses the pentagon's vertices
+  const std::vector<glm::vec4> colors = at_corners(m, m.colors);  // a vertex without colour is white
+  EXPECT_EQ(colors[9], glm::vec4(1, 0, 0, 1));
+  EXPECT_EQ(colors[10], glm::vec4(0, 1, 0, 1));
+  EXPECT_EQ(colors[11], glm::vec4(0, 0, 1, 1));
   bool white = false;
-  for (size_t c = 0; c < 9; ++c)
-    white |= m.positions[c] == glm::vec3(-1, 2, 0) && m.colors[c] == glm::vec4(1);
+  for (size_t c = 0; c < 9; ++c) white |= p[c] == glm::vec3(-1, 2, 0) && colors[c] == glm::vec4(1);
   EXPECT_TRUE(white);
 }
 
