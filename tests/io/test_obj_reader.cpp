@@ -132,8 +132,8 @@ TEST(ObjReader, ColoursGroupNamesAndPolygons) {
                                "v 0 0 0 1 0 0\nv 2 0 0 0 1 0\nv 3 2 0 0 0 1\nv 1 3 0 1 1 1\nv -1 2 0\n"
                                "g  a\tb  \n"
                                "f 1 2 3 4 5\n"
-                               "g\n"  // `g` alone is no group line: the group goes on
-                               "f 1 2 +3\n");
+                               "g\n"         // `g` alone is no group line: the group goes on
+                               "f 1 2 +3");  // no line break at the end
   const Scene s = read_with_every_chunk_size(file);
   ASSERT_EQ(s.objects.size(), 1u);
   EXPECT_EQ(s.objects[0].name, "a b");
