@@ -319,7 +319,6 @@ Scene read_obj(const std::filesystem::path& path, size_t chunk_bytes) {
       i = static_cast<int32_t>(i + static_cast<int64_t>(base[which]));
     }
     k.relative = {};
-    // Face of each corner, for error messages: walk the faces in order.
     auto check = [&](const ObjCorner& x, int32_t v_count, int32_t vt_count, int32_t vn_count) -> std::string {
       static const char* const names[] = {"vertex", "texture coordinate", "normal"};
       const int32_t values[3] = {x.v, x.vt, x.vn}, counts[3] = {v_count, vt_count, vn_count};
