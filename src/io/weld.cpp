@@ -1,8 +1,5 @@
 #include "io/weld.hpp"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -15,7 +12,6 @@ namespace lodstream {
 namespace {
 
 constexpr uint32_t kNone = UINT32_MAX;
-constexpr size_t kGrain = 1 << 16;  // elements per parallel task
 
 // Float bits with -0 folded into +0, so that equal values hash and compare equal.
 inline uint32_t bits(float f) {
@@ -74,9 +70,7 @@ std::vector<uint32_t> representatives(const VertexKey& key, size_t n) {
   std::vector<uint64_t> table(capacity, kEmpty);
   // Arrays that are written in full are left uninitialized (zero-filling them cost a tenth of an import).
   auto hashes = std::make_unique_for_overwrite<uint64_t[]>(n);
-  tbb::parallel_for(tbb::blocked_range<uint32_t>(0, static_cast<uint32_t>(n), kGrain), [&](const auto& r) {
-    for (uint32_t v = r.begin(); v < r.end(); ++v) hashes[v] = key.hash(v);
-  });
+  for (uint32_t v = 0; v < n; ++v) hashes[v] = key.hash(v);
   std::vector<uint32_t> rep;
   rep.reserve(n);
   const size_t mask = capacity - 1;
@@ -183,13 +177,11 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
 
   // Face normals, unnormalized: their length is twice the area, which weights the sums.
   auto face = std::make_unique_for_overwrite<glm::vec3[]>(nt);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nt, kGrain), [&](const auto& r) {
-    for (size_t t = r.begin(); t < r.end(); ++t) {
-      const uint32_t* v = &mesh.indices[3 * t];
-      face[t] = glm::cross(mesh.positions[v[1]] - mesh.positions[v[0]],
-                           mesh.positions[v[2]] - mesh.positions[v[0]]);
-    }
-  });
+  for (size_t t = 0; t < nt; ++t) {
+    const uint32_t* v = &mesh.indices[3 * t];
+    face[t] =
+        glm::cross(mesh.positions[v[1]] - mesh.positions[v[0]], mesh.positions[v[2]] - mesh.positions[v[0]]);
+  }
 
   // Corners grouped by position class (counting sort).
   std::vector<uint32_t> start(nv + 1, 0);
