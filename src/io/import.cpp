@@ -1,9 +1,12 @@
 #include "io/import.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 
 #include "core/error.hpp"
 #include "io/import_worker.hpp"
@@ -20,24 +23,30 @@ namespace {
 // Validates and welds every mesh, drops objects whose mesh has no triangles left, and meshes and materials no
 // object uses; prints one warning line per kind of repair.
 void prepare_scene(Scene& scene, const ImportOptions& options, const std::string& file) {
+  // Meshes are independent: validated and welded in parallel; the first error in mesh order is reported.
+  std::vector<std::string> what(scene.meshes.size(), file);
+  if (scene.meshes.size() > 1)
+    for (size_t o = scene.objects.size(); o-- > 0;)
+      if (scene.objects[o].mesh < what.size())
+        what[scene.objects[o].mesh] = file + " (object '" + scene.objects[o].name + "')";
+  std::vector<ValidationCounts> counts(scene.meshes.size());
+  std::vector<std::exception_ptr> errors(scene.meshes.size());
+  tbb::parallel_for(size_t(0), scene.meshes.size(), [&](size_t m) {
+    try {
+      Mesh& mesh = scene.meshes[m];
+      if (mesh.material >= scene.materials.size())
+        throw Error(what[m] + ": material index " + std::to_string(mesh.material) + " out of range");
+      counts[m] = validate_mesh(mesh, what[m]);
+      if (!mesh.indices.empty()) weld(mesh, options.crease_angle_degrees);
+    } catch (...) {
+      errors[m] = std::current_exception();
+    }
+  });
   size_t degenerate = 0, dropped_normals = 0;
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
-    Mesh& mesh = scene.meshes[m];
-    std::string what = file;
-    if (scene.meshes.size() > 1) {
-      for (const auto& o : scene.objects)
-        if (o.mesh == m) {
-          what += " (object '" + o.name + "')";
-          break;
-        }
-    }
-    if (mesh.material >= scene.materials.size())
-      throw Error(what + ": material index " + std::to_string(mesh.material) + " out of range");
-    ValidationCounts counts = validate_mesh(mesh, what);
-    degenerate += counts.degenerate_triangles;
-    dropped_normals += counts.dropped_normals;
-    if (mesh.indices.empty()) continue;
-    weld(mesh, options.crease_angle_degrees);
+    if (errors[m]) std::rethrow_exception(errors[m]);
+    degenerate += counts[m].degenerate_triangles;
+    dropped_normals += counts[m].dropped_normals;
   }
   if (degenerate > 0)
     std::fprintf(stderr, "lodstream: warning: %s: dropped %zu degenerate (zero-area) triangles\n",

@@ -34,7 +34,8 @@ struct ImportOptions {
 // Throws lodstream::Error("<file>: <reason>") on any failure (missing file, bad header, truncated data, huge
 // declared counts, NaN or infinite coordinates, out-of-range indices, no triangles at all; for assimp formats
 // "<file>: import failed: <reason>" when the worker crashes, times out, exits non-zero or returns garbage).
-// Never crashes on bad input. Cost: O(file size); about 1 s per 5M triangles of binary PLY on one core.
+// Never crashes on bad input. Cost: O(file size); about 1 s per 5M triangles of binary PLY on one core; OBJ
+// is parsed, and the meshes of a scene validated and welded, on all cores.
 Scene import_model(const std::filesystem::path& file, const ImportOptions& options = {});
 
 }  // namespace lodstream

@@ -16,6 +16,9 @@ class MappedFile {
   MappedFile& operator=(const MappedFile&) = delete;
 
   const char* data() const { return data_; }
+  // Drops the whole pages inside [begin, end) from this process's resident memory once a reader is done with
+  // them (the page cache keeps them; reading them again maps them back in). Cost: one madvise call.
+  void release(const char* begin, const char* end) const;
   size_t size() const { return size_; }
 
  private:

@@ -377,7 +377,7 @@ void read_binary(const char* data, size_t size, const Header& h, const std::stri
                 return "face " + std::to_string(f) + " at byte offset " + std::to_string(face_start);
               });
             }
-            mesh.indices.insert(mesh.indices.end(), tri, tri + 3);
+            for (uint32_t corner : tri) mesh.indices.push_back(corner);  // no memmove call per face
           } else if (is_face_list(prop)) {
             faces.polygon.resize(static_cast<size_t>(n));
             for (int64_t k = 0; k < n; ++k) {

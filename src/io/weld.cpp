@@ -4,6 +4,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <vector>
 
 namespace lodstream {
@@ -67,9 +68,11 @@ std::vector<uint32_t> representatives(const VertexKey& key, size_t n) {
   while (capacity < 2 * n) capacity *= 2;
   constexpr uint64_t kEmpty = UINT64_MAX;
   std::vector<uint64_t> table(capacity, kEmpty);
-  std::vector<uint64_t> hashes(n);
+  // Arrays that are written in full are left uninitialized (zero-filling them cost a tenth of an import).
+  auto hashes = std::make_unique_for_overwrite<uint64_t[]>(n);
   for (uint32_t v = 0; v < n; ++v) hashes[v] = key.hash(v);
-  std::vector<uint32_t> rep(n);
+  std::vector<uint32_t> rep;
+  rep.reserve(n);
   const size_t mask = capacity - 1;
   // The table is far larger than the caches: prefetching the slot of a vertex a few steps ahead keeps several
   // misses in flight instead of waiting for each.
@@ -83,11 +86,11 @@ std::vector<uint32_t> representatives(const VertexKey& key, size_t n) {
       const uint64_t e = table[slot];
       if (e == kEmpty) {
         table[slot] = (tag << 32) | v;
-        rep[v] = v;
+        rep.push_back(v);
         break;
       }
       if ((e >> 32) == tag && key.equal(static_cast<uint32_t>(e), v)) {
-        rep[v] = static_cast<uint32_t>(e);
+        rep.push_back(static_cast<uint32_t>(e));
         break;
       }
       slot = (slot + 1) & mask;
@@ -100,8 +103,9 @@ std::vector<uint32_t> representatives(const VertexKey& key, size_t n) {
 void compact(Mesh& mesh, const std::vector<uint32_t>& keep) {
   auto pick = [&keep](auto& array) {
     if (array.empty()) return;
-    std::remove_reference_t<decltype(array)> out(keep.size());
-    for (size_t i = 0; i < keep.size(); ++i) out[i] = array[keep[i]];
+    std::remove_reference_t<decltype(array)> out;
+    out.reserve(keep.size());
+    for (uint32_t k : keep) out.push_back(array[k]);
     array.swap(out);
   };
   pick(mesh.positions);
@@ -167,12 +171,12 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
   if (mesh.has_uvs() || mesh.has_colors()) {
     position = representatives(VertexKey{mesh, false, false, false}, nv);
   } else {
-    position.resize(nv);
-    for (uint32_t v = 0; v < nv; ++v) position[v] = v;
+    position.reserve(nv);
+    for (uint32_t v = 0; v < nv; ++v) position.push_back(v);
   }
 
   // Face normals, unnormalized: their length is twice the area, which weights the sums.
-  std::vector<glm::vec3> face(nt);
+  auto face = std::make_unique_for_overwrite<glm::vec3[]>(nt);
   for (size_t t = 0; t < nt; ++t) {
     const uint32_t* v = &mesh.indices[3 * t];
     face[t] =
@@ -180,7 +184,8 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
   }
 
   // Corners grouped by position class (counting sort).
-  std::vector<uint32_t> start(nv + 1, 0), corners(nc);
+  std::vector<uint32_t> start(nv + 1, 0);
+  auto corners = std::make_unique_for_overwrite<uint32_t[]>(nc);
   // The scattered counters are prefetched a few corners ahead, like the hash table in representatives.
   constexpr uint32_t kAhead = 16;
   for (uint32_t c = 0; c < nc; ++c) {

@@ -21,16 +21,21 @@ inline std::filesystem::path write_file(const std::string& name, const std::stri
   return path;
 }
 
-// The message of the lodstream::Error that importing `file` throws ("" and a test failure when none is
-// thrown).
-inline std::string import_error(const std::filesystem::path& file, const ImportOptions& options = {}) {
+// The message of the lodstream::Error that `read(file)` throws ("" and a test failure when none is thrown).
+template <class Read>
+std::string error_of(Read&& read, const std::filesystem::path& file) {
   try {
-    import_model(file, options);
+    read(file);
   } catch (const Error& e) {
     return e.what();
   }
-  ADD_FAILURE() << "importing " << file << " did not fail";
+  ADD_FAILURE() << "reading " << file << " did not fail";
   return "";
+}
+
+// The message of the lodstream::Error that importing `file` throws.
+inline std::string import_error(const std::filesystem::path& file, const ImportOptions& options = {}) {
+  return error_of([&](const std::filesystem::path& f) { import_model(f, options); }, file);
 }
 
 }  // namespace lodstream::test
