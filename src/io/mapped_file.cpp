@@ -29,7 +29,9 @@ MappedFile::MappedFile(const std::filesystem::path& file) {
       ::close(fd);
       throw Error(file.string() + ": cannot map: " + std::strerror(e));
     }
-    ::madvise(p, size_, MADV_SEQUENTIAL | MADV_WILLNEED);
+    // Two calls: the advice values are not flags (SEQUENTIAL | WILLNEED is WILLNEED alone).
+    ::madvise(p, size_, MADV_SEQUENTIAL);
+    ::madvise(p, size_, MADV_WILLNEED);
     data_ = static_cast<const char*>(p);
   }
   ::close(fd);

@@ -109,7 +109,7 @@ class Stitcher {
   void add_run(std::vector<Run>& runs, uint32_t from, uint32_t to) {
     if (to <= from) return;
     auto [it, inserted] = shape_keys_.try_emplace(material_, static_cast<uint32_t>(keys_.size()));
-    if (inserted) keys_.push_back(Key{shape_, material_, name_});
+    if (inserted) keys_.push_back(Key{shape_, material_, name_, 0, {}});
     runs.push_back(Run{from, it->second});
   }
 
