@@ -5,13 +5,13 @@
 #include <algorithm>
 #include <cstring>
 #include <iterator>
-#include <type_traits>
 
 #include "core/error.hpp"
+#include "package/byte_planes.hpp"
 #include "package/bytes.hpp"
 #include "package/coarse_positions.hpp"
 #include "package/node_header.hpp"
-#include "package/octahedral.hpp"
+#include "package/predicted_normals.hpp"
 #include "package/quantized_node.hpp"
 #include "package/vertex_attributes.hpp"
 
@@ -28,18 +28,6 @@ constexpr uint32_t kAcrossWindow = 8;
 // Decoded coarse coordinates stay within ±2^32 (valid ones within ±2^31), so no chain of predictions from
 // hostile residuals (< 2^40) overflows int64.
 constexpr int64_t kMaxCoarse = int64_t(1) << 32;
-
-uint64_t zigzag(int64_t v) {
-  return (static_cast<uint64_t>(v) << 1) ^ static_cast<uint64_t>(v >> 63);
-}
-int64_t unzigzag(uint64_t v) {
-  return static_cast<int64_t>(v >> 1) ^ -static_cast<int64_t>(v & 1);
-}
-uint32_t bytes_for(uint64_t largest) {
-  uint32_t n = 1;
-  while (n < 8 && (largest >> (8 * n)) != 0) ++n;
-  return n;
-}
 
 // Calls visit(v, o1, o2, o) for v = 0, 1, ..., V - 1 with v's predictors, all below v (decoded before it in
 // vertex order): o1 + o2 - o (parallelogram), o1 alone (o2 == kNone), or none (o1 == kNone: predict from
@@ -111,28 +99,6 @@ void parallelogram_form(uint32_t V, uint32_t& o1, uint32_t& o2, uint32_t& o) {
   if (o2 == kNone) o2 = o = o1;
 }
 
-// Area-weighted vertex normals of the node's own triangles (those whose corners are all in the node), over
-// `positions`: sum of cross(p1 - p0, p2 - p0). `index_end` bounds the indices (checked by the caller); when
-// it is first_vertex + V (every node but a progressive step) no corner lies outside and the loop tests none.
-// O(T + V).
-void predicted_normals(std::span<const uint32_t> indices, uint32_t first_vertex, uint32_t index_end,
-                       const glm::vec3* positions, uint32_t V, std::vector<glm::vec3>& sum) {
-  sum.assign(V, glm::vec3(0.0f));
-  auto accumulate = [&](auto all_inside) {
-    for (size_t i = 0; i + 2 < indices.size(); i += 3) {
-      const uint32_t a = indices[i] - first_vertex, b = indices[i + 1] - first_vertex,
-                     c = indices[i + 2] - first_vertex;
-      if (!all_inside && (a >= V || b >= V || c >= V)) continue;
-      const glm::vec3 n = glm::cross(positions[b] - positions[a], positions[c] - positions[a]);
-      sum[a] += n, sum[b] += n, sum[c] += n;
-    }
-  };
-  if (first_vertex == 0 && index_end == V)
-    accumulate(std::true_type{});
-  else
-    accumulate(std::false_type{});
-}
-
 struct Parsed : NodeHeader {
   uint32_t position_bytes = 0, normal_bytes = 0;
   size_t header_size = 0;
@@ -164,44 +130,6 @@ Parsed parse(std::span<const uint8_t> bytes, const std::string& where) {
   p.index_stream = r.bytes(index_size, "index stream");
   p.extra = r.bytes(p.extra_size, "extra bytes");
   return p;
-}
-
-// Unzigzags `count` values of `components` components each, stored as `width` byte planes (byte b of
-// component a at plane b * components + a), into out[a * count + i] (one array per component, so each loop
-// is a plain pass the compiler can vectorize). Cost: O(count * components * width).
-template <typename T>
-void read_planes(const uint8_t* planes, size_t count, uint32_t components, uint32_t width, T* out) {
-  for (uint32_t a = 0; a < components; ++a) {
-    const uint8_t* low = planes + a * count;
-    T* o = out + a * count;
-    if (width == 1) {
-      for (size_t i = 0; i < count; ++i) o[i] = T(int32_t(low[i] >> 1) ^ -int32_t(low[i] & 1));
-    } else if (width == 2) {
-      const uint8_t* high = planes + (components + a) * count;
-      for (size_t i = 0; i < count; ++i) {
-        const uint32_t z = low[i] | uint32_t(high[i]) << 8;
-        o[i] = T(int32_t(z >> 1) ^ -int32_t(z & 1));
-      }
-    } else {
-      for (size_t i = 0; i < count; ++i) {
-        uint64_t value = 0;
-        for (uint32_t b = 0; b < width; ++b)
-          value |= uint64_t(planes[(b * components + a) * count + i]) << (8 * b);
-        o[i] = T(unzigzag(value));
-      }
-    }
-  }
-}
-
-void put_planes(std::vector<uint8_t>& out, const std::vector<uint64_t>& values, uint32_t components,
-                uint32_t width) {
-  const size_t count = values.size() / components;
-  const size_t at = out.size();
-  out.resize(at + values.size() * width);
-  for (size_t i = 0; i < count; ++i)
-    for (uint32_t a = 0; a < components; ++a)
-      for (uint32_t b = 0; b < width; ++b)
-        out[at + (b * components + a) * count + i] = uint8_t(values[components * i + a] >> (8 * b));
 }
 
 }  // namespace
@@ -244,39 +172,16 @@ std::vector<uint8_t> PredictiveCodec::encode(const NodeGeometry& g, const Positi
   const uint32_t position_bytes = bytes_for(largest);
 
   // Normal residuals against the prediction from the decoded positions.
-  std::vector<uint64_t> normal_residuals;
+  const std::vector<uint8_t> locked_stream = encode_locked_stream(n, k);
+  std::vector<uint64_t> normal_planes;
   uint32_t normal_bytes = 0;
   if (flags & kHasNormals) {
-    const std::vector<uint8_t> locked = encode_locked_stream(n, k);
     std::vector<glm::vec3> decoded(V), sum;
-    decode_positions(n.c, LockedStream::parse(locked, V, k, "node codec"), grid, decoded.data());
+    decode_positions(n.c, LockedStream::parse(locked_stream, V, k, "node codec"), grid, decoded.data());
     predicted_normals(seen, g.first_vertex, n.index_end, decoded.data(), V, sum);
-    normal_residuals.resize(2 * size_t(V));
-    largest = 0;
-    for (uint32_t v = 0; v < V; ++v) {
-      const glm::ivec2 truth = oct_encode(m.normals[n.order[v]], int(g.normal_bits));
-      const glm::ivec2 guess = oct_encode(sum[v], int(g.normal_bits));
-      for (int a = 0; a < 2; ++a) {
-        normal_residuals[2 * size_t(v) + a] = zigzag(truth[a] - guess[a]);
-        largest = std::max(largest, normal_residuals[2 * size_t(v) + a]);
-      }
-    }
-    normal_bytes = bytes_for(largest);
+    normal_planes = normal_residuals(m.normals, n.order, sum, g.normal_bits, normal_bytes);
   }
-
-  // UVs, colours, vertex_data: meshopt's vertex codec over records in vertex order.
-  std::vector<uint8_t> attribute_stream;
-  const AttributeLayout layout = attribute_layout(flags, 0);
-  if (layout.end > 0) {
-    const size_t stride = (layout.end + 3) & ~size_t(3);
-    std::vector<uint8_t> records(V * stride, 0);
-    for (uint32_t v = 0; v < V; ++v)
-      put_attributes(records.data() + v * stride, layout, flags, g, n, n.order[v]);
-    attribute_stream.resize(meshopt_encodeVertexBufferBound(V, stride));
-    attribute_stream.resize(meshopt_encodeVertexBuffer(attribute_stream.data(), attribute_stream.size(),
-                                                       records.data(), V, stride));
-  }
-  const std::vector<uint8_t> locked_stream = encode_locked_stream(n, k);
+  const std::vector<uint8_t> attribute_stream = encode_attribute_stream(flags, g, n);
 
   ByteWriter w;
   NodeHeader::of(kFormat, flags, g, n).write(w);
@@ -285,7 +190,7 @@ std::vector<uint8_t> PredictiveCodec::encode(const NodeGeometry& g, const Positi
   w.varint(locked_stream.size());
   w.varint(index_stream.size());
   put_planes(w.bytes, residuals, 3, position_bytes);
-  if (normal_bytes) put_planes(w.bytes, normal_residuals, 2, normal_bytes);
+  if (normal_bytes) put_planes(w.bytes, normal_planes, 2, normal_bytes);
   w.raw(attribute_stream);
   w.raw(locked_stream);
   w.raw(index_stream);
@@ -340,33 +245,11 @@ DecodedNode PredictiveCodec::decode(std::span<const uint8_t> bytes, const Positi
 
   if (p.flags & kHasNormals) {
     thread_local std::vector<glm::vec3> sum;
-    thread_local std::vector<int32_t> normal_residual;
     predicted_normals(m.indices, p.first_vertex, p.index_end, m.positions.data(), V, sum);
-    normal_residual.resize(2 * size_t(V));
-    read_planes(p.normal_planes.data(), V, 2, p.normal_bytes, normal_residual.data());
     m.normals.resize(V);
-    const int bits = int(p.normal_bits);
-    const float inv_scale = 1.0f / static_cast<float>((1 << (bits - 1)) - 1);
-    for (uint32_t v = 0; v < V; ++v) {
-      const glm::ivec2 guess = oct_encode(sum[v], bits);
-      // oct_decode clamps; residuals of a valid node are below 2^17, hostile ones are clamped first.
-      const int x = guess.x + std::clamp(normal_residual[v], -(1 << 18), 1 << 18);
-      const int y = guess.y + std::clamp(normal_residual[size_t(V) + v], -(1 << 18), 1 << 18);
-      m.normals[v] = oct_decode(x, y, inv_scale);
-    }
+    decode_predicted_normals(sum, p.normal_planes.data(), p.normal_bytes, p.normal_bits, m.normals.data());
   }
-
-  const AttributeLayout layout = attribute_layout(p.flags, 0);
-  if (layout.end > 0) {
-    const size_t stride = (layout.end + 3) & ~size_t(3);
-    std::vector<uint8_t> records(V * stride);
-    if (meshopt_decodeVertexBuffer(records.data(), V, stride, p.attribute_stream.data(),
-                                   p.attribute_stream.size()) != 0)
-      throw Error(where + ": corrupted attribute stream");
-    get_attributes(records.data(), stride, V, layout, p.flags, p.uv_min, p.uv_extent, out);
-  } else if (!p.attribute_stream.empty()) {
-    throw Error(where + ": attribute stream without attributes");
-  }
+  decode_attribute_stream(p.attribute_stream, p.flags, V, p.uv_min, p.uv_extent, out, where);
   return out;
 }
 

@@ -25,12 +25,7 @@
 //   progressive step's corners at or past first_vertex + V (in later steps), are not in the node: never
 //   predictors. The decode is one branch-free pass over the corners (first corner of each vertex) and one
 //   pass over the vertices; no hash maps.
-// Normals: predicted per vertex as the area-weighted sum of the normals of the node's own triangles over the
-//   DECODED positions (cross(p1 - p0, p2 - p0), Gouraud's smooth normal), octahedral-encoded at normal_bits
-//   (octahedral.hpp); the residual oct(n) - oct(pred) per component, zigzag-mapped, byte b of component a at
-//   plane 2b + a. Interior vertices of a smooth mesh mostly store 0. Unlike positions, normals need no
-//   bit-exact prediction: a decoder whose floating point rounds the prediction differently is off by at most
-//   one octahedral step.
+// Normals: predicted from the decoded positions, residuals as byte planes (predicted_normals.hpp).
 #pragma once
 
 #include "package/node_codec.hpp"
