@@ -284,10 +284,10 @@ void BM_DecodeCodecOnly(benchmark::State& state) {
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(meshlets().triangles));
 }
 
-BENCHMARK(BM_Encode)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_EncodeAndWrite)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Decode)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_DecodeCodecOnly)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Encode)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EncodeAndWrite)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Decode)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DecodeCodecOnly)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
@@ -308,7 +308,7 @@ int main(int argc, char** argv) {
   int n = int(rest.size());
   benchmark::Initialize(&n, rest.data());
   try {
-    for (uint32_t id : {1u, 2u}) print_sizes(node_codec(id));
+    for (uint32_t id : {1u, 2u, 3u}) print_sizes(node_codec(id));
   } catch (const lodstream::Error& e) {
     std::fprintf(stderr, "bench_package: error: %s\n", e.what());
     return 1;

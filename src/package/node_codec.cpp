@@ -3,6 +3,7 @@
 #include "core/error.hpp"
 #include "package/meshopt_codec.hpp"
 #include "package/predictive_codec.hpp"
+#include "package/traversal_codec.hpp"
 
 namespace lodstream::package {
 
@@ -18,8 +19,10 @@ const NodeCodec& default_node_codec() {
 const NodeCodec& node_codec(uint32_t id) {
   static const MeshoptCodec meshopt;
   static const PredictiveCodec predictive;
+  static const TraversalCodec traversal;
   if (id == MeshoptCodec::kId) return meshopt;
   if (id == PredictiveCodec::kId) return predictive;
+  if (id == TraversalCodec::kId) return traversal;
   throw Error("unknown node codec id " + std::to_string(id));
 }
 

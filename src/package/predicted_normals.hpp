@@ -1,5 +1,5 @@
-// Normals predicted from the decoded geometry, as the predictive codecs store them: the prediction of vertex v
-// is the area-weighted sum of the normals of the node's own triangles around v over the DECODED positions,
+// Normals predicted from the decoded geometry, as the predictive codecs store them: the prediction of vertex
+// v is the area-weighted sum of the normals of the node's own triangles around v over the DECODED positions,
 // sum of cross(p1 - p0, p2 - p0) (Gouraud's smooth normal), octahedral-encoded at normal_bits
 // (octahedral.hpp); a node stores only the residual oct(n) - oct(prediction) per component, zigzag-mapped, as
 // byte planes (byte_planes.hpp; byte b of component a at plane 2b + a). Interior vertices of a smooth mesh

@@ -41,6 +41,7 @@ std::vector<uint8_t> encode_attribute_stream(uint32_t flags, const NodeGeometry&
 // Decodes such a stream of V records into out (throws lodstream::Error starting with `where` on a corrupted
 // stream, or a non-empty one without attributes). Cost: O(V).
 void decode_attribute_stream(std::span<const uint8_t> stream, uint32_t flags, size_t vertices,
-                             glm::vec2 uv_min, glm::vec2 uv_extent, DecodedNode& out, const std::string& where);
+                             glm::vec2 uv_min, glm::vec2 uv_extent, DecodedNode& out,
+                             const std::string& where);
 
 }  // namespace lodstream::package

@@ -13,6 +13,7 @@
 #include "package/meshopt_codec.hpp"
 #include "package/octahedral.hpp"
 #include "package/predictive_codec.hpp"
+#include "package/traversal_codec.hpp"
 #include "support/shapes.hpp"
 
 namespace lodstream::test {
@@ -41,7 +42,8 @@ TEST(Octahedral, AngularErrorShrinksWithBits) {
 }
 
 class NodeCodecTest : public ::testing::TestWithParam<uint32_t> {};
-INSTANTIATE_TEST_SUITE_P(Codecs, NodeCodecTest, ::testing::Values(MeshoptCodec::kId, PredictiveCodec::kId),
+INSTANTIATE_TEST_SUITE_P(Codecs, NodeCodecTest,
+                         ::testing::Values(MeshoptCodec::kId, PredictiveCodec::kId, TraversalCodec::kId),
                          [](const auto& info) { return "codec" + std::to_string(info.param); });
 
 TEST_P(NodeCodecTest, EmptyNodeRoundTrips) {
