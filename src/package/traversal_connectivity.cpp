@@ -18,14 +18,15 @@ class Front {
   };
 
   void reset(size_t triangles) {
-    edges_.clear();
-    edges_.reserve(3 * triangles);  // a piece start adds 3 edges, every other triangle at most 2
-    gate_ = 0;
+    // A piece start adds 3 edges, every other triangle at most 2: no more than 3T edges, whatever the
+    // symbols.
+    if (edges_.size() < 3 * triangles) edges_.resize(3 * triangles);
+    size_ = gate_ = 0;
   }
   // The next edge to process, or kNone.
   uint32_t gate() {
-    while (gate_ < edges_.size() && edges_[gate_].state != kPending) ++gate_;
-    return gate_ < edges_.size() ? uint32_t(gate_) : kNone;
+    while (gate_ < size_ && edges_[gate_].state != kPending) ++gate_;
+    return gate_ < size_ ? uint32_t(gate_) : kNone;
   }
   const Edge& edge(uint32_t e) const { return edges_[e]; }
   // p of the gate's kLeft, n of its kRight (kNone unless its loop has 3 edges or more), and whether its loop
@@ -44,52 +45,56 @@ class Front {
   }
 
   void start(uint32_t v0, uint32_t v1, uint32_t v2) {
-    const uint32_t at = uint32_t(edges_.size());
-    edges_.push_back({v0, v1, v2, at + 2, at + 1, kPending});
-    edges_.push_back({v1, v2, v0, at, at + 2, kPending});
-    edges_.push_back({v2, v0, v1, at + 1, at, kPending});
+    const uint32_t at = uint32_t(size_);
+    push(v0, v1, v2, at + 2, at + 1);
+    push(v1, v2, v0, at, at + 2);
+    push(v2, v0, v1, at + 1, at);
   }
   // kVertex and kSplit: the gate a -> b becomes a -> c, c -> b.
   void attach(uint32_t e, uint32_t c) {
-    const Edge g = edges_[e];
-    const uint32_t x = uint32_t(edges_.size()), y = x + 1;
-    edges_.push_back({g.a, c, g.b, g.prev, y, kPending});
-    edges_.push_back({c, g.b, g.a, x, g.next, kPending});
+    Edge& g = edges_[e];
+    const uint32_t x = uint32_t(size_), y = x + 1;
+    push(g.a, c, g.b, g.prev, y);
+    push(c, g.b, g.a, x, g.next);
     edges_[g.prev].next = x;  // a loop has 2 edges or more: prev and next are not the gate
     edges_[g.next].prev = y;
-    edges_[e].state = kGone;
+    g.state = kGone;
   }
   // kLeft: P = p -> a and the gate become p -> b.
   void close_left(uint32_t e) {
-    const Edge g = edges_[e], p = edges_[g.prev];
-    replace(p.prev, g.next, {p.a, g.b, g.a, p.prev, g.next, kPending});
-    edges_[g.prev].state = edges_[e].state = kGone;
+    Edge &g = edges_[e], &p = edges_[g.prev];
+    link(p.prev, g.next, p.a, g.b, g.a);
+    p.state = g.state = kGone;
   }
   // kRight: the gate and N = b -> n become a -> n.
   void close_right(uint32_t e) {
-    const Edge g = edges_[e], n = edges_[g.next];
-    replace(g.prev, n.next, {g.a, n.b, g.b, g.prev, n.next, kPending});
-    edges_[g.next].state = edges_[e].state = kGone;
+    Edge &g = edges_[e], &n = edges_[g.next];
+    link(g.prev, n.next, g.a, n.b, g.b);
+    n.state = g.state = kGone;
   }
   // kEnd: the loop of 3 is gone.
   void close_loop(uint32_t e) {
-    const Edge g = edges_[e];
-    edges_[g.prev].state = edges_[g.next].state = edges_[e].state = kGone;
+    Edge& g = edges_[e];
+    edges_[g.prev].state = edges_[g.next].state = g.state = kGone;
   }
   // kBoundary.
   void done(uint32_t e) { edges_[e].state = kDone; }
 
  private:
-  // Links a new edge between `before` and `after`.
-  void replace(uint32_t before, uint32_t after, const Edge& edge) {
-    const uint32_t x = uint32_t(edges_.size());
-    edges_.push_back(edge);
+  void push(uint32_t a, uint32_t b, uint32_t o, uint32_t prev, uint32_t next) {
+    Edge& x = edges_[size_++];
+    x.a = a, x.b = b, x.o = o, x.prev = prev, x.next = next, x.state = kPending;
+  }
+  // A new edge a -> b (third corner o) between `before` and `after`.
+  void link(uint32_t before, uint32_t after, uint32_t a, uint32_t b, uint32_t o) {
+    const uint32_t x = uint32_t(size_);
+    push(a, b, o, before, after);
     edges_[before].next = x;
     edges_[after].prev = x;
   }
 
   std::vector<Edge> edges_;
-  size_t gate_ = 0;
+  size_t size_ = 0, gate_ = 0;
 };
 
 void put_varint(std::vector<uint8_t>& out, uint32_t v) {
