@@ -52,13 +52,13 @@ class Front {
   }
   // kVertex and kSplit: the gate a -> b becomes a -> c, c -> b.
   void attach(uint32_t e, uint32_t c) {
-    Edge& g = edges_[e];
+    const uint32_t a = edges_[e].a, b = edges_[e].b, prev = edges_[e].prev, next = edges_[e].next;
     const uint32_t x = uint32_t(size_), y = x + 1;
-    push(g.a, c, g.b, g.prev, y);
-    push(c, g.b, g.a, x, g.next);
-    edges_[g.prev].next = x;  // a loop has 2 edges or more: prev and next are not the gate
-    edges_[g.next].prev = y;
-    g.state = kGone;
+    push(a, c, b, prev, y);
+    push(c, b, a, x, next);
+    edges_[prev].next = x;  // a loop has 2 edges or more: prev and next are not the gate
+    edges_[next].prev = y;
+    edges_[e].state = kGone;
   }
   // kLeft: P = p -> a and the gate become p -> b.
   void close_left(uint32_t e) {
@@ -232,13 +232,14 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
       continue;
     }
     if (s == symbols.size()) fail("symbols end early");
-    const Front::Edge g = front.edge(e);
+    const Front::Edge& g = front.edge(e);
+    const uint32_t a = g.a, b = g.b;
     uint32_t c;
     switch (symbols[s++]) {
       case kVertex:
         if (next == V) fail("more vertices than the node holds");
         c = next++;
-        predictors[3 * c] = g.a, predictors[3 * c + 1] = g.b, predictors[3 * c + 2] = g.o;
+        predictors[3 * c] = a, predictors[3 * c + 1] = b, predictors[3 * c + 2] = g.o;
         front.attach(e, c);
         break;
       case kLeft:
@@ -269,7 +270,7 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
       default:
         fail("unknown symbol");
     }
-    out[0] = g.b, out[1] = g.a, out[2] = c;
+    out[0] = b, out[1] = a, out[2] = c;
     out += 3;
   }
   if (s != symbols.size()) fail("symbols left over");
