@@ -10,15 +10,9 @@
 // node, extra bytes: progressive-mesh steps) cannot be renumbered by a traversal: codec 3 stores them as
 // codec 2 does (its bytes, format 1) and decodes by the format byte.
 //
-// Bytes of a traversal node:
-//   the common header (node_header.hpp) with format 2 and flags 1 normals, 2 uvs, 4 colors, 8 vertex_data;
-//   u8 widths (low nibble: bytes per position residual wp, 1..5; high nibble: bytes per normal residual wn,
-//   0..3); varint sizes of the attribute, locked and symbol streams; then the position planes (3 wp V bytes),
-//   the normal planes (2 wn V bytes), the attribute, locked and symbol streams, and the references (the
-//   rest).
-// Positions: vertices are numbered in traversal order; vertex v's coarse coordinates (quantized_node.hpp) are
-//   c[v] = c[o1] + c[o2] - c[o] + residual[v] with the traversal's predictors (cmin for "none"); the
-//   residuals zigzag-mapped, byte b of axis a at plane 3b + a.
+// Bytes of a traversal node: predictive_node.hpp's layout with format 2 and flags 1 normals, 2 uvs,
+//   4 colors, 8 vertex_data; the connectivity stream is the traversal's symbols, the tail its references.
+//   Vertices are numbered in traversal order and predicted by the traversal's predictors.
 #pragma once
 
 #include "package/node_codec.hpp"
