@@ -1,10 +1,11 @@
 // bench_package: size and speed of the .lods package on a real mesh cut into meshlets (the finest level of a
 // cluster DAG: 64 vertices / 124 triangles, positions on a 2^-14 grid of the diagonal, octahedral normals).
 //
-//   bench_package [--mesh=FILE] [--normal-bits=N] [--zstd-level=L] [google benchmark flags]
+//   bench_package [--mesh=FILE] [--normal-bits=N] [--zstd-level=L] [--no-sizes] [google benchmark flags]
 //
-// Every figure is measured for codec 1 (meshoptimizer's codecs) and codec 2 (predicted positions and normals)
-// side by side in one run (benchmark argument = codec id). Before the timings it prints the size table: bytes
+// Every figure is measured for codec 1 (meshoptimizer's codecs), codec 2 (predicted positions and normals)
+// and codec 3 (traversal-ordered connectivity, predicted positions and normals) side by side in one run
+// (benchmark argument = codec id). Before the timings it prints the size table: bytes
 // per triangle of the whole package and where they go (positions, normals, UVs, connectivity, index), each
 // measured after zstd by encoding with and without the attribute. Timings report triangles per second on one
 // core: encode (codec), write (codec + zstd + file), decode (checksum + zstd + codec, from pages in memory)
@@ -32,6 +33,7 @@ using namespace lodstream::package;
 std::filesystem::path g_mesh_file = LODSTREAM_SOURCE_DIR "/data/refined_elephant.off";
 uint32_t g_normal_bits = 10;
 int g_zstd_level = WriterOptions{}.zstd_level;
+bool g_sizes = true;  // --no-sizes: timings only (e.g. under callgrind, which the zstd-19 sizes would slow)
 
 struct Meshlets {
   Mesh mesh;  // the whole input mesh (all objects' meshes merged)
@@ -284,10 +286,10 @@ void BM_DecodeCodecOnly(benchmark::State& state) {
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(meshlets().triangles));
 }
 
-BENCHMARK(BM_Encode)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_EncodeAndWrite)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Decode)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_DecodeCodecOnly)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Encode)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EncodeAndWrite)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Decode)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DecodeCodecOnly)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
@@ -301,6 +303,8 @@ int main(int argc, char** argv) {
       g_normal_bits = uint32_t(std::stoi(a.substr(14)));
     } else if (a.rfind("--zstd-level=", 0) == 0) {
       g_zstd_level = std::stoi(a.substr(13));
+    } else if (a == "--no-sizes") {
+      g_sizes = false;
     } else {
       rest.push_back(argv[i]);
     }
@@ -308,7 +312,8 @@ int main(int argc, char** argv) {
   int n = int(rest.size());
   benchmark::Initialize(&n, rest.data());
   try {
-    for (uint32_t id : {1u, 2u}) print_sizes(node_codec(id));
+    for (uint32_t id : {1u, 2u, 3u})
+      if (g_sizes) print_sizes(node_codec(id));
   } catch (const lodstream::Error& e) {
     std::fprintf(stderr, "bench_package: error: %s\n", e.what());
     return 1;

@@ -9,7 +9,7 @@
 // Because the grid is shared by every node of a representation and the decode is one deterministic formula, a
 // vertex that two nodes store as locked (or with the same shift) decodes bit-identically in both: that keeps
 // cuts crack-free. See quantized_node.hpp for how the remaining precision is spent. The codecs: MeshoptCodec
-// (id 1, the default) and PredictiveCodec (id 2).
+// (id 1, the default), PredictiveCodec (id 2) and TraversalCodec (id 3).
 #pragma once
 
 #include <cstdint>

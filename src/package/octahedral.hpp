@@ -20,23 +20,26 @@ inline float sign_not_zero(float v) {
 // n need not be unit length; a zero (or non-finite) vector encodes as +z. Returns components in
 // [-(2^(bits-1)-1), 2^(bits-1)-1].
 inline glm::ivec2 oct_encode(glm::vec3 n, int bits) {
+  // Selects only (no branch, no short-circuit, the division unconditional), so that a loop of encodes
+  // vectorizes: the predictive codecs encode a predicted normal per vertex when decoding.
   const float l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
-  const bool usable = l1 > 0.0f && l1 <= std::numeric_limits<float>::max();  // not zero, NaN or infinite
-  glm::vec2 p = usable ? glm::vec2(n.x, n.y) / l1 : glm::vec2(0.0f);
-  if (usable && n.z < 0.0f) {
-    p = glm::vec2((1.0f - std::abs(p.y)) * sign_not_zero(p.x), (1.0f - std::abs(p.x)) * sign_not_zero(p.y));
-  }
-  // Round half away from zero without a libm call (codec 2's decoder encodes a predicted normal per vertex).
+  const bool usable = (l1 > 0.0f) & (l1 <= std::numeric_limits<float>::max());  // not zero, NaN or infinite
+  const float px = usable ? n.x / l1 : 0.0f, py = usable ? n.y / l1 : 0.0f;     // as before: same codes
+  const bool lower = usable & (n.z < 0.0f);
+  const float fx = lower ? (1.0f - std::abs(py)) * sign_not_zero(px) : px;
+  const float fy = lower ? (1.0f - std::abs(px)) * sign_not_zero(py) : py;
+  // Round half away from zero without a libm call.
   const float scale = static_cast<float>((1 << (bits - 1)) - 1);
-  const float x = std::clamp(p.x, -1.0f, 1.0f) * scale, y = std::clamp(p.y, -1.0f, 1.0f) * scale;
+  const float x = std::min(std::max(fx, -1.0f), 1.0f) * scale,
+              y = std::min(std::max(fy, -1.0f), 1.0f) * scale;
   return {static_cast<int>(x + std::copysign(0.5f, x)), static_cast<int>(y + std::copysign(0.5f, y))};
 }
 
 // Inverse of oct_encode for any integer pair (garbage in gives some unit vector, never NaN). The fold of the
 // lower half is written branch-free: with t = max(-z, 0), x += (x >= 0 ? -t : t) equals (1 - |y|) sign(x).
 inline glm::vec3 oct_decode(int x, int y, float inv_scale) {
-  float fx = std::clamp(static_cast<float>(x) * inv_scale, -1.0f, 1.0f);
-  float fy = std::clamp(static_cast<float>(y) * inv_scale, -1.0f, 1.0f);
+  float fx = std::min(std::max(static_cast<float>(x) * inv_scale, -1.0f), 1.0f);
+  float fy = std::min(std::max(static_cast<float>(y) * inv_scale, -1.0f), 1.0f);
   float fz = 1.0f - std::abs(fx) - std::abs(fy);
   float t = std::max(-fz, 0.0f);
   fx += fx >= 0.0f ? -t : t;

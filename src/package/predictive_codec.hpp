@@ -4,12 +4,9 @@
 // locked stream are codec 1's (quantized_node.hpp, coarse_positions.hpp), so positions decode to the same
 // grid values and locked vertices bit-identically on the finest grid.
 //
-// Bytes of a node:
-//   the common header (node_header.hpp) with format 1 and flags 1 normals, 2 uvs, 4 colors, 8 vertex_data,
-//   32 progressive; u8 widths (low nibble: bytes per position residual wp, 1..5; high nibble: bytes per
-//   normal residual wn, 0..3); varint sizes of the attribute, locked and index streams; then the position
-//   planes (3 wp V bytes), the normal planes (2 wn V bytes), the attribute, locked and index streams;
-//   [progressive: the extra bytes].
+// Bytes of a node: predictive_node.hpp's layout with format 1 and flags 1 normals, 2 uvs, 4 colors,
+//   8 vertex_data, 32 progressive; the connectivity stream is the index stream, the tail the extra bytes.
+//   Codec 3 stores the nodes whose order is significant (progressive-mesh steps) this way.
 // Index stream: meshopt_encodeIndexBuffer (version 1). The decoder decodes it first; everything below walks
 //   the decoded triangles, so encoder and decoder predict from the same data.
 // Positions (parallelogram prediction, Touma & Gotsman 1998, "Triangle Mesh Compression", GI'98): the
@@ -20,17 +17,11 @@
 //                               pred = c[o1] + c[o2] - c[o]   (the parallelogram across edge o1-o2)
 //     else o1 or o2 < v:        pred = c[that corner]
 //     else:                     pred = c[v - 1], or cmin for v = 0 (also for vertices no triangle uses).
-//   Residual c - pred is stored zigzag-mapped, byte b of axis a of vertex v at plane 3b + a, offset v
-//   (equal bytes together, so zstd models low and high bytes apart). Chunk vertices below first_vertex, and a
+//   Residuals c - pred as predictive_node.hpp stores them. Chunk vertices below first_vertex, and a
 //   progressive step's corners at or past first_vertex + V (in later steps), are not in the node: never
 //   predictors. The decode is one branch-free pass over the corners (first corner of each vertex) and one
 //   pass over the vertices; no hash maps.
-// Normals: predicted per vertex as the area-weighted sum of the normals of the node's own triangles over the
-//   DECODED positions (cross(p1 - p0, p2 - p0), Gouraud's smooth normal), octahedral-encoded at normal_bits
-//   (octahedral.hpp); the residual oct(n) - oct(pred) per component, zigzag-mapped, byte b of component a at
-//   plane 2b + a. Interior vertices of a smooth mesh mostly store 0. Unlike positions, normals need no
-//   bit-exact prediction: a decoder whose floating point rounds the prediction differently is off by at most
-//   one octahedral step.
+// Normals: predicted from the decoded positions, residuals as byte planes (predicted_normals.hpp).
 #pragma once
 
 #include "package/node_codec.hpp"

@@ -84,4 +84,16 @@ QuantizedNode quantize_node(const NodeGeometry& g, const PositionGrid& grid) {
   return n;
 }
 
+void reorder_vertices(QuantizedNode& n, std::span<const uint32_t> order) {
+  QuantizedNode r;
+  r.order.resize(order.size()), r.q.resize(3 * order.size()), r.c.resize(3 * order.size());
+  r.locked.resize(order.size());
+  for (size_t v = 0; v < order.size(); ++v) {
+    const uint32_t from = order[v];
+    r.order[v] = n.order[from], r.locked[v] = n.locked[from];
+    for (int a = 0; a < 3; ++a) r.q[3 * v + a] = n.q[3 * from + a], r.c[3 * v + a] = n.c[3 * from + a];
+  }
+  n.order = std::move(r.order), n.q = std::move(r.q), n.c = std::move(r.c), n.locked = std::move(r.locked);
+}
+
 }  // namespace lodstream::package

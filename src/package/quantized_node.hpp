@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "package/node_codec.hpp"
@@ -33,5 +34,9 @@ struct QuantizedNode {
 // meshopt's codecs (vertex-cache, then vertex-fetch order: vertices in first-use order) unless first_vertex >
 // 0 or preserve_order, and quantizes. Cost: O(V + T) plus meshopt's reordering.
 QuantizedNode quantize_node(const NodeGeometry& geometry, const PositionGrid& grid);
+
+// Renumbers the node's vertices: new vertex i is current vertex order[i] (order, q, c and locked follow;
+// the caller renumbers the indices). Cost: O(V).
+void reorder_vertices(QuantizedNode& node, std::span<const uint32_t> order);
 
 }  // namespace lodstream::package

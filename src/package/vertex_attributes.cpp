@@ -4,6 +4,9 @@
 #include <cmath>
 #include <cstring>
 
+#include <meshoptimizer.h>
+
+#include "core/error.hpp"
 #include "package/bytes.hpp"
 
 namespace lodstream::package {
@@ -61,6 +64,32 @@ void get_attributes(const uint8_t* records, size_t stride, size_t V, const Attri
     out.vertex_data.resize(V);
     for (size_t v = 0; v < V; ++v) out.vertex_data[v] = load_raw<uint32_t>(records + v * stride + l.data);
   }
+}
+
+std::vector<uint8_t> encode_attribute_stream(uint32_t flags, const NodeGeometry& g, const QuantizedNode& n) {
+  std::vector<uint8_t> stream;
+  const AttributeLayout layout = attribute_layout(flags, 0);
+  if (layout.end == 0) return stream;
+  const size_t V = n.order.size(), stride = (layout.end + 3) & ~size_t(3);
+  std::vector<uint8_t> records(V * stride, 0);
+  for (size_t v = 0; v < V; ++v) put_attributes(records.data() + v * stride, layout, flags, g, n, n.order[v]);
+  stream.resize(meshopt_encodeVertexBufferBound(V, stride));
+  stream.resize(meshopt_encodeVertexBuffer(stream.data(), stream.size(), records.data(), V, stride));
+  return stream;
+}
+
+void decode_attribute_stream(std::span<const uint8_t> stream, uint32_t flags, size_t V, glm::vec2 uv_min,
+                             glm::vec2 uv_extent, DecodedNode& out, const std::string& where) {
+  const AttributeLayout layout = attribute_layout(flags, 0);
+  if (layout.end == 0) {
+    if (!stream.empty()) throw Error(where + ": attribute stream without attributes");
+    return;
+  }
+  const size_t stride = (layout.end + 3) & ~size_t(3);
+  std::vector<uint8_t> records(V * stride);
+  if (meshopt_decodeVertexBuffer(records.data(), V, stride, stream.data(), stream.size()) != 0)
+    throw Error(where + ": corrupted attribute stream");
+  get_attributes(records.data(), stride, V, layout, flags, uv_min, uv_extent, out);
 }
 
 }  // namespace lodstream::package

@@ -5,6 +5,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
 
 #include "package/quantized_node.hpp"
 
@@ -29,5 +32,16 @@ void put_attributes(uint8_t* record, const AttributeLayout& layout, uint32_t fla
 // Cost: O(V).
 void get_attributes(const uint8_t* records, size_t stride, size_t vertices, const AttributeLayout& layout,
                     uint32_t flags, glm::vec2 uv_min, glm::vec2 uv_extent, DecodedNode& out);
+
+// The attribute stream of the predictive codecs: UV, colour and vertex_data (flags permitting) of the node's
+// vertices in stored order (node.order), as records starting at byte 0 padded to a multiple of 4, coded by
+// meshopt_encodeVertexBuffer; empty without such attributes. Cost: O(V).
+std::vector<uint8_t> encode_attribute_stream(uint32_t flags, const NodeGeometry& geometry,
+                                             const QuantizedNode& node);
+// Decodes such a stream of V records into out (throws lodstream::Error starting with `where` on a corrupted
+// stream, or a non-empty one without attributes). Cost: O(V).
+void decode_attribute_stream(std::span<const uint8_t> stream, uint32_t flags, size_t vertices,
+                             glm::vec2 uv_min, glm::vec2 uv_extent, DecodedNode& out,
+                             const std::string& where);
 
 }  // namespace lodstream::package

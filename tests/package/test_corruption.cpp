@@ -13,6 +13,7 @@
 #include "package/meshopt_codec.hpp"
 #include "package/predictive_codec.hpp"
 #include "package/reader.hpp"
+#include "package/traversal_codec.hpp"
 #include "package_fixture.hpp"
 #include "support/run.hpp"
 
@@ -143,7 +144,8 @@ class Corruption : public ::testing::TestWithParam<uint32_t> {
   RootIndex root;
 };
 
-INSTANTIATE_TEST_SUITE_P(Codecs, Corruption, ::testing::Values(MeshoptCodec::kId, PredictiveCodec::kId),
+INSTANTIATE_TEST_SUITE_P(Codecs, Corruption,
+                         ::testing::Values(MeshoptCodec::kId, PredictiveCodec::kId, TraversalCodec::kId),
                          [](const auto& info) { return "codec" + std::to_string(info.param); });
 
 TEST_P(Corruption, TheRebuildHelperItselfGivesAValidPackage) {

@@ -1,0 +1,35 @@
+// Normals predicted from the decoded geometry, as the predictive codecs store them: the prediction of vertex
+// v is the area-weighted sum of the normals of the node's own triangles around v over the DECODED positions,
+// sum of cross(p1 - p0, p2 - p0) (Gouraud's smooth normal), octahedral-encoded at normal_bits
+// (octahedral.hpp); a node stores only the residual oct(n) - oct(prediction) per component, zigzag-mapped, as
+// byte planes (byte_planes.hpp; byte b of component a at plane 2b + a). Interior vertices of a smooth mesh
+// mostly store 0; seams and creases store what they differ by. Unlike positions, normals need no bit-exact
+// prediction: a decoder whose floating point rounds the prediction differently is off by at most one
+// octahedral step.
+#pragma once
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <span>
+#include <vector>
+
+namespace lodstream::package {
+
+// sum[v] for v < V: the unnormalized prediction over `positions` from the triangles whose corners are all in
+// the node (indices minus first_vertex below V). `index_end` bounds the indices (checked by the caller); when
+// it is first_vertex + V (every node but a progressive step) no corner lies outside and the loop tests none.
+// Cost: O(T + V), one cross product per triangle.
+void predicted_normals(std::span<const uint32_t> indices, uint32_t first_vertex, uint32_t index_end,
+                       const glm::vec3* positions, uint32_t V, std::vector<glm::vec3>& sum);
+
+// The zigzagged residuals (2 per vertex) of normals[order[v]] against sum[v], and in `width` the bytes per
+// residual (1..3) the planes need. Cost: O(V), two octahedral encodes per vertex.
+std::vector<uint64_t> normal_residuals(std::span<const glm::vec3> normals, std::span<const uint32_t> order,
+                                       std::span<const glm::vec3> sum, uint32_t bits, uint32_t& width);
+
+// normals[v] = oct_decode(oct(sum[v]) + residual[v]) from the residual planes (2 * width * V bytes; hostile
+// residuals are clamped, never overflow). Cost: O(V), an octahedral encode and decode per vertex.
+void decode_predicted_normals(std::span<const glm::vec3> sum, const uint8_t* planes, uint32_t width,
+                              uint32_t bits, glm::vec3* normals);
+
+}  // namespace lodstream::package

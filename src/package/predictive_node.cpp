@@ -1,0 +1,135 @@
+#include "package/predictive_node.hpp"
+
+#include <algorithm>
+#include <iterator>
+
+#include "core/error.hpp"
+#include "package/byte_planes.hpp"
+#include "package/bytes.hpp"
+#include "package/predicted_normals.hpp"
+#include "package/vertex_attributes.hpp"
+
+namespace lodstream::package {
+
+namespace {
+
+constexpr uint32_t kMaxPositionBytes = 5, kMaxNormalBytes = 3;
+// Decoded coarse coordinates stay within ±2^32 (valid ones within ±2^31), so no chain of predictions from
+// hostile residuals (< 2^40) overflows int64.
+constexpr int64_t kMaxCoarse = int64_t(1) << 32;
+
+}  // namespace
+
+PredictiveNode PredictiveNode::parse(std::span<const uint8_t> bytes, uint8_t format, uint32_t known_flags,
+                                     const std::string& where) {
+  ByteReader r(bytes, where);
+  PredictiveNode p;
+  static_cast<NodeHeader&>(p) = NodeHeader::read(r, format, known_flags, bytes.size());
+  const uint8_t widths = r.u8();
+  p.position_bytes = widths & 15, p.normal_bytes = widths >> 4;
+  if (p.position_bytes < 1 || p.position_bytes > kMaxPositionBytes || p.normal_bytes > kMaxNormalBytes ||
+      (p.normal_bytes == 0) != !(p.flags & kHasNormals))
+    r.fail("invalid residual widths");
+  const uint64_t attribute_size = r.varint(), locked_size = r.varint(), connectivity_size = r.varint();
+  p.header_size = r.position();
+  const uint64_t planes = uint64_t(p.vertices) * (3 * p.position_bytes + 2 * p.normal_bytes);  // V ≤ 65536
+  if (planes > r.remaining() || attribute_size > r.remaining() - planes ||
+      locked_size > r.remaining() - planes - attribute_size ||
+      connectivity_size > r.remaining() - planes - attribute_size - locked_size)
+    r.fail("stream sizes do not add up to the node size");
+  p.position_planes = r.bytes(size_t(3) * p.position_bytes * p.vertices, "position residuals");
+  p.normal_planes = r.bytes(size_t(2) * p.normal_bytes * p.vertices, "normal residuals");
+  p.attribute_stream = r.bytes(attribute_size, "attribute stream");
+  p.locked_stream = r.bytes(locked_size, "locked stream");
+  p.connectivity = r.bytes(connectivity_size, "connectivity");
+  p.tail = r.bytes(r.remaining(), "tail");
+  return p;
+}
+
+PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedNode& n,
+                                         std::span<const uint32_t> predictors,
+                                         std::span<const uint32_t> indices,
+                                         std::span<const uint8_t> locked_stream, const PositionGrid& grid) {
+  const size_t V = n.order.size();
+  PredictiveResiduals r;
+  std::vector<int64_t> c(n.c);
+  c.insert(c.end(), std::begin(n.cmin), std::end(n.cmin));
+  r.positions.resize(3 * V);
+  uint64_t largest = 0;
+  for (size_t v = 0; v < V; ++v) {
+    const uint32_t* o = &predictors[3 * v];
+    for (int a = 0; a < 3; ++a) {
+      const int64_t predicted = c[3 * size_t(o[0]) + a] + c[3 * size_t(o[1]) + a] - c[3 * size_t(o[2]) + a];
+      r.positions[3 * v + a] = zigzag(c[3 * v + a] - predicted);
+      largest = std::max(largest, r.positions[3 * v + a]);
+    }
+  }
+  r.position_bytes = bytes_for(largest);
+  if (g.mesh->has_normals()) {
+    std::vector<glm::vec3> decoded(V), sum;
+    decode_positions(n.c, LockedStream::parse(locked_stream, V, g.position_shift, "node codec"), grid,
+                     decoded.data());
+    predicted_normals(indices, g.first_vertex, n.index_end, decoded.data(), uint32_t(V), sum);
+    r.normals = normal_residuals(g.mesh->normals, n.order, sum, g.normal_bits, r.normal_bytes);
+  }
+  return r;
+}
+
+std::vector<uint8_t> write_predictive_node(const NodeHeader& header, const PredictiveResiduals& r,
+                                           std::span<const uint8_t> attribute_stream,
+                                           std::span<const uint8_t> locked_stream,
+                                           std::span<const uint8_t> connectivity,
+                                           std::span<const uint8_t> tail) {
+  ByteWriter w;
+  header.write(w);
+  w.u8(static_cast<uint8_t>(r.position_bytes | r.normal_bytes << 4));
+  w.varint(attribute_stream.size());
+  w.varint(locked_stream.size());
+  w.varint(connectivity.size());
+  put_planes(w.bytes, r.positions, 3, r.position_bytes);
+  if (r.normal_bytes) put_planes(w.bytes, r.normals, 2, r.normal_bytes);
+  w.raw(attribute_stream);
+  w.raw(locked_stream);
+  w.raw(connectivity);
+  w.raw(tail);
+  return std::move(w.bytes);
+}
+
+void decode_predicted_vertices(const PredictiveNode& p, std::span<const uint32_t> predictors,
+                               const PositionGrid& grid, DecodedNode& out, const std::string& where) {
+  const uint32_t V = p.vertices;
+  Mesh& m = out.mesh;
+  const LockedStream locked = LockedStream::parse(p.locked_stream, V, p.shift, where);
+  // c[v] = c[o1] + c[o2] - c[o] + residual, with entry V holding cmin. The arithmetic wraps (unsigned), so
+  // hostile residuals cannot overflow; the results are range-checked after.
+  thread_local std::vector<int64_t> residual, c;
+  residual.resize(3 * size_t(V)), c.resize(3 * (size_t(V) + 1));
+  read_planes(p.position_planes.data(), V, 3, p.position_bytes, residual.data());
+  const int64_t *rx = residual.data(), *ry = rx + V, *rz = ry + V;
+  uint64_t* cu = reinterpret_cast<uint64_t*>(c.data());
+  for (int a = 0; a < 3; ++a) cu[3 * size_t(V) + a] = uint64_t(p.cmin[a]);
+  const uint32_t* o = predictors.data();
+  for (uint32_t v = 0; v < V; ++v, o += 3) {
+    const uint64_t *x = cu + 3 * size_t(o[0]), *y = cu + 3 * size_t(o[1]), *z = cu + 3 * size_t(o[2]);
+    uint64_t* to = cu + 3 * size_t(v);
+    to[0] = x[0] + y[0] - z[0] + uint64_t(rx[v]);
+    to[1] = x[1] + y[1] - z[1] + uint64_t(ry[v]);
+    to[2] = x[2] + y[2] - z[2] + uint64_t(rz[v]);
+  }
+  bool out_of_range = false;
+  for (size_t i = 0; i < 3 * size_t(V); ++i)
+    out_of_range |= cu[i] + uint64_t(kMaxCoarse) > 2 * uint64_t(kMaxCoarse);
+  if (out_of_range) throw Error(where + ": predicted position out of the grid's range");
+  m.positions.resize(V);
+  decode_positions(std::span(c).first(3 * size_t(V)), locked, grid, m.positions.data());
+
+  if (p.flags & kHasNormals) {
+    thread_local std::vector<glm::vec3> sum;
+    predicted_normals(m.indices, p.first_vertex, p.index_end, m.positions.data(), V, sum);
+    m.normals.resize(V);
+    decode_predicted_normals(sum, p.normal_planes.data(), p.normal_bytes, p.normal_bits, m.normals.data());
+  }
+  decode_attribute_stream(p.attribute_stream, p.flags, V, p.uv_min, p.uv_extent, out, where);
+}
+
+}  // namespace lodstream::package

@@ -1,0 +1,65 @@
+// What the two predictive codecs (predictive_codec.hpp: codec 2, traversal_codec.hpp: codec 3) share: the
+// layout of a node's bytes, the parallelogram-predicted positions and the normals predicted from them.
+//
+// Bytes of a node:
+//   the common header (node_header.hpp); u8 widths (low nibble: bytes per position residual wp, 1..5; high
+//   nibble: bytes per normal residual wn, 0..3, 0 exactly without normals); varint sizes of the attribute,
+//   locked and connectivity streams; then the position planes (3 wp V bytes), the normal planes (2 wn V
+//   bytes), the attribute stream (vertex_attributes.hpp), the locked stream (coarse_positions.hpp), the
+//   connectivity stream and the tail (the rest: each codec says what).
+// Positions: vertex v's coarse coordinates (quantized_node.hpp) are c[v] = c[o1] + c[o2] - c[o] + residual[v]
+//   (the parallelogram across edge o1-o2 of the triangle o1 o2 o, Touma & Gotsman 1998, "Triangle Mesh
+//   Compression", GI'98) with predictors below v that the codec derives from the connectivity; a single
+//   predictor x is (x, x, x), and index V stands for cmin (no predictor). The residuals are zigzag-mapped,
+//   byte b of axis a at plane 3b + a (byte_planes.hpp).
+// Normals: predicted from the decoded positions (predicted_normals.hpp).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "package/coarse_positions.hpp"
+#include "package/node_header.hpp"
+
+namespace lodstream::package {
+
+struct PredictiveNode : NodeHeader {
+  uint32_t position_bytes = 0, normal_bytes = 0;
+  size_t header_size = 0;
+  std::span<const uint8_t> position_planes, normal_planes, attribute_stream, locked_stream, connectivity,
+      tail;
+
+  // Reads and validates the layout (NodeHeader::read's checks for `format` and `known_flags`, widths, sizes
+  // that add up); throws lodstream::Error starting with `where`. Cost: O(1).
+  static PredictiveNode parse(std::span<const uint8_t> bytes, uint8_t format, uint32_t known_flags,
+                              const std::string& where);
+};
+
+// The encoder's side. Residuals of the quantized node's coarse coordinates against `predictors` (3 per
+// vertex, as above), and the normals' against the prediction from the decoded positions over `indices` (the
+// triangles as the decoder will see them, numbered from first_vertex; `locked_stream` the node's,
+// encode_locked_stream); then the node's bytes. Cost: O(T + V).
+struct PredictiveResiduals {
+  std::vector<uint64_t> positions, normals;
+  uint32_t position_bytes = 0, normal_bytes = 0;
+};
+PredictiveResiduals predictive_residuals(const NodeGeometry& geometry, const QuantizedNode& node,
+                                         std::span<const uint32_t> predictors,
+                                         std::span<const uint32_t> indices,
+                                         std::span<const uint8_t> locked_stream, const PositionGrid& grid);
+std::vector<uint8_t> write_predictive_node(const NodeHeader& header, const PredictiveResiduals& residuals,
+                                           std::span<const uint8_t> attribute_stream,
+                                           std::span<const uint8_t> locked_stream,
+                                           std::span<const uint8_t> connectivity,
+                                           std::span<const uint8_t> tail);
+
+// The decoder's side: out.mesh.positions and (with normals) out.mesh.normals, UVs, colours and vertex_data of
+// a parsed node whose out.mesh.indices are decoded, from `predictors` (3V entries or more; any values: they
+// index entries below V + 1 only). Throws lodstream::Error starting with `where` on positions off the grid's
+// range. Cost: O(T + V).
+void decode_predicted_vertices(const PredictiveNode& node, std::span<const uint32_t> predictors,
+                               const PositionGrid& grid, DecodedNode& out, const std::string& where);
+
+}  // namespace lodstream::package

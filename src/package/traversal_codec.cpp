@@ -1,0 +1,75 @@
+#include "package/traversal_codec.hpp"
+
+#include <algorithm>
+
+#include "package/predictive_codec.hpp"
+#include "package/predictive_node.hpp"
+#include "package/quantized_node.hpp"
+#include "package/traversal_connectivity.hpp"
+#include "package/vertex_attributes.hpp"
+
+namespace lodstream::package {
+
+namespace {
+
+constexpr uint8_t kFormat = 2;
+constexpr uint8_t kOrderedFormat = 1;  // codec 2's bytes
+constexpr uint32_t kAllFlags = kHasNormals | kHasUvs | kHasColors | kHasVertexData;
+
+const PredictiveCodec& ordered_codec() {
+  static const PredictiveCodec codec;
+  return codec;
+}
+
+bool order_is_significant(const NodeGeometry& g) {
+  return g.first_vertex > 0 || g.preserve_order || g.index_end > g.mesh->positions.size() || !g.extra.empty();
+}
+
+}  // namespace
+
+std::vector<uint8_t> TraversalCodec::encode(const NodeGeometry& g, const PositionGrid& grid) const {
+  if (g.mesh && order_is_significant(g)) return ordered_codec().encode(g, grid);
+  NodeGeometry in_order = g;
+  in_order.preserve_order = true;  // the traversal chooses the order
+  QuantizedNode n = quantize_node(in_order, grid);
+  const Mesh& m = *g.mesh;
+  const uint32_t V = uint32_t(m.positions.size());
+  const uint32_t flags = attribute_flags(g);
+
+  TraversalCode code = encode_traversal(n.indices, V);
+  reorder_vertices(n, code.order);
+  n.indices = std::move(code.indices);
+  const std::vector<uint8_t> locked_stream = encode_locked_stream(n, g.position_shift);
+  return write_predictive_node(NodeHeader::of(kFormat, flags, g, n),
+                               predictive_residuals(g, n, code.predictors, n.indices, locked_stream, grid),
+                               encode_attribute_stream(flags, g, n), locked_stream, code.symbols,
+                               code.references);
+}
+
+DecodedNode TraversalCodec::decode(std::span<const uint8_t> bytes, const PositionGrid& grid,
+                                   const std::string& where) const {
+  if (!bytes.empty() && bytes[0] == kOrderedFormat) return ordered_codec().decode(bytes, grid, where);
+  const PredictiveNode p = PredictiveNode::parse(bytes, kFormat, kAllFlags, where);
+  const uint32_t V = p.vertices;
+  DecodedNode out;
+  out.index_end = V;
+  out.mesh.indices.resize(3 * size_t(p.triangles));
+  thread_local std::vector<uint32_t> predictors;
+  predictors.resize(3 * (size_t(V) + 1));
+  decode_traversal(p.connectivity, p.tail, p.triangles, V, out.mesh.indices.data(), predictors.data(), where);
+  decode_predicted_vertices(p, predictors, grid, out, where);
+  return out;
+}
+
+NodeSizeBreakdown TraversalCodec::breakdown(std::span<const uint8_t> bytes, const std::string& where) const {
+  if (!bytes.empty() && bytes[0] == kOrderedFormat) return ordered_codec().breakdown(bytes, where);
+  const PredictiveNode p = PredictiveNode::parse(bytes, kFormat, kAllFlags, where);
+  NodeSizeBreakdown b;
+  b.header = p.header_size;
+  b.vertices = p.position_planes.size() + p.normal_planes.size() + p.attribute_stream.size();
+  b.locked = p.locked_stream.size();
+  b.indices = p.connectivity.size() + p.tail.size();
+  return b;
+}
+
+}  // namespace lodstream::package

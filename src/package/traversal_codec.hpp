@@ -1,0 +1,32 @@
+// The third node codec (id 3): connectivity as a traversal (traversal_connectivity.hpp), so that every new
+// vertex arrives across a known edge and is predicted by the parallelogram of that edge's triangle; normals
+// predicted from the decoded positions (predicted_normals.hpp); residuals as byte planes (byte_planes.hpp)
+// that the writer's per-page zstd entropy-codes; UVs, colours and vertex_data as codec 2 stores them
+// (vertex_attributes.hpp). Quantization and the locked stream are codec 1's (quantized_node.hpp,
+// coarse_positions.hpp): positions decode to the same grid values, locked vertices bit-identically on the
+// finest grid.
+//
+// Nodes whose vertex and triangle order is significant (first_vertex > 0, preserve_order, indices past the
+// node, extra bytes: progressive-mesh steps) cannot be renumbered by a traversal: codec 3 stores them as
+// codec 2 does (its bytes, format 1) and decodes by the format byte.
+//
+// Bytes of a traversal node: predictive_node.hpp's layout with format 2 and flags 1 normals, 2 uvs,
+//   4 colors, 8 vertex_data; the connectivity stream is the traversal's symbols, the tail its references.
+//   Vertices are numbered in traversal order and predicted by the traversal's predictors.
+#pragma once
+
+#include "package/node_codec.hpp"
+
+namespace lodstream::package {
+
+class TraversalCodec final : public NodeCodec {
+ public:
+  static constexpr uint32_t kId = 3;
+  uint32_t id() const override { return kId; }
+  std::vector<uint8_t> encode(const NodeGeometry& geometry, const PositionGrid& grid) const override;
+  DecodedNode decode(std::span<const uint8_t> bytes, const PositionGrid& grid,
+                     const std::string& where) const override;
+  NodeSizeBreakdown breakdown(std::span<const uint8_t> bytes, const std::string& where) const override;
+};
+
+}  // namespace lodstream::package

@@ -1,0 +1,284 @@
+#include "package/traversal_connectivity.hpp"
+
+#include "core/error.hpp"
+#include "package/bytes.hpp"
+
+namespace lodstream::package {
+
+namespace {
+
+constexpr uint32_t kNone = UINT32_MAX;
+
+// The front of traversal_connectivity.hpp, shared by encoder and decoder so that both apply the same rules.
+class Front {
+ public:
+  enum State : uint32_t { kPending, kDone, kGone };  // to process; in its loop, processed; out of the loops
+  struct Edge {
+    uint32_t a, b, o, prev, next, state;
+  };
+
+  void reset(size_t triangles) {
+    // A piece start adds 3 edges, every other triangle at most 2: no more than 3T edges, whatever the
+    // symbols.
+    if (edges_.size() < 3 * triangles) edges_.resize(3 * triangles);
+    size_ = gate_ = 0;
+  }
+  // The next edge to process, or kNone.
+  uint32_t gate() {
+    while (gate_ < size_ && edges_[gate_].state != kPending) ++gate_;
+    return gate_ < size_ ? uint32_t(gate_) : kNone;
+  }
+  const Edge& edge(uint32_t e) const { return edges_[e]; }
+  // p of the gate's kLeft, n of its kRight (kNone unless its loop has 3 edges or more), and whether its loop
+  // has exactly 3 (kEnd).
+  uint32_t left(uint32_t e) const {
+    const Edge& g = edges_[e];
+    return g.prev != g.next ? edges_[g.prev].a : kNone;
+  }
+  uint32_t right(uint32_t e) const {
+    const Edge& g = edges_[e];
+    return g.prev != g.next ? edges_[g.next].b : kNone;
+  }
+  bool closes(uint32_t e) const {
+    const Edge& g = edges_[e];
+    return g.prev != g.next && edges_[g.next].next == g.prev;
+  }
+
+  void start(uint32_t v0, uint32_t v1, uint32_t v2) {
+    const uint32_t at = uint32_t(size_);
+    push(v0, v1, v2, at + 2, at + 1);
+    push(v1, v2, v0, at, at + 2);
+    push(v2, v0, v1, at + 1, at);
+  }
+  // kVertex and kSplit: the gate a -> b becomes a -> c, c -> b.
+  void attach(uint32_t e, uint32_t c) {
+    const uint32_t a = edges_[e].a, b = edges_[e].b, prev = edges_[e].prev, next = edges_[e].next;
+    const uint32_t x = uint32_t(size_), y = x + 1;
+    push(a, c, b, prev, y);
+    push(c, b, a, x, next);
+    edges_[prev].next = x;  // a loop has 2 edges or more: prev and next are not the gate
+    edges_[next].prev = y;
+    edges_[e].state = kGone;
+  }
+  // kLeft: P = p -> a and the gate become p -> b.
+  void close_left(uint32_t e) {
+    Edge &g = edges_[e], &p = edges_[g.prev];
+    link(p.prev, g.next, p.a, g.b, g.a);
+    p.state = g.state = kGone;
+  }
+  // kRight: the gate and N = b -> n become a -> n.
+  void close_right(uint32_t e) {
+    Edge &g = edges_[e], &n = edges_[g.next];
+    link(g.prev, n.next, g.a, n.b, g.b);
+    n.state = g.state = kGone;
+  }
+  // kEnd: the loop of 3 is gone.
+  void close_loop(uint32_t e) {
+    Edge& g = edges_[e];
+    edges_[g.prev].state = edges_[g.next].state = g.state = kGone;
+  }
+  // kBoundary.
+  void done(uint32_t e) { edges_[e].state = kDone; }
+
+ private:
+  void push(uint32_t a, uint32_t b, uint32_t o, uint32_t prev, uint32_t next) {
+    Edge& x = edges_[size_++];
+    x.a = a, x.b = b, x.o = o, x.prev = prev, x.next = next, x.state = kPending;
+  }
+  // A new edge a -> b (third corner o) between `before` and `after`.
+  void link(uint32_t before, uint32_t after, uint32_t a, uint32_t b, uint32_t o) {
+    const uint32_t x = uint32_t(size_);
+    push(a, b, o, before, after);
+    edges_[before].next = x;
+    edges_[after].prev = x;
+  }
+
+  std::vector<Edge> edges_;
+  size_t size_ = 0, gate_ = 0;
+};
+
+void put_varint(std::vector<uint8_t>& out, uint32_t v) {
+  for (; v >= 0x80; v >>= 7) out.push_back(uint8_t(v | 0x80));
+  out.push_back(uint8_t(v));
+}
+
+}  // namespace
+
+TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V) {
+  const uint32_t T = uint32_t(indices.size() / 3);
+  TraversalCode code;
+  code.indices.reserve(indices.size());
+  code.predictors.reserve(3 * size_t(V));
+  // Outgoing half-edges per vertex (corner c = 3t + k goes from indices[c] to the next corner of t).
+  std::vector<uint32_t> first(size_t(V) + 1, 0), corners(indices.size());
+  for (uint32_t i : indices) ++first[i + 1];
+  for (uint32_t v = 0; v < V; ++v) first[v + 1] += first[v];
+  {
+    std::vector<uint32_t> fill(first.begin(), first.end() - 1);
+    for (uint32_t c = 0; c < indices.size(); ++c) corners[fill[indices[c]]++] = c;
+  }
+  auto next_corner = [](uint32_t c) { return c % 3 == 2 ? c - 2 : c + 1; };
+  std::vector<uint8_t> encoded(T, 0);
+  std::vector<uint32_t> decoded(V, kNone);  // decoded[input vertex] = its number
+  auto add_vertex = [&](uint32_t input, uint32_t o1, uint32_t o2, uint32_t o) {
+    decoded[input] = uint32_t(code.order.size());
+    code.order.push_back(input);
+    code.predictors.insert(code.predictors.end(), {o1, o2, o});
+    return decoded[input];
+  };
+  auto emit = [&](uint32_t a, uint32_t b, uint32_t c) { code.indices.insert(code.indices.end(), {a, b, c}); };
+
+  Front front;
+  front.reset(T);
+  uint32_t scan = 0;  // triangles below it are encoded
+  uint32_t done = 0;  // triangles emitted
+  while (done < T) {
+    const uint32_t e = front.gate();
+    if (e == kNone) {
+      while (encoded[scan]) ++scan;
+      encoded[scan] = 1;
+      uint32_t corner[3];
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t input = indices[3 * scan + k];
+        const uint32_t next = uint32_t(code.order.size());
+        if (decoded[input] != kNone) {
+          put_varint(code.references, next - decoded[input]);
+          corner[k] = decoded[input];
+        } else {
+          put_varint(code.references, 0);
+          const uint32_t from = k > 0 ? corner[k - 1] : next > 0 ? next - 1 : V;
+          corner[k] = add_vertex(input, from, from, from);
+        }
+      }
+      front.start(corner[0], corner[1], corner[2]);
+      emit(corner[0], corner[1], corner[2]);
+      ++done;
+      continue;
+    }
+    const Front::Edge g = front.edge(e);
+    // The triangle across a -> b holds half-edge b -> a.
+    const uint32_t a_in = code.order[g.a], b_in = code.order[g.b];
+    uint32_t across = kNone;
+    for (uint32_t i = first[b_in]; i < first[b_in + 1] && across == kNone; ++i) {
+      const uint32_t c = corners[i];
+      if (!encoded[c / 3] && indices[next_corner(c)] == a_in) across = c;
+    }
+    if (across == kNone) {
+      code.symbols.push_back(kBoundary);
+      front.done(e);
+      continue;
+    }
+    encoded[across / 3] = 1;
+    const uint32_t c_in = indices[next_corner(next_corner(across))];
+    uint32_t c = decoded[c_in];
+    if (c == kNone) {
+      code.symbols.push_back(kVertex);
+      c = add_vertex(c_in, g.a, g.b, g.o);
+      front.attach(e, c);
+    } else if (front.closes(e) && c == front.left(e)) {
+      code.symbols.push_back(kEnd);
+      front.close_loop(e);
+    } else if (c == front.left(e)) {
+      code.symbols.push_back(kLeft);
+      front.close_left(e);
+    } else if (c == front.right(e)) {
+      code.symbols.push_back(kRight);
+      front.close_right(e);
+    } else {
+      code.symbols.push_back(kSplit);
+      put_varint(code.references, uint32_t(code.order.size()) - 1 - c);
+      front.attach(e, c);
+    }
+    emit(g.b, g.a, c);
+    ++done;
+  }
+  for (uint32_t v = 0; v < V; ++v) {
+    if (decoded[v] != kNone) continue;
+    const uint32_t from = code.order.empty() ? V : uint32_t(code.order.size()) - 1;
+    add_vertex(v, from, from, from);
+  }
+  return code;
+}
+
+void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t> references, uint32_t T,
+                      uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where) {
+  ByteReader refs(references, where);
+  auto fail = [&](const char* what) { throw Error(where + ": corrupted connectivity (" + what + ")"); };
+  thread_local Front front;
+  front.reset(T);
+  uint32_t next = 0;  // the next new vertex
+  size_t s = 0;
+  uint32_t* out = indices;
+  const uint32_t* const end = indices + 3 * size_t(T);
+  while (out != end) {
+    const uint32_t e = front.gate();
+    if (e == kNone) {
+      uint32_t corner[3];
+      for (int k = 0; k < 3; ++k) {
+        const uint64_t r = refs.varint();
+        if (r == 0) {
+          if (next == V) fail("more vertices than the node holds");
+          const uint32_t from = k > 0 ? corner[k - 1] : next > 0 ? next - 1 : V;
+          predictors[3 * next] = predictors[3 * next + 1] = predictors[3 * next + 2] = from;
+          corner[k] = next++;
+        } else {
+          if (r > next) fail("reference to a vertex not decoded yet");
+          corner[k] = next - uint32_t(r);
+        }
+      }
+      front.start(corner[0], corner[1], corner[2]);
+      out[0] = corner[0], out[1] = corner[1], out[2] = corner[2];
+      out += 3;
+      continue;
+    }
+    if (s == symbols.size()) fail("symbols end early");
+    const Front::Edge& g = front.edge(e);
+    const uint32_t a = g.a, b = g.b;
+    uint32_t c;
+    switch (symbols[s++]) {
+      case kVertex:
+        if (next == V) fail("more vertices than the node holds");
+        c = next++;
+        predictors[3 * c] = a, predictors[3 * c + 1] = b, predictors[3 * c + 2] = g.o;
+        front.attach(e, c);
+        break;
+      case kLeft:
+        c = front.left(e);
+        if (c == kNone) fail("left turn in a loop of 2");
+        front.close_left(e);
+        break;
+      case kRight:
+        c = front.right(e);
+        if (c == kNone) fail("right turn in a loop of 2");
+        front.close_right(e);
+        break;
+      case kEnd:
+        if (!front.closes(e)) fail("end of a loop that is not 3 edges");
+        c = front.left(e);
+        front.close_loop(e);
+        break;
+      case kSplit: {
+        const uint64_t r = refs.varint();
+        if (r >= next) fail("reference to a vertex not decoded yet");
+        c = next - 1 - uint32_t(r);
+        front.attach(e, c);
+        break;
+      }
+      case kBoundary:
+        front.done(e);
+        continue;
+      default:
+        fail("unknown symbol");
+    }
+    out[0] = b, out[1] = a, out[2] = c;
+    out += 3;
+  }
+  if (s != symbols.size()) fail("symbols left over");
+  if (!refs.at_end()) fail("references left over");
+  for (; next < V; ++next) {
+    const uint32_t from = next > 0 ? next - 1 : V;
+    predictors[3 * next] = predictors[3 * next + 1] = predictors[3 * next + 2] = from;
+  }
+}
+
+}  // namespace lodstream::package

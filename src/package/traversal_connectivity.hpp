@@ -1,0 +1,61 @@
+// Connectivity as a traversal of the triangles across their edges, so that every triangle but the first of
+// each connected piece arrives attached to a known edge of the decoded part (Rossignac 1999, "Edgebreaker:
+// Connectivity Compression for Triangle Meshes", IEEE TVCG 5(1); here in the form of a front of edges
+// processed first in, first out, as Ponchio's Corto codec does). The decoder then knows, for every new
+// vertex, the triangle across the edge it was attached to: the parallelogram prediction (Touma & Gotsman
+// 1998) needs no search.
+//
+// The front: loops of half-edges (a -> b) of decoded triangles whose other side is not decoded yet, each loop
+// chained (an edge's b is the next edge's a) and each edge knowing o, the third corner of its triangle. Edges
+// are processed in the order they were created (the "gate"); for gate a -> b with loop neighbours
+// P = (p -> a) and N = (b -> n), one symbol (a byte) says what lies across it:
+//   kVertex:   triangle (b, a, c) with c a new vertex (the next number); the gate becomes a -> c, c -> b.
+//              c's position is predicted as a + b - o (the parallelogram).
+//   kLeft:     triangle (b, a, p); P and the gate become p -> b (requires a loop of 3 edges or more).
+//   kRight:    triangle (b, a, n); the gate and N become a -> n (likewise).
+//   kEnd:      triangle (b, a, p) closes a loop of exactly 3 edges; the loop is gone.
+//   kSplit:    triangle (b, a, c) with c an earlier vertex that is neither p nor n (a reference follows);
+//              the gate becomes a -> c, c -> b.
+//   kBoundary: nothing across (a border of the node, or a triangle already decoded from another edge); the
+//              edge stays in its loop, done.
+// When no edge is left to process and triangles remain, a new piece starts with a triangle of three
+// references (varint 0 = a new vertex, r > 0 = the vertex r below the next new one) whose edges form a new
+// loop; its new vertices are predicted from the vertex before them (the first vertex of all from cmin).
+// References of splits are varints r = (next new vertex - 1 - vertex). Vertices no triangle uses come last,
+// each predicted from the vertex before it.
+//
+// On a manifold patch about half the symbols are kVertex and most others kLeft / kRight / kBoundary (border
+// edges), so zstd's entropy stage takes them to about 2 bits per triangle. Decode: O(T), no search, no hash.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace lodstream::package {
+
+enum TraversalSymbol : uint8_t { kVertex = 0, kLeft = 1, kRight = 2, kBoundary = 3, kSplit = 4, kEnd = 5 };
+
+struct TraversalCode {
+  std::vector<uint8_t> symbols;     // one per gate processed
+  std::vector<uint8_t> references;  // varints: three per piece start, one per split
+  std::vector<uint32_t> order;      // order[decoded vertex] = the input vertex
+  std::vector<uint32_t> indices;    // the input's triangles in decoded order and numbering, each rotated
+  // Per decoded vertex v, (o1, o2, o): v is predicted as c[o1] + c[o2] - c[o], every corner below v or V
+  // (standing for cmin); a single predictor x is (x, x, x).
+  std::vector<uint32_t> predictors;
+};
+
+// Encodes the triangles `indices` (every index below V). Triangles are found across edges with a per-vertex
+// list of outgoing half-edges; a non-manifold edge takes any of its triangles, the others start pieces or
+// arrive as splits. Cost: O(T + V) (times the vertex valence for the look-ups).
+TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V);
+
+// Decodes T triangles of V vertices into indices (3T entries) and predictors (3V entries, as
+// TraversalCode's); every symbol, reference and vertex count is checked: corrupted streams throw
+// lodstream::Error starting with `where`. Cost: O(T + V), one pass over the symbols.
+void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t> references, uint32_t T,
+                      uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where);
+
+}  // namespace lodstream::package
