@@ -60,16 +60,20 @@ TEST(CliBake, ElephantBuildsAVerifiedHierarchy) {
   EXPECT_NEAR(wall, j["time_s"].get<double>(), 0.01);
 }
 
-TEST(CliBake, BothNodeCodecsVerifyAndCodecTwoIsSmaller) {
-  // The same hierarchy through codec 1 (meshoptimizer's codecs) and codec 2 (predicted positions and
-  // normals): both packages pass inspect --verify (crack-free cuts need codec 2's locked vertices exact too).
+TEST(CliBake, EveryNodeCodecVerifiesAndEachIsSmallerThanTheLast) {
+  // The same hierarchy through codec 1 (meshoptimizer's codecs), codec 2 (predicted positions and normals)
+  // and codec 3 (2 with edge-front connectivity): every package passes inspect --verify (crack-free cuts need
+  // the predictive codecs' locked vertices exact too), each smaller than the one before.
   const auto dir = temp_dir();
   auto one = bake_and_verify("bunny.obj", dir / "bunny1.lods", {"--codec", "1"});
   auto two = bake_and_verify("bunny.obj", dir / "bunny2.lods", {"--codec", "2"});
+  auto three = bake_and_verify("bunny.obj", dir / "bunny3.lods", {"--codec", "3"});
   EXPECT_EQ(one["nodes"], two["nodes"]);
+  EXPECT_EQ(one["nodes"], three["nodes"]);
   EXPECT_LT(two["bytes"].get<double>(), 0.9 * one["bytes"].get<double>());
+  EXPECT_LT(three["bytes"].get<double>(), 0.95 * two["bytes"].get<double>());
   auto bad = run_lodstream(
-      {"bake", data_file("elephant.off").string(), "-o", (dir / "x.lods").string(), "--codec", "3"});
+      {"bake", data_file("elephant.off").string(), "-o", (dir / "x.lods").string(), "--codec", "4"});
   EXPECT_EQ(bad.status, 1);
   EXPECT_NE(bad.err.find("lodstream: error: --codec"), std::string::npos) << bad.err;
 }
