@@ -579,33 +579,31 @@ class Simplifier {
   // weights (attributes eliminated per end) it measured mixed, so it applies positions only.
   void place(Plan& p) const {
     constexpr double kEndShare = 0.1;
-    Reduced r;
-    double w = 0;
-    std::array<Reduced, 2> own;  // Q_a, Q_b (positions only)
+    std::array<Reduced, 2> own;  // Q_a, Q_b
     std::array<double, 2> own_w{0.0, 0.0};
-    // Everything relative to b's origin o (a's quadrics shifted by o - o_a), x = o + y.
+    // Everything relative to b's origin o (a's quadrics shifted by o - o_a; b's wedges share o), x = o + y.
     const glm::dvec3 o = origin_of(p.b), shift = o - origin_of(p.a);
-    for (int side = 0; side < 2; ++side) {
-      const uint32_t end = side ? p.b : p.a;
-      const glm::dvec3 d = side ? glm::dvec3(0.0) : shift;
-      uint32_t v = end;
-      do {
-        r.add(quadric_[v], d);
-        w += quadric_[v].w;
-        if (channels_ == 0) own[side].add(quadric_[v], d), own_w[side] += quadric_[v].w;
-        v = wedge_[v];
-      } while (v != end);
-    }
+    uint32_t v = p.a;
+    do own[0].add(quadric_[v], shift), own_w[0] += quadric_[v].w, v = wedge_[v];
+    while (v != p.a);
+    v = p.b;
+    do own[1].add(quadric_[v]), own_w[1] += quadric_[v].w, v = wedge_[v];
+    while (v != p.b);
+    Reduced r = own[0];
+    r.add(own[1]);
+    const double w = own_w[0] + own_w[1];
     for (int pair = 0; pair < 2 && channels_ > 0; ++pair) {
       uint32_t a = pair ? p.a2 : p.a, b = pair ? p.b2 : p.b;
       if (a == kNone) continue;
       double ww = double(quadric_[a].w) + quadric_[b].w;
       if (!(ww > 0)) continue;
+      ChannelSums sums;
+      const AttributeTerm *ta = &attr_[a * size_t(channels_)], *tb = &attr_[b * size_t(channels_)];
       for (int j = 0; j < channels_; ++j) {
-        const AttributeTerm &ta = attr_[a * size_t(channels_) + j], &tb = attr_[b * size_t(channels_) + j];
-        r.eliminate(glm::dvec3(ta.g) + glm::dvec3(tb.g),
-                    double(ta.d) + glm::dot(glm::dvec3(ta.g), shift) + tb.d, ww);
+        const glm::dvec3 ga(ta[j].g);
+        sums.add(ga + glm::dvec3(tb[j].g), double(ta[j].d) + glm::dot(ga, shift) + tb[j].d);
       }
+      r.eliminate(sums, ww);
     }
     const glm::dvec3 pa = glm::dvec3(pos_[p.a]) - o, pb = glm::dvec3(pos_[p.b]) - o;
     const uint8_t ka = kind_[p.a], kb = kind_[p.b];
