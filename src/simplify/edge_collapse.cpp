@@ -1133,14 +1133,16 @@ class Simplifier {
       }
     for (const Segment& o : sc.old_edges) {
       const glm::dvec2 rel = o.origin - yx;
+      // s = cross2(rel, od) / den, t = cross2(rel, nd) / den, both strictly inside (0, 1); sn is the same for
+      // every spoke, so its sign fixes den's.
+      const double sn = cross2(rel, o.direction);
+      if (sn == 0) continue;
       for (const Segment& e : sc.spokes) {
         const double den = cross2(e.direction, o.direction);
+        if (sn > 0 ? den <= sn : den >= sn) continue;
         if (std::abs(den) < 1e-30) continue;
-        // s = cross2(rel, od) / den, t = cross2(rel, nd) / den, both strictly inside (0, 1).
-        const double sn = cross2(rel, o.direction), tn = cross2(rel, e.direction);
-        if (den > 0 ? (sn <= 0 || sn >= den || tn <= 0 || tn >= den)
-                    : (sn >= 0 || sn <= den || tn >= 0 || tn <= den))
-          continue;
+        const double tn = cross2(rel, e.direction);
+        if (sn > 0 ? (tn <= 0 || tn >= den) : (tn >= 0 || tn <= den)) continue;
         const double s = sn / den, t = tn / den;
         if (!(s > 0 && s < 1 && t > 0 && t < 1)) continue;
         const double gap = std::abs((1 - s) * hx + s * e.h0 - ((1 - t) * o.h0 + t * o.h1));
