@@ -3,11 +3,13 @@
 // bound (meshoptimizer 0.18 has positions-only half-edge collapse and no bound; OpenMesh's decimater has
 // neither seams nor a bound).
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 
@@ -56,12 +58,12 @@ struct Segment {
   double h0, h1, r0, r1;
 };
 
-constexpr uint8_t kAnyRegion = 2;
+constexpr uint32_t kAnyRegion = UINT32_MAX;
 
 // What one thread of the collapse loop needs of its own: the collapse's neighbourhood, vertical_bound's
 // faces and edges, and what its collapses changed (merged into the mesh's totals after the loop).
 struct Scratch {
-  uint8_t region = kAnyRegion;  // collapses must keep every face they read inside this region
+  uint32_t region = kAnyRegion;  // collapses must keep every face they read inside this region
   std::vector<uint32_t> na, nb, apex, removed;
   std::vector<Corners> old;
   std::vector<Segment> old_edges, spokes;  // spokes: direction from x, origin unused
@@ -97,7 +99,6 @@ class Simplifier {
     build_adjacency();
     classify();
     build_quadrics();
-    choose_split();
     const size_t target = opt_.target_triangles;
     const size_t start_tris = alive_triangles_;
     bool stalled = false, retried = false;
@@ -168,14 +169,15 @@ class Simplifier {
   std::vector<float> bucket_;    // goal_cost's candidate costs in one histogram bucket
   std::vector<uint32_t> dirty_;  // vertices of the faces around touched vertices, this pass
   std::vector<uint8_t> vertex_mark_;
-  // Two spatial halves of the vertices (split at the median along one axis, the next axis each time, so
-  // that no band of the mesh is always left to the serial part) for the parallel part of the collapse loop;
-  // side_ and pending_: per order_ entry, its half (kAnyRegion when it crosses) and whether its half's thread
-  // left it for the serial part.
-  std::vector<uint8_t> region_, side_, pending_;
-  glm::vec3 split_{0.0f};
-  int split_axis_ = 0;
-  std::array<Scratch, 2> scratch_;
+  // Regions of the collapse loop's parallel part (region_of): runs of kRegionVertices vertices in Morton
+  // order, shifted by region_shift_, which turns each pass so that no band of the mesh is always left to the
+  // serial part. region_start_: where each region's candidates begin in sorted_ (grouped by region after the
+  // cost sort, as (cost, order_ index)); pending_: per order_ entry, whether the serial part is to try it.
+  static constexpr uint32_t kRegionVertices = 4096;
+  uint32_t region_shift_ = 0;
+  std::vector<uint32_t> region_start_;
+  std::vector<uint8_t> pending_;
+  Scratch serial_;
   bool rejected_ = false;  // slots were set to +inf by failed collapses since the last full evaluation
   uint32_t step_ = 0;
   std::vector<Collapse>* record_ = nullptr;
@@ -505,20 +507,6 @@ class Simplifier {
                             : (c.attribute == 1 ? uv_[v][c.component] : col_[v][c.component]);
   }
 
-  // The median of the vertices along each axis: the planes that split them into the two halves of
-  // collapse_in_order. O(V) (nth_element on a copy).
-  void choose_split() {
-    const size_t m = pos_.size();
-    region_.assign(m, 0);
-    if (m == 0) return;
-    std::vector<float> c(m);
-    for (int axis = 0; axis < 3; ++axis) {
-      for (size_t v = 0; v < m; ++v) c[v] = pos_[v][axis];
-      std::nth_element(c.begin(), c.begin() + m / 2, c.end());
-      split_[axis] = c[m / 2];
-    }
-  }
-
   // The weighted channel values of v (s_j = weight_j x component_j).
   void channel_values(uint32_t v, float* s) {
     for (int j = 0; j < channels_; ++j) s[j] = channel(v, j) * channel_[j].weight;
@@ -726,69 +714,63 @@ class Simplifier {
 
   // The collapse loop over order_ (cost order, up to `limit`, until the target): independent collapses,
   // none touching a vertex an earlier one in this pass touched. Large passes (not recording collapses) run
-  // it on both halves of the mesh at once first, each thread taking the candidates of its half in order up
-  // to half the triangles still to remove; collapses whose faces cross the split, and what a thread left,
-  // follow serially in order. Each half's outcome depends only on its own faces, so the result is the same
-  // on every run. Returns the number of collapses.
+  // it first on many small regions at once (both cores, each region's data cache-resident: candidates come in
+  // cost order, random in space), each region taking its own candidates in order up to its share of the
+  // triangles still to remove (in proportion to its candidates); collapses whose faces cross a region's
+  // border, and what a region left, follow serially in order. Each region's outcome depends only on its own
+  // faces, so the result is the same on every run. Returns the number of collapses.
   size_t collapse_in_order(float limit, size_t target) {
     size_t collapsed = 0;
-    // The order_ index from which a half's candidates are left to the serial part.
-    std::array<size_t, 2> stop{0, 0};
     constexpr size_t kParallelMin = 1024;
     const bool parallel = !record_ && order_.size() >= kParallelMin && alive_triangles_ > target + 8;
     if (parallel) {
-      const size_t quota = (alive_triangles_ - target) / 2;
-      const int axis = split_axis_;
-      split_axis_ = (split_axis_ + 1) % 3;
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, region_.size(), 4096), [&](const auto& r) {
-        for (size_t v = r.begin(); v < r.end(); ++v) region_[v] = pos_[v][axis] < split_[axis] ? 0 : 1;
-      });
-      // Each candidate's half (kAnyRegion: its ends lie in both), once: the threads then read only their
-      // own candidates' slots (in cost order, random in memory).
-      side_.resize(order_.size());
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, order_.size(), 4096), [&](const auto& r) {
-        for (size_t i = r.begin(); i < r.end(); ++i) {
-          const Candidate& c = slots_[order_[i].slot];
-          side_[i] = region_[c.a] == region_[c.b] ? region_[c.a] : kAnyRegion;
-        }
-      });
-      pending_.assign(order_.size(), 0);
-      std::array<size_t, 2> count{0, 0};
-      auto half = [&](uint8_t r) {
-        Scratch& s = scratch_[r];
-        s.region = r;
-        size_t i = 0;
-        for (; i < order_.size(); ++i) {
-          if (order_[i].cost > limit || s.removed_triangles + 2 > quota) break;
-          prefetch(i, r);
-          if (side_[i] != r) continue;
-          const Candidate& c = slots_[order_[i].slot];
-          Plan p;
-          if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
-          p.slot = order_[i].slot;
-          if (p.a2 != kNone && (touched_[p.a2] || touched_[p.b2])) continue;
-          switch (try_collapse(p, s)) {
-            case Outcome::kCollapsed:
-              ++count[r];
-              break;
-            case Outcome::kOutsideRegion:
-              pending_[i] = 1;
-              break;
-            case Outcome::kRejected:
-              break;
+      group_by_region();
+      const size_t n = order_.size(), removable = alive_triangles_ - target;
+      const uint32_t regions = uint32_t(region_start_.size() - 1);
+      tbb::enumerable_thread_specific<Scratch> scratch;
+      std::atomic<size_t> count{0};
+      tbb::parallel_for(tbb::blocked_range<uint32_t>(0, regions, 1), [&](const auto& range) {
+        Scratch& s = scratch.local();
+        size_t here = 0;
+        for (uint32_t r = range.begin(); r < range.end(); ++r) {
+          const uint32_t begin = region_start_[r], end = region_start_[r + 1];
+          const size_t quota = size_t(double(removable) * (end - begin) / double(n));
+          const size_t removed_before = s.removed_triangles;
+          s.region = r;
+          for (uint32_t k = begin; k < end; ++k) {
+            if (s.removed_triangles - removed_before + 2 > quota) break;
+            prefetch(k, end);
+            const uint32_t i = sorted_[k].slot;
+            pending_[i] = 0;
+            const Candidate& c = slots_[order_[i].slot];
+            Plan p;
+            if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
+            p.slot = order_[i].slot;
+            if (p.a2 != kNone && (touched_[p.a2] || touched_[p.b2])) continue;
+            switch (try_collapse(p, s)) {
+              case Outcome::kCollapsed:
+                ++here;
+                break;
+              case Outcome::kOutsideRegion:
+                pending_[i] = 1;
+                break;
+              case Outcome::kRejected:
+                break;
+            }
           }
         }
-        stop[r] = i;
-      };
-      tbb::parallel_invoke([&] { half(0); }, [&] { half(1); });
-      collapsed = count[0] + count[1];
-      gather(scratch_[0]), gather(scratch_[1]);
+        count += here;
+      });
+      collapsed = count;
+      for (Scratch& s : scratch) gather(s);
+    } else {
+      pending_.assign(order_.size(), 1);
     }
-    Scratch& s = scratch_[0];
+    Scratch& s = serial_;
     s.region = kAnyRegion;
     for (size_t i = 0; i < order_.size(); ++i) {
       if (order_[i].cost > limit || alive_triangles_ - s.removed_triangles <= target) break;
-      if (parallel && side_[i] != kAnyRegion && !pending_[i] && i < stop[side_[i]]) continue;
+      if (!pending_[i]) continue;
       const Candidate& c = slots_[order_[i].slot];
       Plan p;
       if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
@@ -800,15 +782,39 @@ class Simplifier {
     return collapsed;
   }
 
-  // Candidates come in cost order, random in memory, so each try starts with cache misses: this loads the
-  // slot of the candidate kSlotAhead places on, and the per-vertex data of the ends of the one kEndAhead on
-  // (its slot loaded earlier), if they belong to half r, so that their misses overlap the tries between.
-  void prefetch(size_t i, uint8_t r) const {
-    constexpr size_t kSlotAhead = 16, kEndAhead = 8;
-    if (i + kSlotAhead < order_.size() && side_[i + kSlotAhead] == r)
-      __builtin_prefetch(&slots_[order_[i + kSlotAhead].slot]);
-    if (i + kEndAhead < order_.size() && side_[i + kEndAhead] == r) {
-      const Candidate& c = slots_[order_[i + kEndAhead].slot];
+  uint32_t region_of(uint32_t v) const { return (v + region_shift_) / kRegionVertices; }
+
+  // Groups the pass's candidates by region into sorted_ as (cost, order_ index), in cost order within each
+  // region (a counting sort; candidates whose ends lie in two regions are left out) and sets region_start_;
+  // pending_ = 1 (for the serial part) for every candidate until a region takes it. Turns region_shift_.
+  void group_by_region() {
+    region_shift_ = (region_shift_ + kRegionVertices / 3 + 1) % kRegionVertices;
+    const uint32_t regions = region_of(uint32_t(source_.size())) + 1;
+    region_start_.assign(regions + 1, 0);
+    sorted_.resize(order_.size());
+    auto region = [&](size_t i) {
+      const Candidate& c = slots_[order_[i].slot];
+      const uint32_t ra = region_of(c.a);
+      return ra == region_of(c.b) ? ra : kAnyRegion;
+    };
+    for (size_t i = 0; i < order_.size(); ++i)
+      if (uint32_t r = region(i); r != kAnyRegion) ++region_start_[r + 1];
+    for (uint32_t r = 0; r < regions; ++r) region_start_[r + 1] += region_start_[r];
+    std::vector<uint32_t> fill(region_start_.begin(), region_start_.end() - 1);
+    for (size_t i = 0; i < order_.size(); ++i)
+      if (uint32_t r = region(i); r != kAnyRegion) sorted_[fill[r]++] = {order_[i].cost, uint32_t(i)};
+    pending_.assign(order_.size(), 1);
+  }
+
+  // Candidates come in cost order, random in their region, so each try starts with cache misses: this loads
+  // the slot of the candidate kSlotAhead places on in the region's list (sorted_, before `end`), and the
+  // per-vertex data of the ends of the one kEndAhead on (its slot loaded earlier), so that their misses
+  // overlap the tries between.
+  void prefetch(uint32_t k, uint32_t end) const {
+    constexpr uint32_t kSlotAhead = 16, kEndAhead = 8;
+    if (k + kSlotAhead < end) __builtin_prefetch(&slots_[order_[sorted_[k + kSlotAhead].slot].slot]);
+    if (k + kEndAhead < end) {
+      const Candidate& c = slots_[order_[sorted_[k + kEndAhead].slot].slot];
       for (uint32_t v : {c.a, c.b}) {
         __builtin_prefetch(&touched_[v]), __builtin_prefetch(&offsets_[v]), __builtin_prefetch(&pos_[v]);
         __builtin_prefetch(&quadric_[v]), __builtin_prefetch(&radius_[v]), __builtin_prefetch(&pid_[v]);
@@ -897,7 +903,7 @@ class Simplifier {
     bool inside = true;
     auto in_region = [&](const uint32_t* t) {
       return s.region == kAnyRegion ||
-             (region_[t[0]] == s.region && region_[t[1]] == s.region && region_[t[2]] == s.region);
+             (region_of(t[0]) == s.region && region_of(t[1]) == s.region && region_of(t[2]) == s.region);
     };
     for_faces(p.a, [&](uint32_t f) {
       const uint32_t* t = &indices_[3 * size_t(f)];
