@@ -162,19 +162,20 @@ class Simplifier {
   bool error_limited_ = false;  // a collapse was refused because of Options::max_error
 
   std::vector<uint32_t> indices_;  // alive faces; dead ones have indices_[3f] == kNone during a pass
-  size_t alive_triangles_ = 0;
-  std::vector<uint32_t> offsets_, faces_;  // vertex -> faces (CSR), rebuilt each pass
+  size_t alive_triangles_ = 0, welded_triangles_ = 0;  // welded_: before the first collapse
+  std::vector<uint32_t> offsets_, faces_;              // vertex -> faces (CSR), rebuilt each pass
   std::vector<Candidate> slots_;
   std::vector<Ranked> order_, sorted_;
   std::vector<float> bucket_;    // goal_cost's candidate costs in one histogram bucket
   std::vector<uint32_t> dirty_;  // vertices of the faces around touched vertices, this pass
   std::vector<uint8_t> vertex_mark_;
-  // Regions of the collapse loop's parallel part (region_of): runs of kRegionVertices vertices in Morton
-  // order, shifted by region_shift_, which turns each pass so that no band of the mesh is always left to the
-  // serial part. region_start_: where each region's candidates begin in sorted_ (grouped by region after the
-  // cost sort, as (cost, order_ index)); pending_: per order_ entry, whether the serial part is to try it.
-  static constexpr uint32_t kRegionVertices = 4096;
-  uint32_t region_shift_ = 0;
+  // Regions of the collapse loop's parallel part (region_of): runs of region_vertices_ vertex numbers in
+  // Morton order (about kRegionVertices alive vertices: the run grows as the mesh shrinks), shifted by
+  // region_shift_, which turns each pass so that no band of the mesh is always left to the serial part.
+  // region_start_: where each region's candidates begin in sorted_ (grouped by region after the cost sort, as
+  // (cost, order_ index)); pending_: per order_ entry, whether the serial part is to try it.
+  static constexpr uint32_t kRegionVertices = 16384;
+  uint32_t region_vertices_ = kRegionVertices, region_shift_ = 0;
   std::vector<uint32_t> region_start_;
   std::vector<uint8_t> pending_;
   Scratch serial_;
@@ -237,7 +238,7 @@ class Simplifier {
       if (a == b || b == c || a == c) continue;
       indices_.insert(indices_.end(), {a, b, c});
     }
-    alive_triangles_ = indices_.size() / 3;
+    alive_triangles_ = welded_triangles_ = indices_.size() / 3;
     sort_faces();
   }
 
@@ -782,13 +783,15 @@ class Simplifier {
     return collapsed;
   }
 
-  uint32_t region_of(uint32_t v) const { return (v + region_shift_) / kRegionVertices; }
+  uint32_t region_of(uint32_t v) const { return (v + region_shift_) / region_vertices_; }
 
   // Groups the pass's candidates by region into sorted_ as (cost, order_ index), in cost order within each
   // region (a counting sort; candidates whose ends lie in two regions are left out) and sets region_start_;
   // pending_ = 1 (for the serial part) for every candidate until a region takes it. Turns region_shift_.
   void group_by_region() {
-    region_shift_ = (region_shift_ + kRegionVertices / 3 + 1) % kRegionVertices;
+    const size_t shrink = welded_triangles_ / std::max<size_t>(alive_triangles_, 1);
+    region_vertices_ = kRegionVertices * uint32_t(std::clamp<size_t>(shrink, 1, 1024));
+    region_shift_ = (region_shift_ + region_vertices_ / 3 + 1) % region_vertices_;
     const uint32_t regions = region_of(uint32_t(source_.size())) + 1;
     region_start_.assign(regions + 1, 0);
     sorted_.resize(order_.size());
