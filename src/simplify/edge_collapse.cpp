@@ -170,11 +170,12 @@ class Simplifier {
   std::vector<uint32_t> dirty_;  // vertices of the faces around touched vertices, this pass
   std::vector<uint8_t> vertex_mark_;
   // Regions of the collapse loop's parallel part (region_of): runs of region_vertices_ vertex numbers in
-  // Morton order (about kRegionVertices alive vertices: the run grows as the mesh shrinks), shifted by
-  // region_shift_, which turns each pass so that no band of the mesh is always left to the serial part.
+  // Morton order (about kRegionVertices alive vertices, at least kMinRegions regions on a smaller mesh; the
+  // run grows as the mesh shrinks), shifted by region_shift_, which turns each pass so that no band of the
+  // mesh is always left to the serial part.
   // region_start_: where each region's candidates begin in sorted_ (grouped by region after the cost sort, as
   // (cost, order_ index)); pending_: per order_ entry, whether the serial part is to try it.
-  static constexpr uint32_t kRegionVertices = 16384;
+  static constexpr uint32_t kRegionVertices = 16384, kMinRegions = 8;
   uint32_t region_vertices_ = kRegionVertices, region_shift_ = 0;
   std::vector<uint32_t> region_start_;
   std::vector<uint8_t> pending_;
@@ -790,7 +791,8 @@ class Simplifier {
   // pending_ = 1 (for the serial part) for every candidate until a region takes it. Turns region_shift_.
   void group_by_region() {
     const size_t shrink = welded_triangles_ / std::max<size_t>(alive_triangles_, 1);
-    region_vertices_ = kRegionVertices * uint32_t(std::clamp<size_t>(shrink, 1, 1024));
+    const size_t first = std::clamp<size_t>(source_.size() / kMinRegions, 1, kRegionVertices);
+    region_vertices_ = uint32_t(first * std::clamp<size_t>(shrink, 1, 1024));
     region_shift_ = (region_shift_ + region_vertices_ / 3 + 1) % region_vertices_;
     const uint32_t regions = region_of(uint32_t(source_.size())) + 1;
     region_start_.assign(regions + 1, 0);

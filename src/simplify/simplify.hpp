@@ -14,9 +14,9 @@
 // edges with an end touched by the previous one and radix-sorts the candidates), each pass limited to 1.5x
 // the cost of the collapse that would reach the target, which keeps the order close to greedy. A collapse
 // that fails the validity checks is not tried again until an end is touched (or a pass finds nothing). The
-// collapse loop of a large pass runs on many small regions (about 16384 alive vertices in Morton order,
-// shifted each pass) on both cores, the collapses that cross a region's border after them, serially; the
-// result does not depend on thread timing.
+// collapse loop of a large pass runs on many small regions (runs of about 16384 alive vertices in Morton
+// order, at least 8 runs, shifted each pass) on both cores, the collapses that cross a region's border after
+// them, serially; the result does not depend on thread timing.
 //
 // Vertices are classified once (meshoptimizer's vertex kinds, extended): Manifold (interior), Border (one
 // open edge in and out), Seam (two vertices share the position and their open edges pair up: a UV, normal
