@@ -175,7 +175,7 @@ class Simplifier {
   // mesh is always left to the serial part.
   // region_start_: where each region's candidates begin in sorted_ (grouped by region after the cost sort, as
   // (cost, order_ index)); pending_: per order_ entry, whether the serial part is to try it.
-  static constexpr uint32_t kRegionVertices = 16384, kMinRegions = 8;
+  static constexpr uint32_t kRegionVertices = 16384, kMinRegions = 2;
   uint32_t region_vertices_ = kRegionVertices, region_shift_ = 0;
   std::vector<uint32_t> region_start_;
   std::vector<uint8_t> pending_;
