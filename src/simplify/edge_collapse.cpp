@@ -3,11 +3,13 @@
 // bound (meshoptimizer 0.18 has positions-only half-edge collapse and no bound; OpenMesh's decimater has
 // neither seams nor a bound).
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 
@@ -56,12 +58,12 @@ struct Segment {
   double h0, h1, r0, r1;
 };
 
-constexpr uint8_t kAnyRegion = 2;
+constexpr uint32_t kAnyRegion = UINT32_MAX;
 
 // What one thread of the collapse loop needs of its own: the collapse's neighbourhood, vertical_bound's
 // faces and edges, and what its collapses changed (merged into the mesh's totals after the loop).
 struct Scratch {
-  uint8_t region = kAnyRegion;  // collapses must keep every face they read inside this region
+  uint32_t region = kAnyRegion;  // collapses must keep every face they read inside this region
   std::vector<uint32_t> na, nb, apex, removed;
   std::vector<Corners> old;
   std::vector<Segment> old_edges, spokes;  // spokes: direction from x, origin unused
@@ -97,7 +99,6 @@ class Simplifier {
     build_adjacency();
     classify();
     build_quadrics();
-    choose_split();
     const size_t target = opt_.target_triangles;
     const size_t start_tris = alive_triangles_;
     bool stalled = false, retried = false;
@@ -146,7 +147,13 @@ class Simplifier {
   std::vector<float> radius_;  // bound radius r_v (simplify.hpp), normalized units
   std::vector<Quadric> quadric_;
   std::vector<AttributeTerm> attr_;  // channels_ per vertex
-  std::vector<float> channel_weight_;
+  // Weighted attribute channels in the cost: one component of the normal, UV or colour, with its weight.
+  struct Channel {
+    int attribute;  // 0 normal, 1 uv, 2 colour
+    int component;
+    float weight;
+  };
+  std::vector<Channel> channel_;
   int channels_ = 0;
   std::vector<uint32_t> open_out_, open_in_;
   glm::vec3 origin_{0.0f};
@@ -155,21 +162,24 @@ class Simplifier {
   bool error_limited_ = false;  // a collapse was refused because of Options::max_error
 
   std::vector<uint32_t> indices_;  // alive faces; dead ones have indices_[3f] == kNone during a pass
-  size_t alive_triangles_ = 0;
-  std::vector<uint32_t> offsets_, faces_;  // vertex -> faces (CSR), rebuilt each pass
+  size_t alive_triangles_ = 0, welded_triangles_ = 0;  // welded_: before the first collapse
+  std::vector<uint32_t> offsets_, faces_;              // vertex -> faces (CSR), rebuilt each pass
   std::vector<Candidate> slots_;
   std::vector<Ranked> order_, sorted_;
   std::vector<float> bucket_;    // goal_cost's candidate costs in one histogram bucket
   std::vector<uint32_t> dirty_;  // vertices of the faces around touched vertices, this pass
   std::vector<uint8_t> vertex_mark_;
-  // Two spatial halves of the vertices (split at the median along one axis, the next axis each time, so
-  // that no band of the mesh is always left to the serial part) for the parallel part of the collapse loop;
-  // side_ and pending_: per order_ entry, its half (kAnyRegion when it crosses) and whether its half's thread
-  // left it for the serial part.
-  std::vector<uint8_t> region_, side_, pending_;
-  glm::vec3 split_{0.0f};
-  int split_axis_ = 0;
-  std::array<Scratch, 2> scratch_;
+  // Regions of the collapse loop's parallel part (region_of): runs of region_vertices_ vertex numbers in
+  // Morton order (about kRegionVertices alive vertices, at least kMinRegions regions on a smaller mesh; the
+  // run grows as the mesh shrinks), shifted by region_shift_, which turns each pass so that no band of the
+  // mesh is always left to the serial part.
+  // region_start_: where each region's candidates begin in sorted_ (grouped by region after the cost sort, as
+  // (cost, order_ index)); pending_: per order_ entry, whether the serial part is to try it.
+  static constexpr uint32_t kRegionVertices = 16384, kMinRegions = 2;
+  uint32_t region_vertices_ = kRegionVertices, region_shift_ = 0;
+  std::vector<uint32_t> region_start_;
+  std::vector<uint8_t> pending_;
+  Scratch serial_;
   bool rejected_ = false;  // slots were set to +inf by failed collapses since the last full evaluation
   uint32_t step_ = 0;
   std::vector<Collapse>* record_ = nullptr;
@@ -229,15 +239,31 @@ class Simplifier {
       if (a == b || b == c || a == c) continue;
       indices_.insert(indices_.end(), {a, b, c});
     }
-    alive_triangles_ = indices_.size() / 3;
+    alive_triangles_ = welded_triangles_ = indices_.size() / 3;
+    sort_faces();
+  }
+
+  // Orders the faces by their smallest vertex (a counting sort; vertices are in Morton order), so that the
+  // faces around a vertex lie in a few cache lines of indices_ and slots_: each collapse walks them in cost
+  // order, random in space, and in input order the first read of every face was a cache miss (about a third
+  // of try_collapse's samples on elephant_1m). O(T + V).
+  void sort_faces() {
+    std::vector<uint32_t> start(source_.size() + 1, 0);
+    auto key = [&](size_t f) { return std::min({indices_[f], indices_[f + 1], indices_[f + 2]}); };
+    for (size_t f = 0; f < indices_.size(); f += 3) ++start[key(f) + 1];
+    for (size_t v = 1; v < start.size(); ++v) start[v] += start[v - 1];
+    std::vector<uint32_t> sorted(indices_.size());
+    for (size_t f = 0; f < indices_.size(); f += 3)
+      std::copy_n(&indices_[f], 3, &sorted[3 * size_t(start[key(f)]++)]);
+    indices_.swap(sorted);
   }
 
   // Renumbers the welded vertices in Morton (Z-curve) order of their positions, so that a collapse's
   // neighbourhood lies in a few cache lines of every per-vertex array: the collapses come in cost order,
   // which is random in space, and on a large mesh in input order most of their time went to cache misses
   // (with the quadrics' origins at the current positions: elephant_1m 10 %, CPU s under load 4-6, default
-  // weights 7.5-7.8 -> 6.1-7.6, positions only 5.9-7.0 -> 5.4-6.7; the same collapses up to ties). Faces
-  // keep the input order: sorting them too measured no clear gain. O(V log V).
+  // weights 7.5-7.8 -> 6.1-7.6, positions only 5.9-7.0 -> 5.4-6.7; the same collapses up to ties). The faces
+  // follow (sort_faces). O(V log V).
   void renumber_spatially() {
     const size_t m = source_.size();
     auto spread = [](uint64_t x) {  // bit i of x to bit 3i (21 bits)
@@ -398,18 +424,16 @@ class Simplifier {
   }
 
   // Face plane quadrics (area-weighted), attribute gradients (Hoppe 99) and boundary/seam penalty planes.
+  // Each face's planes (position and every channel) are summed once, relative to its first corner, then
+  // shifted to each corner's origin (Quadric::add_shifted): one shift per corner instead of 1 + channels
+  // planes per corner. O(T (channels + 1)).
   void build_quadrics() {
     const size_t m = source_.size();
-    if (nrm_.size() == m && opt_.normal_weight > 0)
-      for (int i = 0; i < 3; ++i) channel_weight_.push_back(opt_.normal_weight);
-    if (uv_.size() == m && opt_.uv_weight > 0)
-      for (int i = 0; i < 2; ++i) channel_weight_.push_back(opt_.uv_weight);
-    if (col_.size() == m && opt_.color_weight > 0)
-      for (int i = 0; i < 4; ++i) channel_weight_.push_back(opt_.color_weight);
-    channels_ = int(channel_weight_.size());
+    choose_channels();
     quadric_.assign(m, Quadric{});
     attr_.assign(m * size_t(channels_), AttributeTerm{});
     std::vector<float> s0(channels_), s1(channels_), s2(channels_);
+    std::vector<AttributeTerm> gradient(channels_);
     for (size_t f = 0; f < indices_.size(); f += 3) {
       uint32_t v0 = indices_[f], v1 = indices_[f + 1], v2 = indices_[f + 2];
       glm::vec3 p0 = pos_[v0], e1 = pos_[v1] - p0, e2 = pos_[v2] - p0;
@@ -417,29 +441,32 @@ class Simplifier {
       float len = glm::length(n);
       if (!(len > 0)) continue;
       float area = 0.5f * len;
-      glm::vec3 nu = n / len;
-      glm::vec3 ge1{0.0f}, ge2{0.0f};
+      Quadric face;  // relative to p0
+      face.add_plane(n / len, 0.0f, area);
+      face.w = area;
       if (channels_ > 0) {
         channel_values(v0, s0.data()), channel_values(v1, s1.data()), channel_values(v2, s2.data());
-        ge1 = glm::cross(e2, n) / (len * len), ge2 = glm::cross(n, e1) / (len * len);
-      }
-      for (uint32_t v : {v0, v1, v2}) {  // each corner's planes relative to its own origin (origin_of)
-        const glm::vec3 rel = p0 - pos_[v];
-        Quadric& q = quadric_[v];
-        q.add_plane(nu, -glm::dot(nu, rel), area);
-        q.w += area;
+        // s(p) = g.(p - p0) + s0 with g = (s1 - s0) ge1 + (s2 - s0) ge2 (the face's gradient).
+        const glm::vec3 ge1 = glm::cross(e2, n) / (len * len), ge2 = glm::cross(n, e1) / (len * len);
         for (int j = 0; j < channels_; ++j) {
-          glm::vec3 g = (s1[j] - s0[j]) * ge1 + (s2[j] - s0[j]) * ge2;
-          float d = s0[j] - glm::dot(g, rel);
-          q.add_plane(g, d, area);
-          attr_[v * size_t(channels_) + j].g += area * g;
-          attr_[v * size_t(channels_) + j].d += area * d;
+          gradient[j] = {(s1[j] - s0[j]) * ge1 + (s2[j] - s0[j]) * ge2, s0[j]};
+          face.add_plane(gradient[j].g, gradient[j].d, area);
+        }
+      }
+      for (uint32_t v : {v0, v1, v2}) {  // relative to each corner's own origin (origin_of)
+        const glm::vec3 d = pos_[v] - p0;
+        quadric_[v].add_shifted(face, glm::dvec3(d));
+        for (int j = 0; j < channels_; ++j) {
+          attr_[v * size_t(channels_) + j].g += area * gradient[j].g;
+          attr_[v * size_t(channels_) + j].d += area * (gradient[j].d + glm::dot(gradient[j].g, d));
         }
       }
     }
     // Penalty planes through open edges (borders and both sides of seams), perpendicular to their face.
+    // Manifold vertices have none.
     std::vector<uint32_t> outs, ins;
     for (uint32_t v = 0; v < m; ++v) {
+      if (kind_[v] == kManifold) continue;
       fan(v, outs, ins);
       for (size_t i = 0; i < outs.size(); ++i) {
         if (std::find(ins.begin(), ins.end(), outs[i]) != ins.end()) continue;
@@ -456,28 +483,35 @@ class Simplifier {
     }
   }
 
-  // The median of the vertices along each axis: the planes that split them into the two halves of
-  // collapse_in_order. O(V) (nth_element on a copy).
-  void choose_split() {
-    const size_t m = pos_.size();
-    region_.assign(m, 0);
-    if (m == 0) return;
-    std::vector<float> c(m);
-    for (int axis = 0; axis < 3; ++axis) {
-      for (size_t v = 0; v < m; ++v) c[v] = pos_[v][axis];
-      std::nth_element(c.begin(), c.begin() + m / 2, c.end());
-      split_[axis] = c[m / 2];
-    }
+  // The weighted channels, less those constant over the whole mesh: their gradients are 0 and their
+  // quadrics (W s^2 - (W s)^2 / W) only float noise, which took 12.7 % of the instructions on horse (its
+  // alpha) and whose rounding decided collapse order.
+  void choose_channels() {
+    const size_t m = source_.size();
+    auto add = [&](int attribute, const float* first, size_t stride, int components, float weight) {
+      if (weight <= 0 || m == 0) return;
+      for (int i = 0; i < components; ++i) {
+        bool constant = true;
+        for (size_t v = 1; v < m && constant; ++v) constant = first[v * stride + i] == first[i];
+        if (!constant) channel_.push_back({attribute, i, weight});
+      }
+    };
+    if (nrm_.size() == m) add(0, &nrm_[0].x, 3, 3, opt_.normal_weight);
+    if (uv_.size() == m) add(1, &uv_[0].x, 2, 2, opt_.uv_weight);
+    if (col_.size() == m) add(2, &col_[0].x, 4, 4, opt_.color_weight);
+    channels_ = int(channel_.size());
   }
 
-  void channel_values(uint32_t v, float* s) const {
-    int j = 0;
-    if (nrm_.size() && opt_.normal_weight > 0)
-      for (int i = 0; i < 3; ++i) s[j++] = nrm_[v][i] * opt_.normal_weight;
-    if (uv_.size() && opt_.uv_weight > 0)
-      for (int i = 0; i < 2; ++i) s[j++] = uv_[v][i] * opt_.uv_weight;
-    if (col_.size() && opt_.color_weight > 0)
-      for (int i = 0; i < 4; ++i) s[j++] = col_[v][i] * opt_.color_weight;
+  // Component j of v's attributes (unweighted).
+  float& channel(uint32_t v, int j) {
+    const Channel& c = channel_[j];
+    return c.attribute == 0 ? nrm_[v][c.component]
+                            : (c.attribute == 1 ? uv_[v][c.component] : col_[v][c.component]);
+  }
+
+  // The weighted channel values of v (s_j = weight_j x component_j).
+  void channel_values(uint32_t v, float* s) {
+    for (int j = 0; j < channels_; ++j) s[j] = channel(v, j) * channel_[j].weight;
   }
 
   // The origin of v's quadric and attribute terms: its current position, the same for all its wedges (a
@@ -535,33 +569,31 @@ class Simplifier {
   // weights (attributes eliminated per end) it measured mixed, so it applies positions only.
   void place(Plan& p) const {
     constexpr double kEndShare = 0.1;
-    Reduced r;
-    double w = 0;
-    std::array<Reduced, 2> own;  // Q_a, Q_b (positions only)
+    std::array<Reduced, 2> own;  // Q_a, Q_b
     std::array<double, 2> own_w{0.0, 0.0};
-    // Everything relative to b's origin o (a's quadrics shifted by o - o_a), x = o + y.
+    // Everything relative to b's origin o (a's quadrics shifted by o - o_a; b's wedges share o), x = o + y.
     const glm::dvec3 o = origin_of(p.b), shift = o - origin_of(p.a);
-    for (int side = 0; side < 2; ++side) {
-      const uint32_t end = side ? p.b : p.a;
-      const glm::dvec3 d = side ? glm::dvec3(0.0) : shift;
-      uint32_t v = end;
-      do {
-        r.add(quadric_[v], d);
-        w += quadric_[v].w;
-        if (channels_ == 0) own[side].add(quadric_[v], d), own_w[side] += quadric_[v].w;
-        v = wedge_[v];
-      } while (v != end);
-    }
+    uint32_t v = p.a;
+    do own[0].add(quadric_[v], shift), own_w[0] += quadric_[v].w, v = wedge_[v];
+    while (v != p.a);
+    v = p.b;
+    do own[1].add(quadric_[v]), own_w[1] += quadric_[v].w, v = wedge_[v];
+    while (v != p.b);
+    Reduced r = own[0];
+    r.add(own[1]);
+    const double w = own_w[0] + own_w[1];
     for (int pair = 0; pair < 2 && channels_ > 0; ++pair) {
       uint32_t a = pair ? p.a2 : p.a, b = pair ? p.b2 : p.b;
       if (a == kNone) continue;
       double ww = double(quadric_[a].w) + quadric_[b].w;
       if (!(ww > 0)) continue;
+      ChannelSums sums;
+      const AttributeTerm *ta = &attr_[a * size_t(channels_)], *tb = &attr_[b * size_t(channels_)];
       for (int j = 0; j < channels_; ++j) {
-        const AttributeTerm &ta = attr_[a * size_t(channels_) + j], &tb = attr_[b * size_t(channels_) + j];
-        r.eliminate(glm::dvec3(ta.g) + glm::dvec3(tb.g),
-                    double(ta.d) + glm::dot(glm::dvec3(ta.g), shift) + tb.d, ww);
+        const glm::dvec3 ga(ta[j].g);
+        sums.add(ga + glm::dvec3(tb[j].g), double(ta[j].d) + glm::dot(ga, shift) + tb[j].d);
       }
+      r.eliminate(sums, ww);
     }
     const glm::dvec3 pa = glm::dvec3(pos_[p.a]) - o, pb = glm::dvec3(pos_[p.b]) - o;
     const uint8_t ka = kind_[p.a], kb = kind_[p.b];
@@ -684,69 +716,63 @@ class Simplifier {
 
   // The collapse loop over order_ (cost order, up to `limit`, until the target): independent collapses,
   // none touching a vertex an earlier one in this pass touched. Large passes (not recording collapses) run
-  // it on both halves of the mesh at once first, each thread taking the candidates of its half in order up
-  // to half the triangles still to remove; collapses whose faces cross the split, and what a thread left,
-  // follow serially in order. Each half's outcome depends only on its own faces, so the result is the same
-  // on every run. Returns the number of collapses.
+  // it first on many small regions at once (both cores, each region's data cache-resident: candidates come in
+  // cost order, random in space), each region taking its own candidates in order up to its share of the
+  // triangles still to remove (in proportion to its candidates); collapses whose faces cross a region's
+  // border, and what a region left, follow serially in order. Each region's outcome depends only on its own
+  // faces, so the result is the same on every run. Returns the number of collapses.
   size_t collapse_in_order(float limit, size_t target) {
     size_t collapsed = 0;
-    // The order_ index from which a half's candidates are left to the serial part.
-    std::array<size_t, 2> stop{0, 0};
     constexpr size_t kParallelMin = 1024;
     const bool parallel = !record_ && order_.size() >= kParallelMin && alive_triangles_ > target + 8;
     if (parallel) {
-      const size_t quota = (alive_triangles_ - target) / 2;
-      const int axis = split_axis_;
-      split_axis_ = (split_axis_ + 1) % 3;
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, region_.size(), 4096), [&](const auto& r) {
-        for (size_t v = r.begin(); v < r.end(); ++v) region_[v] = pos_[v][axis] < split_[axis] ? 0 : 1;
-      });
-      // Each candidate's half (kAnyRegion: its ends lie in both), once: the threads then read only their
-      // own candidates' slots (in cost order, random in memory).
-      side_.resize(order_.size());
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, order_.size(), 4096), [&](const auto& r) {
-        for (size_t i = r.begin(); i < r.end(); ++i) {
-          const Candidate& c = slots_[order_[i].slot];
-          side_[i] = region_[c.a] == region_[c.b] ? region_[c.a] : kAnyRegion;
-        }
-      });
-      pending_.assign(order_.size(), 0);
-      std::array<size_t, 2> count{0, 0};
-      auto half = [&](uint8_t r) {
-        Scratch& s = scratch_[r];
-        s.region = r;
-        size_t i = 0;
-        for (; i < order_.size(); ++i) {
-          if (order_[i].cost > limit || s.removed_triangles + 2 > quota) break;
-          prefetch(i, r);
-          if (side_[i] != r) continue;
-          const Candidate& c = slots_[order_[i].slot];
-          Plan p;
-          if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
-          p.slot = order_[i].slot;
-          if (p.a2 != kNone && (touched_[p.a2] || touched_[p.b2])) continue;
-          switch (try_collapse(p, s)) {
-            case Outcome::kCollapsed:
-              ++count[r];
-              break;
-            case Outcome::kOutsideRegion:
-              pending_[i] = 1;
-              break;
-            case Outcome::kRejected:
-              break;
+      group_by_region();
+      const size_t n = order_.size(), removable = alive_triangles_ - target;
+      const uint32_t regions = uint32_t(region_start_.size() - 1);
+      tbb::enumerable_thread_specific<Scratch> scratch;
+      std::atomic<size_t> count{0};
+      tbb::parallel_for(tbb::blocked_range<uint32_t>(0, regions, 1), [&](const auto& range) {
+        Scratch& s = scratch.local();
+        size_t here = 0;
+        for (uint32_t r = range.begin(); r < range.end(); ++r) {
+          const uint32_t begin = region_start_[r], end = region_start_[r + 1];
+          const size_t quota = size_t(double(removable) * (end - begin) / double(n));
+          const size_t removed_before = s.removed_triangles;
+          s.region = r;
+          for (uint32_t k = begin; k < end; ++k) {
+            if (s.removed_triangles - removed_before + 2 > quota) break;
+            prefetch(k, end);
+            const uint32_t i = sorted_[k].slot;
+            pending_[i] = 0;
+            const Candidate& c = slots_[order_[i].slot];
+            Plan p;
+            if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
+            p.slot = order_[i].slot;
+            if (p.a2 != kNone && (touched_[p.a2] || touched_[p.b2])) continue;
+            switch (try_collapse(p, s)) {
+              case Outcome::kCollapsed:
+                ++here;
+                break;
+              case Outcome::kOutsideRegion:
+                pending_[i] = 1;
+                break;
+              case Outcome::kRejected:
+                break;
+            }
           }
         }
-        stop[r] = i;
-      };
-      tbb::parallel_invoke([&] { half(0); }, [&] { half(1); });
-      collapsed = count[0] + count[1];
-      gather(scratch_[0]), gather(scratch_[1]);
+        count += here;
+      });
+      collapsed = count;
+      for (Scratch& s : scratch) gather(s);
+    } else {
+      pending_.assign(order_.size(), 1);
     }
-    Scratch& s = scratch_[0];
+    Scratch& s = serial_;
     s.region = kAnyRegion;
     for (size_t i = 0; i < order_.size(); ++i) {
       if (order_[i].cost > limit || alive_triangles_ - s.removed_triangles <= target) break;
-      if (parallel && side_[i] != kAnyRegion && !pending_[i] && i < stop[side_[i]]) continue;
+      if (!pending_[i]) continue;
       const Candidate& c = slots_[order_[i].slot];
       Plan p;
       if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
@@ -758,15 +784,42 @@ class Simplifier {
     return collapsed;
   }
 
-  // Candidates come in cost order, random in memory, so each try starts with cache misses: this loads the
-  // slot of the candidate kSlotAhead places on, and the per-vertex data of the ends of the one kEndAhead on
-  // (its slot loaded earlier), if they belong to half r, so that their misses overlap the tries between.
-  void prefetch(size_t i, uint8_t r) const {
-    constexpr size_t kSlotAhead = 16, kEndAhead = 8;
-    if (i + kSlotAhead < order_.size() && side_[i + kSlotAhead] == r)
-      __builtin_prefetch(&slots_[order_[i + kSlotAhead].slot]);
-    if (i + kEndAhead < order_.size() && side_[i + kEndAhead] == r) {
-      const Candidate& c = slots_[order_[i + kEndAhead].slot];
+  uint32_t region_of(uint32_t v) const { return (v + region_shift_) / region_vertices_; }
+
+  // Groups the pass's candidates by region into sorted_ as (cost, order_ index), in cost order within each
+  // region (a counting sort; candidates whose ends lie in two regions are left out) and sets region_start_;
+  // pending_ = 1 (for the serial part) for every candidate until a region takes it. Turns region_shift_.
+  void group_by_region() {
+    const size_t shrink = welded_triangles_ / std::max<size_t>(alive_triangles_, 1);
+    const size_t first = std::clamp<size_t>(source_.size() / kMinRegions, 1, kRegionVertices);
+    region_vertices_ = uint32_t(first * std::clamp<size_t>(shrink, 1, 1024));
+    region_shift_ = (region_shift_ + region_vertices_ / 3 + 1) % region_vertices_;
+    const uint32_t regions = region_of(uint32_t(source_.size())) + 1;
+    region_start_.assign(regions + 1, 0);
+    sorted_.resize(order_.size());
+    auto region = [&](size_t i) {
+      const Candidate& c = slots_[order_[i].slot];
+      const uint32_t ra = region_of(c.a);
+      return ra == region_of(c.b) ? ra : kAnyRegion;
+    };
+    for (size_t i = 0; i < order_.size(); ++i)
+      if (uint32_t r = region(i); r != kAnyRegion) ++region_start_[r + 1];
+    for (uint32_t r = 0; r < regions; ++r) region_start_[r + 1] += region_start_[r];
+    std::vector<uint32_t> fill(region_start_.begin(), region_start_.end() - 1);
+    for (size_t i = 0; i < order_.size(); ++i)
+      if (uint32_t r = region(i); r != kAnyRegion) sorted_[fill[r]++] = {order_[i].cost, uint32_t(i)};
+    pending_.assign(order_.size(), 1);
+  }
+
+  // Candidates come in cost order, random in their region, so each try starts with cache misses: this loads
+  // the slot of the candidate kSlotAhead places on in the region's list (sorted_, before `end`), and the
+  // per-vertex data of the ends of the one kEndAhead on (its slot loaded earlier), so that their misses
+  // overlap the tries between.
+  void prefetch(uint32_t k, uint32_t end) const {
+    constexpr uint32_t kSlotAhead = 16, kEndAhead = 8;
+    if (k + kSlotAhead < end) __builtin_prefetch(&slots_[order_[sorted_[k + kSlotAhead].slot].slot]);
+    if (k + kEndAhead < end) {
+      const Candidate& c = slots_[order_[sorted_[k + kEndAhead].slot].slot];
       for (uint32_t v : {c.a, c.b}) {
         __builtin_prefetch(&touched_[v]), __builtin_prefetch(&offsets_[v]), __builtin_prefetch(&pos_[v]);
         __builtin_prefetch(&quadric_[v]), __builtin_prefetch(&radius_[v]), __builtin_prefetch(&pid_[v]);
@@ -855,7 +908,7 @@ class Simplifier {
     bool inside = true;
     auto in_region = [&](const uint32_t* t) {
       return s.region == kAnyRegion ||
-             (region_[t[0]] == s.region && region_[t[1]] == s.region && region_[t[2]] == s.region);
+             (region_of(t[0]) == s.region && region_of(t[1]) == s.region && region_of(t[2]) == s.region);
     };
     for_faces(p.a, [&](uint32_t f) {
       const uint32_t* t = &indices_[3 * size_t(f)];
@@ -1091,14 +1144,16 @@ class Simplifier {
       }
     for (const Segment& o : sc.old_edges) {
       const glm::dvec2 rel = o.origin - yx;
+      // s = cross2(rel, od) / den, t = cross2(rel, nd) / den, both strictly inside (0, 1); sn is the same for
+      // every spoke, so its sign fixes den's.
+      const double sn = cross2(rel, o.direction);
+      if (sn == 0) continue;
       for (const Segment& e : sc.spokes) {
         const double den = cross2(e.direction, o.direction);
+        if (sn > 0 ? den <= sn : den >= sn) continue;
         if (std::abs(den) < 1e-30) continue;
-        // s = cross2(rel, od) / den, t = cross2(rel, nd) / den, both strictly inside (0, 1).
-        const double sn = cross2(rel, o.direction), tn = cross2(rel, e.direction);
-        if (den > 0 ? (sn <= 0 || sn >= den || tn <= 0 || tn >= den)
-                    : (sn >= 0 || sn <= den || tn >= 0 || tn <= den))
-          continue;
+        const double tn = cross2(rel, e.direction);
+        if (sn > 0 ? (tn <= 0 || tn >= den) : (tn >= 0 || tn <= den)) continue;
         const double s = sn / den, t = tn / den;
         if (!(s > 0 && s < 1 && t > 0 && t < 1)) continue;
         const double gap = std::abs((1 - s) * hx + s * e.h0 - ((1 - t) * o.h0 + t * o.h1));
@@ -1108,8 +1163,9 @@ class Simplifier {
     return need;
   }
 
-  // Merges quadrics and sets b's attributes: the attribute quadric's optimum s* = (G.x + D)/W for weighted
-  // channels, linear interpolation along the edge for the others; half-edge collapses keep b's.
+  // Merges quadrics and sets b's attributes: the attribute quadric's optimum s* = (G.x + D)/W for the
+  // channels in the cost (channel_), linear interpolation along the edge for the others; half-edge collapses
+  // keep b's.
   void merge(uint32_t a, uint32_t b, const Plan& p) {
     const glm::dvec3 ob = origin_of(b), shift = ob - origin_of(a);
     if (p.move) {
@@ -1120,22 +1176,13 @@ class Simplifier {
       if (!uv_.empty()) uv_[b] = glm::mix(uv_[b], uv_[a], t);
       if (!col_.empty()) col_[b] = glm::mix(col_[b], col_[a], t);
       double w = double(quadric_[a].w) + quadric_[b].w;
-      if (channels_ > 0 && w > 0) {
-        int j = 0;
-        auto solved = [&](float weight) {
+      if (w > 0)
+        for (int j = 0; j < channels_; ++j) {
           const AttributeTerm &ta = attr_[a * size_t(channels_) + j], &tb = attr_[b * size_t(channels_) + j];
-          ++j;
-          return float((glm::dot(glm::dvec3(ta.g) + glm::dvec3(tb.g), p.x - ob) + ta.d +
-                        glm::dot(glm::dvec3(ta.g), shift) + tb.d) /
-                       w / weight);
-        };
-        if (!nrm_.empty() && opt_.normal_weight > 0)
-          for (int i = 0; i < 3; ++i) nrm_[b][i] = solved(opt_.normal_weight);
-        if (!uv_.empty() && opt_.uv_weight > 0)
-          for (int i = 0; i < 2; ++i) uv_[b][i] = solved(opt_.uv_weight);
-        if (!col_.empty() && opt_.color_weight > 0)
-          for (int i = 0; i < 4; ++i) col_[b][i] = solved(opt_.color_weight);
-      }
+          channel(b, j) = float((glm::dot(glm::dvec3(ta.g) + glm::dvec3(tb.g), p.x - ob) + ta.d +
+                                 glm::dot(glm::dvec3(ta.g), shift) + tb.d) /
+                                w / channel_[j].weight);
+        }
       if (!nrm_.empty()) {
         float l = glm::length(nrm_[b]);
         nrm_[b] = l > 0 ? nrm_[b] / l : nrm_[a];

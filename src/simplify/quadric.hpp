@@ -41,13 +41,28 @@ struct AttributeTerm {
   float d = 0.0f;
 };
 
+// Sums over attribute channels of G G^T, G D and D^2 (the terms Reduced::eliminate subtracts).
+struct ChannelSums {
+  double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+  double xd = 0, yd = 0, zd = 0;
+  double dd = 0;
+
+  void add(const glm::dvec3& g, double d) {
+    xx += g.x * g.x, xy += g.x * g.y, xz += g.x * g.z, yy += g.y * g.y, yz += g.y * g.z, zz += g.z * g.z;
+    xd += g.x * d, yd += g.y * d, zd += g.z * d;
+    dd += d * d;
+  }
+};
+
 // Symmetric 3x3 system in double precision, accumulated from quadrics and attribute reductions.
 struct Reduced {
   double a00 = 0, a01 = 0, a02 = 0, a11 = 0, a12 = 0, a22 = 0;
   double b0 = 0, b1 = 0, b2 = 0;
   double c = 0;
 
-  void add(const Quadric& q) {
+  // Adds a Quadric or a Reduced (same origin).
+  template <class Q>
+  void add(const Q& q) {
     a00 += q.a00, a01 += q.a01, a02 += q.a02, a11 += q.a11, a12 += q.a12, a22 += q.a22;
     b0 += q.b0, b1 += q.b1, b2 += q.b2, c += q.c;
   }
@@ -61,13 +76,14 @@ struct Reduced {
     c += q.c + 2 * (double(q.b0) * d.x + double(q.b1) * d.y + double(q.b2) * d.z) + ad0 * d.x + ad1 * d.y +
          ad2 * d.z;
   }
-  // Subtracts G G^T / W, G D / W, D^2 / W for one attribute channel (the closed-form minimum over s).
-  void eliminate(const glm::dvec3& g, double d, double w) {
-    double iw = 1.0 / w;
-    a00 -= g.x * g.x * iw, a01 -= g.x * g.y * iw, a02 -= g.x * g.z * iw;
-    a11 -= g.y * g.y * iw, a12 -= g.y * g.z * iw, a22 -= g.z * g.z * iw;
-    b0 -= g.x * d * iw, b1 -= g.y * d * iw, b2 -= g.z * d * iw;
-    c -= d * d * iw;
+  // Subtracts sum_j (G_j G_j^T, G_j D_j, D_j^2) / W over the attribute channels summed in `s` (the
+  // closed-form minimum over each s_j): one division and one scaling for all channels.
+  void eliminate(const ChannelSums& s, double w) {
+    const double iw = 1.0 / w;
+    a00 -= s.xx * iw, a01 -= s.xy * iw, a02 -= s.xz * iw, a11 -= s.yy * iw, a12 -= s.yz * iw,
+        a22 -= s.zz * iw;
+    b0 -= s.xd * iw, b1 -= s.yd * iw, b2 -= s.zd * iw;
+    c -= s.dd * iw;
   }
   // Q(p) = p^T A p + 2 b.p + c, clamped at 0 (rounding).
   double eval(const glm::dvec3& p) const {

@@ -14,8 +14,9 @@
 // edges with an end touched by the previous one and radix-sorts the candidates), each pass limited to 1.5x
 // the cost of the collapse that would reach the target, which keeps the order close to greedy. A collapse
 // that fails the validity checks is not tried again until an end is touched (or a pass finds nothing). The
-// collapse loop of a large pass runs on two spatial halves at once (the split plane turns each pass), the
-// collapses that cross it after them, serially; the result does not depend on thread timing.
+// collapse loop of a large pass runs on many small regions (runs of about 16384 alive vertices in Morton
+// order, at least 2 runs, shifted each pass) on both cores, the collapses that cross a region's border after
+// them, serially; the result does not depend on thread timing.
 //
 // Vertices are classified once (meshoptimizer's vertex kinds, extended): Manifold (interior), Border (one
 // open edge in and out), Seam (two vertices share the position and their open edges pair up: a UV, normal

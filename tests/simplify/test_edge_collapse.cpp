@@ -105,9 +105,9 @@ TEST(EdgeCollapse, LockedVerticesNeverMoveOrDisappear) {
   EXPECT_LT(r.mesh.triangle_count(), in.triangle_count() / 2);
 }
 
-TEST(EdgeCollapse, ParallelHalvesGiveOneResultAndKeepTheGuarantees) {
-  // Large enough for each pass's collapse loop to run on both halves of the mesh at once; recording the
-  // collapses runs it serially, which gives the reference quality.
+TEST(EdgeCollapse, ParallelRegionsGiveOneResultAndKeepTheGuarantees) {
+  // Large enough for each pass's collapse loop to run on several regions of the mesh at once (both cores);
+  // recording the collapses runs it serially, which gives the reference quality.
   Mesh in = lumpy(sphere(1.0f, 32, 64), 8);
   const size_t target = in.triangle_count() / 10;
   auto r1 = simplify_mesh(in, with_target(target));
