@@ -6,9 +6,11 @@
 
 #include "command.hpp"
 #include "core/error.hpp"
+#include "huge_pages.hpp"
 
 int main(int argc, char** argv) {
   using namespace lodstream;
+  cli::restart_with_huge_pages(argv);
   CLI::App app{"lodstream: stream large 3D scenes to clients that render them at a bounded frame time.",
                "lodstream"};
   app.require_subcommand(1);

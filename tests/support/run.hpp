@@ -29,6 +29,7 @@ class BackgroundProcess {
   // The next line of standard output without its newline; empty after `timeout_s` or at end of output.
   std::string read_line(double timeout_s = 10.0);
   int stop();
+  int pid() const { return pid_; }
 
  private:
   int pid_ = -1;
