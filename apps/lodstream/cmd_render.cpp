@@ -2,8 +2,6 @@
 // line), drawn headless through EGL (llvmpipe without a GPU). A package (.lods) is drawn at its cut for the
 // camera and --pixel-error, with every node available (the reference a streaming client is compared with).
 // With --frames N it draws N times and reports the median time.
-#include <time.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -16,6 +14,7 @@
 #include "core/error.hpp"
 #include "core/image.hpp"
 #include "io/import.hpp"
+#include "process_time.hpp"
 #include "render/context.hpp"
 #include "render/renderer.hpp"
 #include "render/scene_upload.hpp"
@@ -52,12 +51,6 @@ Camera camera_from(const RenderOptions& opt) {
   if (!opt.size.empty()) std::tie(camera.width, camera.height) = parse_size(opt.size, "--size");
   validate_camera(camera, where);
   return camera;
-}
-
-double process_cpu_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
 }
 
 double median(std::vector<double> values) {
@@ -134,9 +127,9 @@ int run_render(const RenderOptions& opt) {
   // shared machine the second tells what a frame costs when the first is inflated by other processes.
   std::vector<double> draw_ms, cpu_ms;
   for (int i = 0; i < opt.frames; ++i) {
-    const double cpu_start = process_cpu_ms();
+    const double cpu_start = 1e3 * process_cpu_s();
     draw_ms.push_back(renderer.draw(camera, upload.items));
-    cpu_ms.push_back(process_cpu_ms() - cpu_start);
+    cpu_ms.push_back(1e3 * process_cpu_s() - cpu_start);
   }
   save_png(renderer.read_pixels(), opt.output);
 

@@ -66,3 +66,21 @@ TEST(CliSimplify, AllowTopologyChangeReachesWhatCollapseCannot) {
   EXPECT_GT(j["output_triangles"].get<size_t>(), 0u);
   EXPECT_GE(j["error_bound"].get<double>(), stuck.json()["error_bound"].get<double>());
 }
+
+TEST(CliSimplify, BenchComparesWithMeshoptimizerAtItsTriangleCount) {
+  auto r = run_lodstream({"bench", "simplify", data_file("elephant.off").string(), "--ratio", "0.5", "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto j = r.json();
+  const size_t meshopt = j["meshoptimizer"]["triangles"];
+  EXPECT_GT(meshopt, 0u);
+  EXPECT_LE(meshopt, j["input_triangles"].get<size_t>() / 2 + 1);
+  for (const char* side : {"meshoptimizer", "lodstream", "lodstream_positions_only"}) {
+    const auto& s = j[side];
+    EXPECT_EQ(s["triangles"].get<size_t>(), meshopt) << side;  // both sides at meshoptimizer's count
+    EXPECT_GT(s["time_s"].get<double>(), 0.0) << side;
+    EXPECT_GT(s["cpu_s"].get<double>(), 0.0) << side;
+    EXPECT_GE(s["hausdorff_relative"].get<double>(), s["mean_relative"].get<double>()) << side;
+    EXPECT_GT(s["mean_relative"].get<double>(), 0.0) << side;
+    EXPECT_GT(s["psnr"].get<double>(), 20.0) << side;
+  }
+}
