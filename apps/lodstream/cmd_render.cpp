@@ -14,12 +14,12 @@
 #include "core/error.hpp"
 #include "core/image.hpp"
 #include "io/import.hpp"
-#include "process_time.hpp"
 #include "render/context.hpp"
 #include "render/renderer.hpp"
 #include "render/scene_upload.hpp"
 #include "runtime/cut_geometry.hpp"
 #include "runtime/quality.hpp"
+#include "timing.hpp"
 
 namespace lodstream::cli {
 namespace {
@@ -51,12 +51,6 @@ Camera camera_from(const RenderOptions& opt) {
   if (!opt.size.empty()) std::tie(camera.width, camera.height) = parse_size(opt.size, "--size");
   validate_camera(camera, where);
   return camera;
-}
-
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
 std::string lower_extension(const std::filesystem::path& file) {
