@@ -34,7 +34,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <fstream>
 #include <memory>
 #include <mutex>
@@ -47,12 +46,11 @@
 #include "hierarchy/hlod.hpp"
 #include "hierarchy/progressive_steps.hpp"
 #include "io/import.hpp"
-#include "package/meshopt_codec.hpp"
-#include "package/predictive_codec.hpp"
+#include "package/node_codec.hpp"
 #include "package/progressive_prefix.hpp"
-#include "package/traversal_codec.hpp"
 #include "package/writer.hpp"
 #include "schedule/screen_error.hpp"
+#include "timing.hpp"
 
 namespace lodstream::cli {
 namespace {
@@ -191,16 +189,18 @@ int run_bake(const BakeArgs& args) {
   nlohmann::json phases;
   double phase_wall = 0.0, phase_cpu = 0.0;
   auto end_phase = [&](const char* name) {
-    const double wall = elapsed(), cpu = double(std::clock()) / CLOCKS_PER_SEC;
+    const double wall = elapsed(), cpu = process_cpu_s();
     phases[name] = {{"wall_s", wall - phase_wall}, {"cpu_s", cpu - phase_cpu}};
     phase_wall = wall, phase_cpu = cpu;
   };
-  phase_cpu = double(std::clock()) / CLOCKS_PER_SEC;
+  phase_cpu = process_cpu_s();
   if (args.normal_bits < 4 || args.normal_bits > 16) throw Error("--normal-bits: must be in 4..16");
   if (args.max_grid_bits < 14 || args.max_grid_bits > 20) throw Error("--max-grid-bits: must be in 14..20");
-  if (args.codec != MeshoptCodec::kId && args.codec != PredictiveCodec::kId &&
-      args.codec != TraversalCodec::kId)
-    throw Error("--codec: must be 1, 2 or 3");
+  try {
+    package::node_codec(args.codec);  // the registry of codec ids
+  } catch (const Error& e) {
+    throw Error(std::string("--codec: ") + e.what() + " (1, 2 or 3)");
+  }
   if (args.pm_max_triangles > kMaxPmTriangles)
     throw Error("--pm-max-triangles: must be in 0.." + std::to_string(kMaxPmTriangles));
   Scene scene = import_all(args.models);

@@ -58,8 +58,9 @@ class ViewClient {
  public:
   // Opens `source`: reads the root index (one read, blocking: a local read or one HTTP request), restores
   // the pages kept on disk (options.cache_dir; files that fail their checks are dropped with a warning on
-  // standard error) and starts the transport. Throws lodstream::Error (unreachable server, not a package, a
-  // cache directory that cannot be created) naming what failed.
+  // standard error) and starts the transport (a push stream without a cache directory starts it first, so
+  // that its handshake overlaps the root index's read). Throws lodstream::Error (unreachable server, not a
+  // package, a cache directory that cannot be created) naming what failed.
   ViewClient(const std::string& source, const ViewClientOptions& options);
   ~ViewClient();  // stops the transport
   ViewClient(const ViewClient&) = delete;

@@ -153,7 +153,6 @@ struct PushClient::Impl {
           held_again(restore->page_id);
           arrived[size_t(schedule::PageKind::data)].insert(restore->page_id);
           inbox->put({{schedule::PageKind::data, restore->page_id, 0}, {}, true});
-          ++owner->restores_;
           wake.cancel();
         } else if (auto* welcome = std::get_if<wire::Welcome>(&m)) {
           if (welcome->package_hash != hello.cached_hash) {  // what the client held is of another package

@@ -46,7 +46,6 @@ class PushClient {
   void released(std::span<const uint32_t> pages, bool on_disk = false);
   bool welcomed() const { return welcomed_; }
   uint64_t pages_received() const { return pages_; }
-  uint64_t restores_received() const { return restores_; }
   // Connections opened again (and welcomed) after one was lost.
   uint64_t reconnects() const { return reconnects_; }
 
@@ -54,7 +53,7 @@ class PushClient {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::atomic<bool> welcomed_{false};
-  std::atomic<uint64_t> pages_{0}, restores_{0}, reconnects_{0};
+  std::atomic<uint64_t> pages_{0}, reconnects_{0};
   std::thread thread_;
 };
 
