@@ -49,10 +49,13 @@ wire::Hello push_hello(const std::string& source, const ViewClientOptions& optio
   return hello;
 }
 
-// The push session opened before the root index is read (nothing cached can be listed then), or null.
+// The push session, opened before the root index is read (null unless pushed). Without a disk cache its
+// Hello goes out at once; with one, the Hello waits for the root index (it lists the pages on disk) while the
+// connection and the WebSocket handshake go ahead.
 std::unique_ptr<PushClient> early_push(const std::string& source, const ViewClientOptions& options,
                                        PageInbox& inbox) {
-  if (!starts_with(source, "ws://") || !options.cache_dir.empty()) return nullptr;
+  if (!starts_with(source, "ws://")) return nullptr;
+  if (!options.cache_dir.empty()) return std::make_unique<PushClient>(source, inbox);
   return std::make_unique<PushClient>(source, push_hello(source, options), inbox);
 }
 
@@ -80,13 +83,13 @@ ViewClient::ViewClient(const std::string& source, const ViewClientOptions& optio
   }
 
   if (mode_ == Mode::push) {
-    if (pusher_) return;
+    if (!disk_) return;
     wire::Hello hello = push_hello(source, options);
     hello.cached_hash = client_.reader().header().content_hash;
     hello.held = wire::page_runs(client_.held(schedule::PageKind::data));
     hello.held_index = wire::page_runs(client_.held(schedule::PageKind::index));
     hello.on_disk = wire::page_runs(left_on_disk);
-    pusher_ = std::make_unique<PushClient>(source, hello, arrived_);
+    pusher_->say_hello(std::move(hello));
     return;
   }
   PullFetcher::SourceFactory make_source;

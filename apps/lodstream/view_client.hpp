@@ -95,9 +95,10 @@ class ViewClient {
   schedule::CutOptions cut_options_;
   std::filesystem::path package_dir_;
   PageInbox arrived_;  // what the transport delivered, for the next frame
-  // Push: the WebSocket session. Without a cache directory it is opened before the root index is read, so
-  // that its handshake and hello overlap that read (as bench stream's simulation has it): the hello names no
-  // package hash then, and nothing is held yet.
+  // Push: the WebSocket session, opened before the root index is read so that its connection and handshake
+  // overlap that read (as bench stream's simulation has it). Without a cache directory its hello goes out at
+  // once (no package hash, nothing held); with one, the hello follows the root read and lists the disk's
+  // pages.
   std::unique_ptr<PushClient> pusher_;
   runtime::ClientPackage client_;
   std::optional<runtime::DiskCache> disk_;

@@ -26,8 +26,10 @@ struct PushClient::Impl {
   asio::steady_timer wake{strand};
   asio::steady_timer stop_timer{strand};  // cuts off a close the server does not answer
   asio::steady_timer backoff{strand};     // the wait before a reconnection
+  asio::steady_timer hello_wait{strand};  // a connection opened before the Hello is known waits on it
   UrlParts url;
   wire::Hello hello;
+  bool has_hello = false;  // owned by the strand
   PageInbox* inbox = nullptr;
   PushClient* owner = nullptr;
   PushReconnect reconnect;
@@ -132,6 +134,15 @@ struct PushClient::Impl {
       ws->binary(true);
       ws->read_message_max(wire::kMaxMessageBytes);
       co_await ws->async_handshake(url.host + ":" + url.port, url.target, use_awaitable);
+      while (!has_hello && !closing) {
+        hello_wait.expires_at(std::chrono::steady_clock::time_point::max());
+        boost::system::error_code ec;
+        co_await hello_wait.async_wait(asio::redirect_error(use_awaitable, ec));
+      }
+      if (closing) {
+        co_await ws->async_close(beast::websocket::close_code::normal, use_awaitable);
+        co_return lost;
+      }
       open = true;
       co_await send(*ws, current_hello());
       asio::co_spawn(strand, writer(ws, number), asio::detached);
@@ -208,11 +219,13 @@ struct PushClient::Impl {
 };
 
 PushClient::PushClient(const std::string& url, wire::Hello hello, PageInbox& inbox, PushReconnect reconnect)
+    : PushClient(url, inbox, reconnect) {
+  say_hello(std::move(hello));
+}
+
+PushClient::PushClient(const std::string& url, PageInbox& inbox, PushReconnect reconnect)
     : impl_(std::make_unique<Impl>()) {
   impl_->url = split_url(url, "ws://");
-  for (const wire::PageRun& run : hello.on_disk)
-    for (uint64_t p = run.first; p < uint64_t(run.first) + run.count; ++p) impl_->on_disk.insert(uint32_t(p));
-  impl_->hello = std::move(hello);
   impl_->inbox = &inbox;
   impl_->owner = this;
   impl_->reconnect = reconnect;
@@ -225,6 +238,7 @@ PushClient::~PushClient() {
     m->closing = true;
     m->wake.cancel();
     m->backoff.cancel();
+    m->hello_wait.cancel();
     if (m->done) return;
     // A normal close takes a round trip; a server that does not answer is cut off.
     m->stop_timer.expires_after(std::chrono::seconds(2));
@@ -233,6 +247,16 @@ PushClient::~PushClient() {
     });
   });
   thread_.join();
+}
+
+void PushClient::say_hello(wire::Hello hello) {
+  asio::post(impl_->strand, [m = impl_.get(), hello = std::move(hello)]() mutable {
+    for (const wire::PageRun& run : hello.on_disk)
+      for (uint64_t p = run.first; p < uint64_t(run.first) + run.count; ++p) m->on_disk.insert(uint32_t(p));
+    m->hello = std::move(hello);
+    m->has_hello = true;
+    m->hello_wait.cancel();
+  });
 }
 
 void PushClient::send_view(const wire::ViewUpdate& view) {

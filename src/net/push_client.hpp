@@ -34,9 +34,16 @@ class PushClient {
   // `url`: ws://HOST:PORT/NAME. Returns at once; connecting happens on the client's thread (a failure is
   // reported through `inbox`). Throws lodstream::Error when the URL is malformed. `inbox` must outlive this.
   PushClient(const std::string& url, wire::Hello hello, PageInbox& inbox, PushReconnect reconnect = {});
+  // The same, but the Hello is not known yet (a client with a disk cache must read the package's root index
+  // to list what it holds): the TCP connection and the WebSocket handshake go ahead at once, and the Hello
+  // goes out when say_hello() gives it.
+  PushClient(const std::string& url, PageInbox& inbox, PushReconnect reconnect = {});
   ~PushClient();  // closes the WebSocket (a normal close) and joins the thread
   PushClient(const PushClient&) = delete;
   PushClient& operator=(const PushClient&) = delete;
+
+  // The Hello of a client constructed without one (call once; before it, nothing is sent).
+  void say_hello(wire::Hello hello);
 
   void send_view(const wire::ViewUpdate& view);
   // Data pages the client's memory cache evicted: said to the server (a Released message) so that it may send

@@ -6,8 +6,10 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <thread>
 
 #include "net/http_server.hpp"
+#include "net/push_client.hpp"
 #include "net/wire.hpp"
 #include "package/reader.hpp"
 #include "raw_package.hpp"
@@ -21,9 +23,9 @@ using tcp = asio::ip::tcp;
 namespace {
 
 // A synchronous WebSocket client speaking the push protocol.
-class PushClient {
+class RawPushClient {
  public:
-  PushClient(uint16_t port, const std::string& target) : ws_(io_) {
+  RawPushClient(uint16_t port, const std::string& target) : ws_(io_) {
     tcp::resolver resolver(io_);
     asio::connect(ws_.next_layer(), resolver.resolve("127.0.0.1", std::to_string(port)));
     ws_.binary(true);
@@ -110,7 +112,7 @@ TEST(PushSession, SendsEveryPageOnceWithTheStoredBytes) {
   PushServer s;
   const uint32_t page_count = uint32_t(s.reader->root().pages.size());
   ASSERT_GT(page_count, 5u);
-  PushClient client(s.server.port(), "/scene");
+  RawPushClient client(s.server.port(), "/scene");
   client.send(hello("scene"));
   client.send(a_view());
   wire::Message m = client.receive();
@@ -128,7 +130,7 @@ TEST(PushSession, SendsEveryPageOnceWithTheStoredBytes) {
 TEST(PushSession, NeverSendsWhatTheClientHolds) {
   PushServer s;
   const uint32_t page_count = uint32_t(s.reader->root().pages.size());
-  PushClient client(s.server.port(), "/scene");
+  RawPushClient client(s.server.port(), "/scene");
   wire::Hello h = hello("scene");
   h.cached_hash = s.written.content_hash;
   h.held = {{0, 2}, {4, 1}};  // pages 0, 1 and 4
@@ -144,7 +146,7 @@ TEST(PushSession, NeverSendsWhatTheClientHolds) {
 TEST(PushSession, HeldPagesOfAnotherPackageVersionAreIgnored) {
   PushServer s;
   const uint32_t page_count = uint32_t(s.reader->root().pages.size());
-  PushClient client(s.server.port(), "/scene");
+  RawPushClient client(s.server.port(), "/scene");
   wire::Hello h = hello("scene");
   h.cached_hash = {1, 2};  // not this package
   h.held = {{0, page_count}};
@@ -158,13 +160,13 @@ TEST(PushSession, HeldPagesOfAnotherPackageVersionAreIgnored) {
 TEST(PushSession, AMalformedMessageEndsOnlyThatSession) {
   PushServer s;
   const uint32_t page_count = uint32_t(s.reader->root().pages.size());
-  PushClient good(s.server.port(), "/scene");
+  RawPushClient good(s.server.port(), "/scene");
   good.send(hello("scene"));
   good.send(a_view());
   ASSERT_TRUE(std::holds_alternative<wire::Welcome>(good.receive()));
   auto first = good.receive_pages(2);
 
-  PushClient bad(s.server.port(), "/scene");
+  RawPushClient bad(s.server.port(), "/scene");
   bad.send_raw(
       {wire::kProtocolVersion, 0, 99, 0, 0, 0, 0, 0});  // this version, unknown type 99, empty payload
   wire::Message m = bad.receive();
@@ -182,14 +184,14 @@ TEST(PushSession, AMalformedMessageEndsOnlyThatSession) {
 TEST(PushSession, AHelloForAnotherPackageOrNoHelloEndsTheSession) {
   PushServer s;
   {
-    PushClient client(s.server.port(), "/scene");
+    RawPushClient client(s.server.port(), "/scene");
     client.send(hello("other"));
     wire::Message m = client.receive();
     ASSERT_TRUE(std::holds_alternative<wire::Bye>(m)) << wire::type_name(m);
     EXPECT_NE(std::get<wire::Bye>(m).reason.find("other"), std::string::npos);
   }
   {
-    PushClient client(s.server.port(), "/scene");
+    RawPushClient client(s.server.port(), "/scene");
     client.send(wire::Ack{1, 0, 0.0, 0.0});
     wire::Message m = client.receive();
     ASSERT_TRUE(std::holds_alternative<wire::Bye>(m)) << wire::type_name(m);
@@ -199,7 +201,41 @@ TEST(PushSession, AHelloForAnotherPackageOrNoHelloEndsTheSession) {
 
 TEST(PushSession, NoStreamAtAnUnknownAddress) {
   PushServer s;
-  EXPECT_THROW(PushClient(s.server.port(), "/nothing"), boost::system::system_error);
+  EXPECT_THROW(RawPushClient(s.server.port(), "/nothing"), boost::system::system_error);
 }
 
 }  // namespace
+
+// A client opened before its Hello is known (view --cache-dir must read the root index first) connects at
+// once but says nothing until say_hello(); then it is welcomed and streamed to like any other, and one that
+// never says hello closes without hanging.
+TEST(PushSession, AClientOpenedBeforeItsHelloWaitsForIt) {
+  PushServer s;
+  const std::string url = "ws://127.0.0.1:" + std::to_string(s.server.port()) + "/scene";
+  {
+    PageInbox silent;
+    lodstream::PushClient never(url, silent);
+  }
+  PageInbox inbox;
+  lodstream::PushClient client(url, inbox);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_FALSE(client.welcomed());
+  EXPECT_TRUE(inbox.take().empty());
+  EXPECT_EQ(inbox.error(), "");
+
+  client.say_hello(hello("scene"));
+  client.send_view(a_view());
+  const size_t page_count = s.reader->root().pages.size();
+  std::set<uint32_t> data_pages;
+  for (int i = 0; i < 500 && data_pages.size() < page_count && inbox.error().empty(); ++i) {
+    for (const ArrivedPage& a : inbox.take())
+      if (a.page.kind == schedule::PageKind::data) {
+        EXPECT_EQ(a.bytes, s.stored(a.page.id)) << "page " << a.page.id;
+        data_pages.insert(a.page.id);
+      }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_EQ(inbox.error(), "");
+  EXPECT_TRUE(client.welcomed());
+  EXPECT_EQ(data_pages.size(), page_count);
+}
