@@ -219,6 +219,28 @@ GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
   return out;
 }
 
+// A position locked in one cluster of a group is locked in every cluster of that group holding it: the
+// group's clusters share one position shift, so a vertex they share must decode the same way in all. Run
+// once every cluster of the group has been consumed (or the build ended), when its flags are complete; the
+// groups' clusters are appended to `finished`.
+void finish_groups(Builder& b, const std::vector<uint32_t>& groups, std::vector<uint32_t>& finished) {
+  ClusterDag& dag = b.dag;
+  tbb::parallel_for(size_t(0), groups.size(), [&](size_t i) {
+    const DagGroup& group = dag.groups[groups[i]];
+    std::vector<uint32_t> locked_ids;
+    for (uint32_t c : group.clusters)
+      for (size_t v = 0; v < b.position_ids[c].size(); ++v)
+        if (dag.clusters[c].locked[v]) locked_ids.push_back(b.position_ids[c][v]);
+    std::sort(locked_ids.begin(), locked_ids.end());
+    for (uint32_t c : group.clusters)
+      for (size_t v = 0; v < b.position_ids[c].size(); ++v)
+        if (std::binary_search(locked_ids.begin(), locked_ids.end(), b.position_ids[c][v]))
+          dag.clusters[c].locked[v] = 1;
+  });
+  for (uint32_t g : groups)
+    finished.insert(finished.end(), dag.groups[g].clusters.begin(), dag.groups[g].clusters.end());
+}
+
 }  // namespace
 
 ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
@@ -230,6 +252,8 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
 
   std::vector<uint32_t> active(dag.clusters.size());
   for (uint32_t c = 0; c < active.size(); ++c) active[c] = c;
+  std::vector<uint32_t> finished;    // final clusters not yet handed to options.finished
+  std::vector<uint32_t> unconsumed;  // by group: its clusters no accepted group has consumed yet
   for (uint32_t level = 1; level <= options.max_levels; ++level) {
     size_t active_triangles = 0;
     for (uint32_t c : active) active_triangles += dag.clusters[c].mesh.triangle_count();
@@ -255,8 +279,17 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
     // Near the root, one group takes everything: no border left to lock, so small meshes with thin parts
     // still reach a small root.
     const bool last = active_triangles <= 2 * options.group_clusters * options.max_cluster_triangles;
-    std::vector<std::vector<uint32_t>> groups =
-        partition_clusters(triangles, centroids, edges, last ? active.size() : options.group_clusters);
+    // Grouping runs on one core (METIS); the clusters the previous level finished are handed over beside it.
+    std::vector<std::vector<uint32_t>> groups;
+    tbb::parallel_invoke(
+        [&] {
+          groups =
+              partition_clusters(triangles, centroids, edges, last ? active.size() : options.group_clusters);
+        },
+        [&] {
+          if (options.finished && !finished.empty()) options.finished(dag, finished);
+        });
+    finished.clear();
     edges = {};
     for (auto& g : groups)
       for (uint32_t& i : g) i = active[i];  // active position -> cluster id
@@ -281,7 +314,7 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
         results[g] = simplify_group(b, groups[g], border, level);
     });
 
-    std::vector<uint32_t> next;
+    std::vector<uint32_t> next, completed_groups;
     bool any = false;
     for (size_t g = 0; g < groups.size(); ++g) {
       GroupResult& r = results[g];
@@ -309,6 +342,10 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
           if (border[ids[v]] ||
               (options.lock_open_boundary && ids[v] < b.open_boundary.size() && b.open_boundary[ids[v]]))
             child.locked[v] = 1;
+        if (child.group == kNoGroup)
+          finished.push_back(c);
+        else if (--unconsumed[child.group] == 0)
+          completed_groups.push_back(child.group);
       }
       for (NewCluster& nc : r.clusters) {
         const uint32_t cid = uint32_t(dag.clusters.size());
@@ -324,28 +361,25 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
         r.group.clusters.push_back(cid);
         next.push_back(cid);
       }
+      unconsumed.push_back(uint32_t(r.group.clusters.size()));
       dag.groups.push_back(std::move(r.group));
       dag.levels = std::max(dag.levels, level + 1);
     }
+    finish_groups(b, completed_groups, finished);
     active = std::move(next);
     if (!any) {
       dag.stalled = true;
       break;
     }
   }
-  // A position locked in one cluster of a group is locked in every cluster of that group holding it: the
-  // group's clusters share one position shift, so a vertex they share must decode the same way in all.
-  tbb::parallel_for(size_t(0), dag.groups.size(), [&](size_t g) {
-    std::vector<uint32_t> locked_ids;
-    for (uint32_t c : dag.groups[g].clusters)
-      for (size_t v = 0; v < b.position_ids[c].size(); ++v)
-        if (dag.clusters[c].locked[v]) locked_ids.push_back(b.position_ids[c][v]);
-    std::sort(locked_ids.begin(), locked_ids.end());
-    for (uint32_t c : dag.groups[g].clusters)
-      for (size_t v = 0; v < b.position_ids[c].size(); ++v)
-        if (std::binary_search(locked_ids.begin(), locked_ids.end(), b.position_ids[c][v]))
-          dag.clusters[c].locked[v] = 1;
-  });
+  // The rest: level-0 roots and the groups that made a root.
+  std::vector<uint32_t> open_groups;
+  for (uint32_t g = 0; g < dag.groups.size(); ++g)
+    if (unconsumed[g] > 0) open_groups.push_back(g);
+  finish_groups(b, open_groups, finished);
+  for (uint32_t c : active)
+    if (dag.clusters[c].group == kNoGroup) finished.push_back(c);
+  if (options.finished && !finished.empty()) options.finished(dag, finished);
   for (uint32_t c : active) {
     DagCluster& root = dag.clusters[c];
     root.parent_group = kNoGroup;
