@@ -109,7 +109,9 @@ Sphere stored_sphere(const Sphere& s, float error, const PositionGrid& grid) {
   return q == 0.0f ? s : Sphere{s.center, std::nextafter(s.radius + q, INFINITY)};
 }
 
-// A DAG cluster's node: on its mesh's grid, free vertices with the shift for its error, locked ones exact.
+// A DAG cluster's node: on its mesh's grid, free vertices with the shift for its error, locked ones exact. A
+// level-0 cluster (error 0, shift 0) is stored exactly without its locked flags, which are not yet set when
+// the DAG hands it over (DagOptions::finished).
 std::vector<uint8_t> encode_cluster(const NodeCodec& codec, const hierarchy::DagCluster& c,
                                     const PositionGrid& grid, uint32_t normal_bits) {
   NodeGeometry geometry;

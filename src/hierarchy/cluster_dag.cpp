@@ -252,8 +252,8 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
 
   std::vector<uint32_t> active(dag.clusters.size());
   for (uint32_t c = 0; c < active.size(); ++c) active[c] = c;
-  std::vector<uint32_t> finished;    // final clusters not yet handed to options.finished
-  std::vector<uint32_t> unconsumed;  // by group: its clusters no accepted group has consumed yet
+  std::vector<uint32_t> finished = active;  // final clusters not yet handed to options.finished
+  std::vector<uint32_t> unconsumed;         // by group: its clusters no accepted group has consumed yet
   for (uint32_t level = 1; level <= options.max_levels; ++level) {
     size_t active_triangles = 0;
     for (uint32_t c : active) active_triangles += dag.clusters[c].mesh.triangle_count();
@@ -342,9 +342,7 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
           if (border[ids[v]] ||
               (options.lock_open_boundary && ids[v] < b.open_boundary.size() && b.open_boundary[ids[v]]))
             child.locked[v] = 1;
-        if (child.group == kNoGroup)
-          finished.push_back(c);
-        else if (--unconsumed[child.group] == 0)
+        if (child.group != kNoGroup && --unconsumed[child.group] == 0)
           completed_groups.push_back(child.group);
       }
       for (NewCluster& nc : r.clusters) {
@@ -372,13 +370,11 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
       break;
     }
   }
-  // The rest: level-0 roots and the groups that made a root.
+  // The rest: the groups that made a root.
   std::vector<uint32_t> open_groups;
   for (uint32_t g = 0; g < dag.groups.size(); ++g)
     if (unconsumed[g] > 0) open_groups.push_back(g);
   finish_groups(b, open_groups, finished);
-  for (uint32_t c : active)
-    if (dag.clusters[c].group == kNoGroup) finished.push_back(c);
   if (options.finished && !finished.empty()) options.finished(dag, finished);
   for (uint32_t c : active) {
     DagCluster& root = dag.clusters[c];
