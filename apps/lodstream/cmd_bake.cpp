@@ -271,6 +271,7 @@ int run_bake(const BakeArgs& args) {
       out.resize(dag.clusters.size());
       tbb::parallel_for(size_t(0), clusters.size(), [&](size_t i) {
         out[clusters[i]] = encode_cluster(codec, dag.clusters[clusters[i]], grids[m], args.normal_bits);
+        out[clusters[i]].shrink_to_fit();  // kept until the pages are written: no growth slack
       });
     };
     dags[m] = hierarchy::build_cluster_dag(std::move(scene.meshes[m]), options);  // the DAG holds it now
