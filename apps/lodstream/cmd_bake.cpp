@@ -280,7 +280,7 @@ int run_bake(const BakeArgs& args) {
   });
   std::fprintf(stderr, "\n");
 
-  end_phase("hierarchy");
+  end_phase("hierarchy");  // DAG clusters included: they are encoded as the DAG finishes them
 
   // HLOD over the objects (none for a single object).
   const double hlod_start = elapsed();
@@ -492,7 +492,8 @@ int run_bake(const BakeArgs& args) {
       for (uint32_t k : dag.groups[c.parent_group].clusters) n.parents.push_back(ids[k]);
   });
 
-  // Encode (parallel, a batch of page groups at a time) and write (serial).
+  // Encode what is left (HLOD proxies, progressive steps; DAG clusters are encoded already), in parallel a
+  // batch of page groups at a time, and write (serial).
   WriterOptions writer_options;
   writer_options.codec = args.codec;
   PackageWriter writer(args.output, writer_options);
@@ -555,7 +556,7 @@ int run_bake(const BakeArgs& args) {
   EmbeddedTextures textures = embed_textures(scene.materials, writer);
   ps.materials = std::move(textures.materials);
   const WrittenPackage written = writer.finish(std::move(ps), std::move(records), root_nodes);
-  end_phase("encode_write");  // node records, encoding, pages, index, textures
+  end_phase("encode_write");  // node records, encoding (not of DAG clusters), pages, index, textures
   const double time_s = elapsed();
   const uint64_t rss = peak_rss_bytes();
   const double per_triangle = double(written.bytes) / double(std::max<uint64_t>(1, input_triangles));
