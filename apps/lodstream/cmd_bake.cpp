@@ -37,6 +37,7 @@
 #include <fstream>
 #include <memory>
 #include <mutex>
+#include <span>
 
 #include "bake_textures.hpp"
 #include "command.hpp"
@@ -106,6 +107,19 @@ float stored_error(float error, const PositionGrid& grid) {
 Sphere stored_sphere(const Sphere& s, float error, const PositionGrid& grid) {
   const float q = std::isinf(error) ? 0.0f : quantization_error(error, grid);
   return q == 0.0f ? s : Sphere{s.center, std::nextafter(s.radius + q, INFINITY)};
+}
+
+// A DAG cluster's node: on its mesh's grid, free vertices with the shift for its error, locked ones exact. A
+// level-0 cluster (error 0, shift 0) is stored exactly without its locked flags, which are not yet set when
+// the DAG hands it over (DagOptions::finished).
+std::vector<uint8_t> encode_cluster(const NodeCodec& codec, const hierarchy::DagCluster& c,
+                                    const PositionGrid& grid, uint32_t normal_bits) {
+  NodeGeometry geometry;
+  geometry.normal_bits = normal_bits;
+  geometry.mesh = &c.mesh;
+  geometry.position_shift = position_shift(c.error, grid);
+  if (geometry.position_shift > 0) geometry.locked = c.locked;
+  return codec.encode(geometry, grid);
 }
 
 Sphere float_sphere(const schedule::WorldSphere& w) {
@@ -215,6 +229,10 @@ int run_bake(const BakeArgs& args) {
   std::vector<hierarchy::ProgressiveSteps> pms(scene.meshes.size());  // steps empty: a DAG
   std::vector<Bounds> bounds(scene.meshes.size());
   std::vector<PositionGrid> grids(scene.meshes.size());
+  // Encoded DAG clusters by mesh and cluster, encoded as the DAG finishes them (DagOptions::finished): the
+  // encoding fills the core that the DAG's grouping (METIS) leaves idle.
+  const NodeCodec& codec = node_codec(args.codec);
+  std::vector<std::vector<std::vector<uint8_t>>> encoded_clusters(scene.meshes.size());
   std::atomic<size_t> done_triangles{0};
   std::mutex progress_mutex;
   int shown_percent = -1;  // the bar is redrawn when the percentage changes (not per cluster batch)
@@ -248,13 +266,21 @@ int run_bake(const BakeArgs& args) {
       const size_t done_here = triangles - std::min(triangles, active);
       if (done_here > reported) report(done_here - reported), reported = done_here;
     };
+    options.finished = [&, m](const hierarchy::ClusterDag& dag, std::span<const uint32_t> clusters) {
+      std::vector<std::vector<uint8_t>>& out = encoded_clusters[m];
+      out.resize(dag.clusters.size());
+      tbb::parallel_for(size_t(0), clusters.size(), [&](size_t i) {
+        out[clusters[i]] = encode_cluster(codec, dag.clusters[clusters[i]], grids[m], args.normal_bits);
+        out[clusters[i]].shrink_to_fit();  // kept until the pages are written: no growth slack
+      });
+    };
     dags[m] = hierarchy::build_cluster_dag(std::move(scene.meshes[m]), options);  // the DAG holds it now
     report(triangles - reported);
     scene.meshes[m] = Mesh{};
   });
   std::fprintf(stderr, "\n");
 
-  end_phase("hierarchy");
+  end_phase("hierarchy");  // DAG clusters included: they are encoded as the DAG finishes them
 
   // HLOD over the objects (none for a single object).
   const double hlod_start = elapsed();
@@ -466,11 +492,11 @@ int run_bake(const BakeArgs& args) {
       for (uint32_t k : dag.groups[c.parent_group].clusters) n.parents.push_back(ids[k]);
   });
 
-  // Encode (parallel, a batch of page groups at a time) and write (serial).
+  // Encode what is left (HLOD proxies, progressive steps; DAG clusters are encoded already), in parallel a
+  // batch of page groups at a time, and write (serial).
   WriterOptions writer_options;
   writer_options.codec = args.codec;
   PackageWriter writer(args.output, writer_options);
-  const NodeCodec& codec = node_codec(args.codec);
   NodeSizeBreakdown breakdown;
   size_t first = 0;
   std::vector<std::vector<uint8_t>> encoded;
@@ -500,12 +526,7 @@ int run_bake(const BakeArgs& args) {
         encoded[id - first] = codec.encode(geometry, ps.representations[order[id].mesh].grid);
         return;
       }
-      const hierarchy::DagCluster& c = dags[order[id].mesh].clusters[order[id].cluster];
-      const PositionGrid& grid = ps.representations[order[id].mesh].grid;
-      geometry.mesh = &c.mesh;
-      geometry.position_shift = position_shift(c.error, grid);
-      if (geometry.position_shift > 0) geometry.locked = c.locked;
-      encoded[id - first] = codec.encode(geometry, grid);
+      encoded[id - first] = std::move(encoded_clusters[order[id].mesh][order[id].cluster]);
     });
     for (size_t id = first; id < end; ++id) {
       NodeSizeBreakdown b = codec.breakdown(encoded[id - first], args.output);
@@ -517,6 +538,7 @@ int run_bake(const BakeArgs& args) {
     first = end;
   }
   encoded = {};
+  encoded_clusters = {};
   size_t stored_triangles = 0;
   for (const NodeRecord& n : records) stored_triangles += n.triangles;
   int grid_bits = 14;
@@ -534,7 +556,7 @@ int run_bake(const BakeArgs& args) {
   EmbeddedTextures textures = embed_textures(scene.materials, writer);
   ps.materials = std::move(textures.materials);
   const WrittenPackage written = writer.finish(std::move(ps), std::move(records), root_nodes);
-  end_phase("encode_write");  // node records, encoding, pages, index, textures
+  end_phase("encode_write");  // node records, encoding (not of DAG clusters), pages, index, textures
   const double time_s = elapsed();
   const uint64_t rss = peak_rss_bytes();
   const double per_triangle = double(written.bytes) / double(std::max<uint64_t>(1, input_triangles));

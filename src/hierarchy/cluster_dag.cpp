@@ -36,20 +36,52 @@ uint64_t edge_key(uint32_t a, uint32_t b) {
   return uint64_t(a) << 32 | b;
 }
 
-// Edges of a cluster used by exactly one of its triangles (by position id), as sorted keys.
+// Edges of a cluster used by exactly one of its triangles (by position id), as keys in no particular order
+// (the callers sort them with the cluster index). Vertices that share a position id (seams) are first merged
+// into one local vertex; each edge between local vertices is then counted (1, or 2 for more) in a per-thread
+// table of V x V cells of which only the touched ones are read back and cleared. Cost: O(V log V + T),
+// against O(T log T) for sorting the 3T edge keys (that sort was ~2 % of a bake).
 std::vector<uint64_t> cluster_boundary(const Mesh& mesh, const std::vector<uint32_t>& ids) {
-  std::vector<uint64_t> edges;
-  edges.reserve(mesh.indices.size());
-  for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3)
-    for (int k = 0; k < 3; ++k)
-      edges.push_back(edge_key(ids[mesh.indices[t + k]], ids[mesh.indices[t + (k + 1) % 3]]));
-  std::sort(edges.begin(), edges.end());
+  const size_t nv = ids.size();
+  // Local vertex -> the first local vertex of its position id, through a per-thread open-addressing table of
+  // at least 2V slots (cleared after use).
+  thread_local std::vector<uint64_t> slots;
+  size_t capacity = 64;
+  while (capacity < 2 * nv) capacity *= 2;
+  if (slots.size() < capacity) slots.assign(capacity, 0);
+  std::vector<uint32_t> merged(nv);
+  for (uint32_t v = 0; v < nv; ++v) {
+    size_t slot = (ids[v] * 0x9E3779B97F4A7C15ull) >> 40 & (capacity - 1);
+    while (slots[slot] != 0 && uint32_t(slots[slot] >> 32) != ids[v]) slot = (slot + 1) & (capacity - 1);
+    if (slots[slot] == 0) slots[slot] = uint64_t(ids[v]) << 32 | (v + 1);  // low half: v + 1, never 0
+    merged[v] = uint32_t(slots[slot]) - 1;
+  }
+  for (uint32_t v = 0; v < nv; ++v) {  // clear what was set: probe runs hold only ids of this cluster
+    size_t slot = (ids[v] * 0x9E3779B97F4A7C15ull) >> 40 & (capacity - 1);
+    while (slots[slot] != 0) slots[slot] = 0, slot = (slot + 1) & (capacity - 1);
+  }
+  thread_local std::vector<uint8_t> count;
+  if (count.size() < nv * nv) count.assign(nv * nv, 0);
+  auto cell = [&](uint32_t a, uint32_t b) -> uint8_t& {
+    return a < b ? count[a * nv + b] : count[b * nv + a];
+  };
+  const size_t corners = mesh.indices.size() / 3 * 3;
+  for (size_t t = 0; t < corners; t += 3) {
+    const uint32_t m0 = merged[mesh.indices[t]], m1 = merged[mesh.indices[t + 1]],
+                   m2 = merged[mesh.indices[t + 2]];
+    for (uint8_t* c : {&cell(m0, m1), &cell(m1, m2), &cell(m2, m0)}) *c = uint8_t(std::min(*c + 1, 2));
+  }
   std::vector<uint64_t> once;
-  for (size_t i = 0; i < edges.size();) {
-    size_t j = i;
-    while (j < edges.size() && edges[j] == edges[i]) ++j;
-    if (j - i == 1) once.push_back(edges[i]);
-    i = j;
+  for (size_t t = 0; t < corners; t += 3) {
+    const uint32_t* i = &mesh.indices[t];
+    const uint32_t m0 = merged[i[0]], m1 = merged[i[1]], m2 = merged[i[2]];
+    const std::pair<uint8_t*, uint64_t> edges[] = {{&cell(m0, m1), edge_key(ids[i[0]], ids[i[1]])},
+                                                   {&cell(m1, m2), edge_key(ids[i[1]], ids[i[2]])},
+                                                   {&cell(m2, m0), edge_key(ids[i[2]], ids[i[0]])}};
+    for (const auto& [c, key] : edges) {
+      if (*c == 1) once.push_back(key);
+      *c = 0;
+    }
   }
   return once;
 }
@@ -219,6 +251,28 @@ GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
   return out;
 }
 
+// A position locked in one cluster of a group is locked in every cluster of that group holding it: the
+// group's clusters share one position shift, so a vertex they share must decode the same way in all. Run
+// once every cluster of the group has been consumed (or the build ended), when its flags are complete; the
+// groups' clusters are appended to `finished`.
+void finish_groups(Builder& b, const std::vector<uint32_t>& groups, std::vector<uint32_t>& finished) {
+  ClusterDag& dag = b.dag;
+  tbb::parallel_for(size_t(0), groups.size(), [&](size_t i) {
+    const DagGroup& group = dag.groups[groups[i]];
+    std::vector<uint32_t> locked_ids;
+    for (uint32_t c : group.clusters)
+      for (size_t v = 0; v < b.position_ids[c].size(); ++v)
+        if (dag.clusters[c].locked[v]) locked_ids.push_back(b.position_ids[c][v]);
+    std::sort(locked_ids.begin(), locked_ids.end());
+    for (uint32_t c : group.clusters)
+      for (size_t v = 0; v < b.position_ids[c].size(); ++v)
+        if (std::binary_search(locked_ids.begin(), locked_ids.end(), b.position_ids[c][v]))
+          dag.clusters[c].locked[v] = 1;
+  });
+  for (uint32_t g : groups)
+    finished.insert(finished.end(), dag.groups[g].clusters.begin(), dag.groups[g].clusters.end());
+}
+
 }  // namespace
 
 ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
@@ -230,6 +284,8 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
 
   std::vector<uint32_t> active(dag.clusters.size());
   for (uint32_t c = 0; c < active.size(); ++c) active[c] = c;
+  std::vector<uint32_t> finished = active;  // final clusters not yet handed to options.finished
+  std::vector<uint32_t> unconsumed;         // by group: its clusters no accepted group has consumed yet
   for (uint32_t level = 1; level <= options.max_levels; ++level) {
     size_t active_triangles = 0;
     for (uint32_t c : active) active_triangles += dag.clusters[c].mesh.triangle_count();
@@ -255,8 +311,17 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
     // Near the root, one group takes everything: no border left to lock, so small meshes with thin parts
     // still reach a small root.
     const bool last = active_triangles <= 2 * options.group_clusters * options.max_cluster_triangles;
-    std::vector<std::vector<uint32_t>> groups =
-        partition_clusters(triangles, centroids, edges, last ? active.size() : options.group_clusters);
+    // Grouping runs on one core (METIS); the clusters the previous level finished are handed over beside it.
+    std::vector<std::vector<uint32_t>> groups;
+    tbb::parallel_invoke(
+        [&] {
+          groups =
+              partition_clusters(triangles, centroids, edges, last ? active.size() : options.group_clusters);
+        },
+        [&] {
+          if (options.finished && !finished.empty()) options.finished(dag, finished);
+        });
+    finished.clear();
     edges = {};
     for (auto& g : groups)
       for (uint32_t& i : g) i = active[i];  // active position -> cluster id
@@ -281,7 +346,7 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
         results[g] = simplify_group(b, groups[g], border, level);
     });
 
-    std::vector<uint32_t> next;
+    std::vector<uint32_t> next, completed_groups;
     bool any = false;
     for (size_t g = 0; g < groups.size(); ++g) {
       GroupResult& r = results[g];
@@ -309,6 +374,8 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
           if (border[ids[v]] ||
               (options.lock_open_boundary && ids[v] < b.open_boundary.size() && b.open_boundary[ids[v]]))
             child.locked[v] = 1;
+        if (child.group != kNoGroup && --unconsumed[child.group] == 0)
+          completed_groups.push_back(child.group);
       }
       for (NewCluster& nc : r.clusters) {
         const uint32_t cid = uint32_t(dag.clusters.size());
@@ -324,28 +391,23 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
         r.group.clusters.push_back(cid);
         next.push_back(cid);
       }
+      unconsumed.push_back(uint32_t(r.group.clusters.size()));
       dag.groups.push_back(std::move(r.group));
       dag.levels = std::max(dag.levels, level + 1);
     }
+    finish_groups(b, completed_groups, finished);
     active = std::move(next);
     if (!any) {
       dag.stalled = true;
       break;
     }
   }
-  // A position locked in one cluster of a group is locked in every cluster of that group holding it: the
-  // group's clusters share one position shift, so a vertex they share must decode the same way in all.
-  tbb::parallel_for(size_t(0), dag.groups.size(), [&](size_t g) {
-    std::vector<uint32_t> locked_ids;
-    for (uint32_t c : dag.groups[g].clusters)
-      for (size_t v = 0; v < b.position_ids[c].size(); ++v)
-        if (dag.clusters[c].locked[v]) locked_ids.push_back(b.position_ids[c][v]);
-    std::sort(locked_ids.begin(), locked_ids.end());
-    for (uint32_t c : dag.groups[g].clusters)
-      for (size_t v = 0; v < b.position_ids[c].size(); ++v)
-        if (std::binary_search(locked_ids.begin(), locked_ids.end(), b.position_ids[c][v]))
-          dag.clusters[c].locked[v] = 1;
-  });
+  // The rest: the groups that made a root.
+  std::vector<uint32_t> open_groups;
+  for (uint32_t g = 0; g < dag.groups.size(); ++g)
+    if (unconsumed[g] > 0) open_groups.push_back(g);
+  finish_groups(b, open_groups, finished);
+  if (options.finished && !finished.empty()) options.finished(dag, finished);
   for (uint32_t c : active) {
     DagCluster& root = dag.clusters[c];
     root.parent_group = kNoGroup;

@@ -1,5 +1,9 @@
 #include "io/ply_reader.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
 #include <bit>
 #include <cstdio>
 #include <cstring>
@@ -307,6 +311,36 @@ int64_t as_index(double v) {
   return v < 0 || v != v ? -1 : static_cast<int64_t>(v);
 }
 
+// The common binary face element, only a list of vertex indices and every face a triangle, read on every core
+// at its fixed stride: true when that is what the file holds (indices appended to `mesh`). False, with `mesh`
+// as it was, on anything else (another layout, a polygon, a bad index), which the item-by-item reader then
+// handles and reports.
+template <bool Swap>
+bool read_triangles(const char* data, size_t size, size_t offset, const Element& e, uint64_t vertex_count,
+                    Mesh& mesh) {
+  if (e.properties.size() != 1 || !is_face_list(e.properties[0])) return false;
+  const Property& prop = e.properties[0];
+  const size_t cs = type_size(prop.count_type), is = type_size(prop.type), stride = cs + 3 * is;
+  if (e.count > (size - offset) / stride) return false;
+  const size_t base = mesh.indices.size();
+  mesh.indices.resize(base + 3 * e.count);
+  std::atomic<bool> ok{true};
+  tbb::parallel_for(
+      tbb::blocked_range<uint64_t>(0, e.count, 1 << 15), [&](const tbb::blocked_range<uint64_t>& r) {
+        const char* p = data + offset + r.begin() * stride;
+        for (uint64_t f = r.begin(); f < r.end() && ok.load(std::memory_order_relaxed); ++f, p += stride) {
+          if (load<Swap>(p, prop.count_type) != 3.0) return ok.store(false);
+          for (int k = 0; k < 3; ++k) {
+            const int64_t idx = as_index(load<Swap>(p + cs + k * is, prop.type));
+            if (idx < 0 || uint64_t(idx) >= vertex_count) return ok.store(false);
+            mesh.indices[base + 3 * f + k] = uint32_t(idx);
+          }
+        }
+      });
+  if (!ok) mesh.indices.resize(base);
+  return ok;
+}
+
 template <bool Swap>
 void read_binary(const char* data, size_t size, const Header& h, const std::string& file, Mesh& mesh,
                  size_t& skipped) {
@@ -337,14 +371,20 @@ void read_binary(const char* data, size_t size, const Header& h, const std::stri
       std::vector<size_t> offsets;
       for (size_t k = 0, o = 0; k < e.properties.size(); o += type_size(e.properties[k].type), ++k)
         offsets.push_back(o);
-      double v[kSlots + 1] = {};
-      const char* p = data + offset;
-      for (uint64_t i = 0; i < e.count; ++i, p += stride) {
-        for (size_t k = 0; k < offsets.size(); ++k)
-          v[layout.slots[k]] = load<Swap>(p + offsets[k], e.properties[k].type);
-        builder.set(i, v);
-      }
+      // Fixed-size items: read on every core.
+      tbb::parallel_for(tbb::blocked_range<uint64_t>(0, e.count, 1 << 14),
+                        [&](const tbb::blocked_range<uint64_t>& r) {
+                          double v[kSlots + 1] = {};
+                          const char* p = data + offset + r.begin() * stride;
+                          for (uint64_t i = r.begin(); i < r.end(); ++i, p += stride) {
+                            for (size_t k = 0; k < offsets.size(); ++k)
+                              v[layout.slots[k]] = load<Swap>(p + offsets[k], e.properties[k].type);
+                            builder.set(i, v);
+                          }
+                        });
       offset += stride * e.count;
+    } else if (e.name == "face" && read_triangles<Swap>(data, size, offset, e, vertex_count, mesh)) {
+      offset += e.count * (type_size(e.properties[0].count_type) + 3 * type_size(e.properties[0].type));
     } else if (e.name == "face") {
       FaceBuilder faces{mesh, vertex_count, file, 0, {}};
       mesh.indices.reserve(3 * e.count);

@@ -1,7 +1,12 @@
 #include "io/validate.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <vector>
 
 #include "core/error.hpp"
 
@@ -35,22 +40,37 @@ ValidationCounts validate_mesh(Mesh& mesh, const std::string& what) {
         !std::isfinite(mesh.colors[v].b) || !std::isfinite(mesh.colors[v].a))
       throw Error(what + ": vertex " + std::to_string(v) + " has a non-finite colour");
 
+  // Triangles are checked on every core (the double-precision cross product is most of the cost) and kept in
+  // order afterwards; the error names the first bad triangle, as a serial scan would.
+  const size_t nt = mesh.indices.size() / 3;
+  std::vector<uint8_t> keep(nt);
+  std::atomic<size_t> first_bad{nt};
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nt, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t t = r.begin(); t < r.end(); ++t) {
+      const uint32_t a = mesh.indices[3 * t], b = mesh.indices[3 * t + 1], c = mesh.indices[3 * t + 2];
+      if (a >= nv || b >= nv || c >= nv) {
+        for (size_t seen = first_bad.load(); t < seen && !first_bad.compare_exchange_weak(seen, t);) {
+        }
+        break;
+      }
+      const glm::dvec3 pa(mesh.positions[a]), pb(mesh.positions[b]), pc(mesh.positions[c]);
+      const glm::dvec3 cross = glm::cross(pb - pa, pc - pa);
+      keep[t] = !(pa == pb || pb == pc || pa == pc || (cross.x == 0 && cross.y == 0 && cross.z == 0));
+    }
+  });
+  if (const size_t t = first_bad.load(); t < nt) {
+    const uint32_t* i = &mesh.indices[3 * t];
+    throw Error(what + ": triangle " + std::to_string(t) + " references vertex " +
+                std::to_string(std::max({i[0], i[1], i[2]})) + ", but there are only " + std::to_string(nv) +
+                " vertices");
+  }
   size_t out = 0;
-  for (size_t t = 0; t < mesh.indices.size() / 3; ++t) {
-    const uint32_t a = mesh.indices[3 * t], b = mesh.indices[3 * t + 1], c = mesh.indices[3 * t + 2];
-    if (a >= nv || b >= nv || c >= nv)
-      throw Error(what + ": triangle " + std::to_string(t) + " references vertex " +
-                  std::to_string(std::max({a, b, c})) + ", but there are only " + std::to_string(nv) +
-                  " vertices");
-    const glm::dvec3 pa(mesh.positions[a]), pb(mesh.positions[b]), pc(mesh.positions[c]);
-    const glm::dvec3 cross = glm::cross(pb - pa, pc - pa);
-    if (pa == pb || pb == pc || pa == pc || (cross.x == 0 && cross.y == 0 && cross.z == 0)) {
+  for (size_t t = 0; t < nt; ++t) {
+    if (!keep[t]) {
       ++counts.degenerate_triangles;
       continue;
     }
-    mesh.indices[3 * out] = a;
-    mesh.indices[3 * out + 1] = b;
-    mesh.indices[3 * out + 2] = c;
+    for (int k = 0; k < 3; ++k) mesh.indices[3 * out + k] = mesh.indices[3 * t + k];
     ++out;
   }
   mesh.indices.resize(3 * out);

@@ -1,5 +1,8 @@
 #include "io/weld.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -70,7 +73,9 @@ std::vector<uint32_t> representatives(const VertexKey& key, size_t n) {
   std::vector<uint64_t> table(capacity, kEmpty);
   // Arrays that are written in full are left uninitialized (zero-filling them cost a tenth of an import).
   auto hashes = std::make_unique_for_overwrite<uint64_t[]>(n);
-  for (uint32_t v = 0; v < n; ++v) hashes[v] = key.hash(v);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v < r.end(); ++v) hashes[v] = key.hash(uint32_t(v));
+  });
   std::vector<uint32_t> rep;
   rep.reserve(n);
   const size_t mask = capacity - 1;
@@ -177,11 +182,13 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
 
   // Face normals, unnormalized: their length is twice the area, which weights the sums.
   auto face = std::make_unique_for_overwrite<glm::vec3[]>(nt);
-  for (size_t t = 0; t < nt; ++t) {
-    const uint32_t* v = &mesh.indices[3 * t];
-    face[t] =
-        glm::cross(mesh.positions[v[1]] - mesh.positions[v[0]], mesh.positions[v[2]] - mesh.positions[v[0]]);
-  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nt, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t t = r.begin(); t < r.end(); ++t) {
+      const uint32_t* v = &mesh.indices[3 * t];
+      face[t] = glm::cross(mesh.positions[v[1]] - mesh.positions[v[0]],
+                           mesh.positions[v[2]] - mesh.positions[v[0]]);
+    }
+  });
 
   // Corners grouped by position class (counting sort).
   std::vector<uint32_t> start(nv + 1, 0);
@@ -207,7 +214,9 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
 
   // Per position: group its corners by crease, then give each (welded vertex, group) pair one output vertex.
   // A welded vertex belongs to exactly one position, so all its corners are handled here and the indices can
-  // be rewritten in place.
+  // be rewritten in place. Runs of positions go to every core; each run numbers its output vertices from 0
+  // and is then shifted by the outputs of the runs before it, which gives the serial numbering (position
+  // order) whatever the timing.
   const float cos_crease = std::cos(glm::radians(crease_angle_degrees));
   struct Group {
     glm::vec3 seed;  // unit normal of the group's first triangle
@@ -216,49 +225,67 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
   struct Output {
     uint32_t vertex, group, out;
   };
-  std::vector<Group> groups;
-  std::vector<uint32_t> corner_group;
-  std::vector<Output> outputs;
-  std::vector<uint32_t> keep;
-  std::vector<glm::vec3> normals;
-  keep.reserve(nv);
-  normals.reserve(nv);
-  for (size_t p = 0; p < nv; ++p) {
-    const uint32_t begin = start[p], end = start[p + 1];
-    if (begin == end) continue;
-    groups.clear();
-    corner_group.clear();
-    for (uint32_t k = begin; k < end; ++k) {
-      if (k + kAhead < nc) {  // corners are gathered in random order: keep misses in flight
-        __builtin_prefetch(&face[corners[k + kAhead] / 3]);
-        __builtin_prefetch(&mesh.indices[corners[k + kAhead]]);
+  struct Run {
+    std::vector<uint32_t> keep;
+    std::vector<glm::vec3> normals;
+  };
+  constexpr size_t kRunPositions = size_t(1) << 15;
+  std::vector<Run> runs((nv + kRunPositions - 1) / kRunPositions);
+  tbb::parallel_for(size_t(0), runs.size(), [&](size_t r) {
+    std::vector<Group> groups;
+    std::vector<uint32_t> corner_group;
+    std::vector<Output> outputs;
+    Run& run = runs[r];
+    const uint32_t run_end = start[std::min(nv, (r + 1) * kRunPositions)];
+    for (size_t p = r * kRunPositions; p < std::min(nv, (r + 1) * kRunPositions); ++p) {
+      const uint32_t begin = start[p], end = start[p + 1];
+      if (begin == end) continue;
+      groups.clear();
+      corner_group.clear();
+      for (uint32_t k = begin; k < end; ++k) {
+        if (k + kAhead < run_end) {  // corners are gathered in random order: keep misses in flight
+          __builtin_prefetch(&face[corners[k + kAhead] / 3]);
+          __builtin_prefetch(&mesh.indices[corners[k + kAhead]]);
+        }
+        const glm::vec3& n = face[corners[k] / 3];
+        const float len = glm::length(n);
+        const glm::vec3 unit = len > 0 ? n / len : glm::vec3(0.0f);
+        size_t g = 0;
+        while (g < groups.size() && glm::dot(groups[g].seed, unit) < cos_crease) ++g;
+        if (g == groups.size()) groups.push_back({unit, glm::vec3(0.0f)});
+        groups[g].sum += n;
+        corner_group.push_back(static_cast<uint32_t>(g));
       }
-      const glm::vec3& n = face[corners[k] / 3];
-      const float len = glm::length(n);
-      const glm::vec3 unit = len > 0 ? n / len : glm::vec3(0.0f);
-      size_t g = 0;
-      while (g < groups.size() && glm::dot(groups[g].seed, unit) < cos_crease) ++g;
-      if (g == groups.size()) groups.push_back({unit, glm::vec3(0.0f)});
-      groups[g].sum += n;
-      corner_group.push_back(static_cast<uint32_t>(g));
-    }
-    outputs.clear();
-    for (uint32_t k = begin; k < end; ++k) {
-      const uint32_t c = corners[k], w = mesh.indices[c], g = corner_group[k - begin];
-      // Distinct (vertex, group) pairs at one position are few (seams, creases): a linear search is enough.
-      auto it = std::find_if(outputs.begin(), outputs.end(),
-                             [w, g](const Output& o) { return o.vertex == w && o.group == g; });
-      if (it == outputs.end()) {
-        const uint32_t out = static_cast<uint32_t>(keep.size());
-        keep.push_back(w);
-        const float len = glm::length(groups[g].sum);
-        normals.push_back(len > 0 ? groups[g].sum / len : glm::vec3(0.0f, 0.0f, 1.0f));
-        outputs.push_back({w, g, out});
-        it = outputs.end() - 1;
+      outputs.clear();
+      for (uint32_t k = begin; k < end; ++k) {
+        const uint32_t c = corners[k], w = mesh.indices[c], g = corner_group[k - begin];
+        // Distinct (vertex, group) pairs at one position are few (seams, creases): a linear search is enough.
+        auto it = std::find_if(outputs.begin(), outputs.end(),
+                               [w, g](const Output& o) { return o.vertex == w && o.group == g; });
+        if (it == outputs.end()) {
+          const uint32_t out = static_cast<uint32_t>(run.keep.size());
+          run.keep.push_back(w);
+          const float len = glm::length(groups[g].sum);
+          run.normals.push_back(len > 0 ? groups[g].sum / len : glm::vec3(0.0f, 0.0f, 1.0f));
+          outputs.push_back({w, g, out});
+          it = outputs.end() - 1;
+        }
+        mesh.indices[c] = it->out;
       }
-      mesh.indices[c] = it->out;
     }
-  }
+  });
+  std::vector<uint32_t> first_output(runs.size() + 1, 0);
+  for (size_t r = 0; r < runs.size(); ++r)
+    first_output[r + 1] = first_output[r] + uint32_t(runs[r].keep.size());
+  std::vector<uint32_t> keep(first_output.back());
+  std::vector<glm::vec3> normals(first_output.back());
+  tbb::parallel_for(size_t(0), runs.size(), [&](size_t r) {
+    const uint32_t shift = first_output[r];
+    for (uint32_t k = start[r * kRunPositions]; k < start[std::min(nv, (r + 1) * kRunPositions)]; ++k)
+      mesh.indices[corners[k]] += shift;
+    std::copy(runs[r].keep.begin(), runs[r].keep.end(), keep.begin() + shift);
+    std::copy(runs[r].normals.begin(), runs[r].normals.end(), normals.begin() + shift);
+  });
   compact(mesh, keep);
   mesh.normals = std::move(normals);
 }

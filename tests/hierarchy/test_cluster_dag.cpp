@@ -7,6 +7,7 @@
 #include <map>
 #include <random>
 #include <set>
+#include <span>
 #include <tuple>
 
 #include "hierarchy/bounding_sphere.hpp"
@@ -200,17 +201,81 @@ TEST(ClusterDag, ErrorBoundHoldsAgainstBruteForceDistance) {
     EXPECT_LE(distance_to(p, roots), double(root_error) * 1.0001 + 1e-6);
 }
 
-TEST(ClusterDag, TerminatesOnNonManifoldAndManyTinyComponents) {
+// `count` separate tetrahedra scattered in a box: many tiny closed components.
+Mesh tetrahedra_soup(int count) {
   Mesh soup;
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(0.0f, 10.0f);
-  for (int k = 0; k < 600; ++k) {  // 600 separate tetrahedra (closed, 4 triangles each)
+  for (int k = 0; k < count; ++k) {  // separate tetrahedra (closed, 4 triangles each)
     const glm::vec3 o(u(rng), u(rng), u(rng));
     const uint32_t base = uint32_t(soup.positions.size());
     for (glm::vec3 d : {glm::vec3(0), glm::vec3(0.1f, 0, 0), glm::vec3(0, 0.1f, 0), glm::vec3(0, 0, 0.1f)})
       soup.positions.push_back(o + d);
     for (uint32_t i : {0u, 2u, 1u, 0u, 1u, 3u, 0u, 3u, 2u, 1u, 2u, 3u}) soup.indices.push_back(base + i);
   }
+  return soup;
+}
+
+// DagOptions::finished hands over every cluster exactly once, already as the build leaves it, and most of
+// them while later levels are still being built (what lets the bake encode beside the grouping).
+void check_finished(const Mesh& mesh) {
+  struct Snapshot {
+    std::vector<glm::vec3> positions;
+    std::vector<uint32_t> indices;
+    std::vector<uint8_t> locked;
+    float error;
+    size_t dag_clusters;  // how many clusters the DAG had when this one was handed over
+  };
+  std::map<uint32_t, Snapshot> seen;
+  size_t calls = 0;
+  DagOptions options;
+  options.finished = [&](const ClusterDag& dag, std::span<const uint32_t> clusters) {
+    ++calls;
+    for (uint32_t c : clusters) {
+      const DagCluster& cluster = dag.clusters[c];
+      const bool fresh = seen.emplace(c, Snapshot{cluster.mesh.positions, cluster.mesh.indices,
+                                                  cluster.locked, cluster.error, dag.clusters.size()})
+                             .second;
+      EXPECT_TRUE(fresh) << "cluster " << c << " handed over twice";
+    }
+  };
+  const ClusterDag dag = build_cluster_dag(mesh, options);
+  ASSERT_GE(dag.levels, 4u);
+  EXPECT_EQ(seen.size(), dag.clusters.size());
+  EXPECT_GE(calls, size_t(dag.levels) - 1);
+  size_t early = 0;
+  for (const auto& [c, s] : seen) {
+    const DagCluster& cluster = dag.clusters[c];
+    EXPECT_EQ(s.positions, cluster.mesh.positions);
+    EXPECT_EQ(s.indices, cluster.mesh.indices);
+    if (cluster.level > 0) {  // level 0 is handed over before any group consumed it (cluster_dag.hpp)
+      EXPECT_EQ(s.locked, cluster.locked) << "cluster " << c << " changed its locked flags after hand-over";
+    } else {
+      EXPECT_EQ(s.error, 0.0f);
+    }
+    EXPECT_EQ(s.error, cluster.error);
+    early += s.dag_clusters < dag.clusters.size();
+  }
+  EXPECT_GE(early, dag.clusters.size() / 2) << "clusters should be handed over level by level";
+  // The same build without the callback is the same DAG.
+  const ClusterDag plain = build_cluster_dag(mesh);
+  ASSERT_EQ(plain.clusters.size(), dag.clusters.size());
+  for (size_t c = 0; c < dag.clusters.size(); ++c) {
+    EXPECT_EQ(plain.clusters[c].locked, dag.clusters[c].locked);
+    EXPECT_EQ(plain.clusters[c].mesh.indices, dag.clusters[c].mesh.indices);
+  }
+}
+
+TEST(ClusterDag, FinishedClustersAreReportedOnceAndStayUnchanged) {
+  check_finished(test::sphere(1.0f, 64, 128));
+  Mesh grid = test::grid(64);
+  for (glm::vec3& p : grid.positions) p.z = 0.02f * std::sin(9.0f * p.x) * std::cos(7.0f * p.y);
+  grid.normals.clear();
+  check_finished(grid);
+}
+
+TEST(ClusterDag, TerminatesOnNonManifoldAndManyTinyComponents) {
+  const Mesh soup = tetrahedra_soup(600);
   const ClusterDag dag = build_cluster_dag(soup);
   check_invariants(dag);
   check_cuts(dag, soup, 20);

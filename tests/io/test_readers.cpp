@@ -107,6 +107,44 @@ TEST(Ply, RoundTripThroughExport) {
   }
 }
 
+// Binary little-endian PLY of `m` (positions only), its faces as triangles plus, when `quad`, one quad at
+// the end; the faces are read in parallel at their stride unless some face is not a triangle.
+std::string binary_ply(const Mesh& m, bool quad) {
+  std::string b = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(m.vertex_count()) +
+                  "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+                  std::to_string(m.triangle_count() + quad) +
+                  "\nproperty list uchar int vertex_indices\nend_header\n";
+  b.append(reinterpret_cast<const char*>(m.positions.data()), m.positions.size() * sizeof(glm::vec3));
+  for (size_t t = 0; t < m.triangle_count(); ++t) {
+    b += char(3);
+    b.append(reinterpret_cast<const char*>(&m.indices[3 * t]), 3 * sizeof(uint32_t));
+  }
+  if (quad) {
+    const int32_t corners[4] = {0, 1, 2, 3};
+    b += char(4);
+    b.append(reinterpret_cast<const char*>(corners), sizeof corners);
+  }
+  return b;
+}
+
+TEST(Ply, LargeBinaryTrianglesInOrderWithOrWithoutAPolygon) {
+  const Mesh m = sphere(1.0f, 150, 300);  // 89,400 triangles: several parallel runs
+  for (bool quad : {false, true}) {
+    Scene back = import_model(write_file(quad ? "big_quad.ply" : "big.ply", binary_ply(m, quad)));
+    const Mesh& r = back.meshes[0];
+    ASSERT_EQ(r.triangle_count(), m.triangle_count() + 2 * quad);
+    for (size_t t = 0; t < m.indices.size(); ++t)
+      ASSERT_EQ(r.positions[r.indices[t]], m.positions[m.indices[t]]);
+  }
+  std::string bad = binary_ply(m, false);
+  const size_t last_index = bad.size() - sizeof(int32_t);
+  const int32_t out_of_range = int32_t(m.vertex_count());
+  std::memcpy(&bad[last_index], &out_of_range, sizeof out_of_range);
+  EXPECT_NE(
+      import_error(write_file("big_bad.ply", bad)).find("face " + std::to_string(m.triangle_count() - 1)),
+      std::string::npos);
+}
+
 TEST(Off, PolygonsCommentsAndCountsOnTheKeywordLine) {
   // A pyramid: square base (one quad) and four triangles; a pentagon elsewhere (fan of 3).
   auto file = write_file("pyramid.off",

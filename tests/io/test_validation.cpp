@@ -3,6 +3,7 @@
 
 #include "files.hpp"
 #include "io/export.hpp"
+#include "io/validate.hpp"
 #include "support/shapes.hpp"
 
 using namespace lodstream;
@@ -109,4 +110,32 @@ TEST(Validation, DegenerateTrianglesAreDroppedAndCounted) {
 TEST(Validation, MissingFileAndUnknownPlyFormat) {
   expect_error(temp_dir() / "missing.ply", "no such file");
   expect_error(write_file("fmt.ply", "ply\nformat binary_middle_endian 1.0\nend_header\n"), "unknown format");
+}
+
+// A mesh large enough to be checked on several cores: the error names the first bad triangle in index order,
+// and the degenerate triangles spread over it are dropped with the order of the others kept.
+TEST(Validation, LargeMeshNamesTheFirstBadTriangleAndKeepsOrder) {
+  const Mesh good = sphere(1.0f, 200, 200);  // 79,600 triangles
+  Mesh bad = good;
+  for (size_t t : {size_t(70000), size_t(41234), size_t(60000)}) bad.indices[3 * t + 1] = 1000000;
+  try {
+    validate_mesh(bad, "big");
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "big: triangle 41234 references vertex 1000000, but there are only " +
+                                         std::to_string(good.vertex_count()) + " vertices");
+  }
+  Mesh degenerate = good;
+  std::vector<uint32_t> expected;
+  for (size_t t = 0; t < good.triangle_count(); ++t) {
+    uint32_t* i = &degenerate.indices[3 * t];
+    if (t % 1000 == 7) {
+      i[2] = i[0];  // a repeated corner
+      continue;
+    }
+    expected.insert(expected.end(), i, i + 3);
+  }
+  const ValidationCounts counts = validate_mesh(degenerate, "big");
+  EXPECT_EQ(counts.degenerate_triangles, good.triangle_count() - expected.size() / 3);
+  EXPECT_EQ(degenerate.indices, expected);
 }
