@@ -66,7 +66,8 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
   }
   r.position_bytes = bytes_for(largest);
   if (g.mesh->has_normals()) {
-    std::vector<glm::vec3> decoded(V), sum;
+    std::vector<glm::vec3> decoded(V);
+    std::vector<NormalSum> sum;
     decode_positions(n.c, LockedStream::parse(locked_stream, V, g.position_shift, "node codec"), grid,
                      decoded.data());
     predicted_normals(indices, g.first_vertex, n.index_end, decoded.data(), uint32_t(V), sum);
@@ -124,7 +125,7 @@ void decode_predicted_vertices(const PredictiveNode& p, std::span<const uint32_t
   decode_positions(std::span(c).first(3 * size_t(V)), locked, grid, m.positions.data());
 
   if (p.flags & kHasNormals) {
-    thread_local std::vector<glm::vec3> sum;
+    thread_local std::vector<NormalSum> sum;
     predicted_normals(m.indices, p.first_vertex, p.index_end, m.positions.data(), V, sum);
     m.normals.resize(V);
     decode_predicted_normals(sum, p.normal_planes.data(), p.normal_bytes, p.normal_bits, m.normals.data());
