@@ -17,11 +17,12 @@ class Front {
     uint32_t a, b, o, prev, next, state;
   };
 
-  void reset(size_t triangles) {
+  // A front for T triangles in `storage` (reused between calls): its position lives in the Front, a local of
+  // the caller, so that the compiler keeps it in registers.
+  Front(std::vector<Edge>& storage, size_t triangles) : edges_(storage) {
     // A piece start adds 3 edges, every other triangle at most 2: no more than 3T edges, whatever the
     // symbols.
     if (edges_.size() < 3 * triangles) edges_.resize(3 * triangles);
-    size_ = gate_ = 0;
   }
   // The next edge to process, or kNone.
   uint32_t gate() {
@@ -93,7 +94,7 @@ class Front {
     edges_[after].prev = x;
   }
 
-  std::vector<Edge> edges_;
+  std::vector<Edge>& edges_;
   size_t size_ = 0, gate_ = 0;
 };
 
@@ -128,8 +129,8 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V) {
   };
   auto emit = [&](uint32_t a, uint32_t b, uint32_t c) { code.indices.insert(code.indices.end(), {a, b, c}); };
 
-  Front front;
-  front.reset(T);
+  std::vector<Front::Edge> edges;
+  Front front(edges, T);
   uint32_t scan = 0;  // triangles below it are encoded
   uint32_t done = 0;  // triangles emitted
   while (done < T) {
@@ -204,8 +205,8 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
                       uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where) {
   ByteReader refs(references, where);
   auto fail = [&](const char* what) { throw Error(where + ": corrupted connectivity (" + what + ")"); };
-  thread_local Front front;
-  front.reset(T);
+  thread_local std::vector<Front::Edge> edges;
+  Front front(edges, T);
   uint32_t next = 0;  // the next new vertex
   size_t s = 0;
   uint32_t* out = indices;
