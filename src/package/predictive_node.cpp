@@ -152,8 +152,7 @@ void decode_predicted_vertices(const PredictiveNode& p, std::span<const uint32_t
   if (p.flags & kHasNormals) {
     thread_local std::vector<NormalSum> sum;
     predicted_normals(m.indices, p.first_vertex, p.index_end, m.positions.data(), V, sum);
-    m.normals.resize(V);
-    decode_predicted_normals(sum, p.normal_planes.data(), p.normal_bytes, p.normal_bits, m.normals.data());
+    decode_predicted_normals(sum, V, p.normal_planes.data(), p.normal_bytes, p.normal_bits, m.normals);
   }
   decode_attribute_stream(p.attribute_stream, p.flags, V, p.uv_min, p.uv_extent, out, where);
 }
