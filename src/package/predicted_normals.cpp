@@ -20,9 +20,12 @@ NormalSum rotate(NormalSum v) {
 
 void predicted_normals(std::span<const uint32_t> indices, uint32_t first_vertex, uint32_t index_end,
                        const glm::vec3* positions, uint32_t V, std::vector<NormalSum>& sum) {
-  thread_local std::vector<NormalSum> p;
-  p.resize(V);
-  for (uint32_t v = 0; v < V; ++v) p[v] = NormalSum{positions[v].x, positions[v].y, positions[v].z, 0.0f};
+  // Lanes 0-2 of a 16-byte load at positions[v] are its x y z; lane 3 (the next vertex's x) is never read.
+  auto p = [positions](uint32_t v) {
+    NormalSum r;
+    std::memcpy(&r, &positions[v], sizeof r);
+    return r;
+  };
   sum.resize((size_t(V) + 3) & ~size_t(3));
   std::memset(sum.data(), 0, sum.size() * sizeof(NormalSum));
   auto accumulate = [&](auto all_inside) {
@@ -31,7 +34,7 @@ void predicted_normals(std::span<const uint32_t> indices, uint32_t first_vertex,
                      c = indices[i + 2] - first_vertex;
       if (!all_inside && (a >= V || b >= V || c >= V)) continue;
       // cross(e, f) = e.yzx * f.zxy - e.zxy * f.yzx, as glm::cross computes each component.
-      const NormalSum e = p[b] - p[a], f = p[c] - p[a];
+      const NormalSum pa = p(a), e = p(b) - pa, f = p(c) - pa;
       const NormalSum e1 = rotate(e), f1 = rotate(f);
       const NormalSum n = e1 * rotate(f1) - rotate(e1) * f1;
       sum[a] += n, sum[b] += n, sum[c] += n;

@@ -98,7 +98,7 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
   }
   r.position_bytes = bytes_for(largest);
   if (g.mesh->has_normals()) {
-    std::vector<glm::vec3> decoded(V);
+    std::vector<glm::vec3> decoded(V + 1);  // predicted_normals reads one past the last
     std::vector<NormalSum> sum;
     decode_positions(n.c, LockedStream::parse(locked_stream, V, g.position_shift, "node codec"), grid,
                      decoded.data());
@@ -146,12 +146,16 @@ void decode_predicted_vertices(const PredictiveNode& p, std::span<const uint32_t
                                 ? predict_positions<2>(planes, V, predictors.data(), cu)
                                 : predict_positions<0>(planes, V, predictors.data(), cu, p.position_bytes);
   if (out_of_range) throw Error(where + ": predicted position out of the grid's range");
-  m.positions.resize(V);
-  decode_positions(std::span(c).first(3 * size_t(V)), locked, grid, m.positions.data());
+  // Decoded into scratch and copied (no zero-fill of m.positions first); one spare entry for
+  // predicted_normals.
+  thread_local std::vector<glm::vec3> positions;
+  positions.resize(size_t(V) + 1);
+  decode_positions(std::span(c).first(3 * size_t(V)), locked, grid, positions.data());
+  m.positions.assign(positions.begin(), positions.begin() + V);
 
   if (p.flags & kHasNormals) {
     thread_local std::vector<NormalSum> sum;
-    predicted_normals(m.indices, p.first_vertex, p.index_end, m.positions.data(), V, sum);
+    predicted_normals(m.indices, p.first_vertex, p.index_end, positions.data(), V, sum);
     decode_predicted_normals(sum, V, p.normal_planes.data(), p.normal_bytes, p.normal_bits, m.normals);
   }
   decode_attribute_stream(p.attribute_stream, p.flags, V, p.uv_min, p.uv_extent, out, where);
