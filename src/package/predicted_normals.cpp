@@ -18,8 +18,12 @@ NormalSum rotate(NormalSum v) {
 
 }  // namespace
 
-void predicted_normals(std::span<const uint32_t> indices, uint32_t first_vertex, uint32_t index_end,
-                       const glm::vec3* positions, uint32_t V, std::vector<NormalSum>& sum) {
+// target_clones: an AVX2 build of the function besides the baseline one, chosen once at load time (ifunc);
+// VEX's 3-operand forms save the register copies that 2-operand SSE needs. Neither build contracts a multiply
+// and an add (AVX2 does not include FMA), so both compute the same bits.
+__attribute__((target_clones("avx2", "default"))) void predicted_normals(
+    std::span<const uint32_t> indices, uint32_t first_vertex, uint32_t index_end, const glm::vec3* positions,
+    uint32_t V, std::vector<NormalSum>& sum) {
   // Lanes 0-2 of a 16-byte load at positions[v] are its x y z; lane 3 (the next vertex's x) is never read.
   auto p = [positions](uint32_t v) {
     NormalSum r;
@@ -63,8 +67,10 @@ std::vector<uint64_t> normal_residuals(std::span<const glm::vec3> normals, std::
   return residuals;
 }
 
-void decode_predicted_normals(std::span<const NormalSum> sum, uint32_t V, const uint8_t* planes,
-                              uint32_t width, uint32_t bits, std::vector<glm::vec3>& normals) {
+// An AVX2 build besides the baseline one, as predicted_normals.
+__attribute__((target_clones("avx2", "default"))) void decode_predicted_normals(
+    std::span<const NormalSum> sum, uint32_t V, const uint8_t* planes, uint32_t width, uint32_t bits,
+    std::vector<glm::vec3>& normals) {
   // Four vertices a step: their sums transposed to lanes, encoded, the residuals added, decoded, transposed
   // back into 12 floats. sum holds a multiple of 4 entries; residual and out take the last step's spare
   // lanes.
