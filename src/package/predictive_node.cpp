@@ -18,32 +18,18 @@ constexpr uint32_t kMaxPositionBytes = 5, kMaxNormalBytes = 3;
 // hostile residuals (< 2^40) overflows int64.
 constexpr int64_t kMaxCoarse = int64_t(1) << 32;
 
-// The residual of value i of a set of `count` stored as `width` planes (byte b at planes[b * stride]),
-// unzigzagged; Width is the width when known at compile time (0: read `width`).
-template <uint32_t Width>
-uint64_t planar_residual(const uint8_t* planes, size_t stride, uint32_t width) {
-  uint64_t z = planes[0];
-  if constexpr (Width == 2) z |= uint64_t(planes[stride]) << 8;
-  if constexpr (Width == 0)
-    for (uint32_t b = 1; b < width; ++b) z |= uint64_t(planes[b * stride]) << (8 * b);
-  return uint64_t(unzigzag(z));
-}
-
-// c[v] = c[o1] + c[o2] - c[o] + residual[v] per axis for v < V (predictive_node.hpp), wrapping, with the
-// residuals read from position planes (byte b of axis a at plane 3b + a) of `width` bytes. One pass; returns
-// whether a result lies outside [-kMaxCoarse, kMaxCoarse).
-template <uint32_t Width>
-bool predict_positions(const uint8_t* planes, uint32_t V, const uint32_t* o, uint64_t* c,
-                       uint32_t width = Width) {
-  const size_t stride = 3 * size_t(V);
-  const uint8_t *px = planes, *py = px + V, *pz = py + V;
+// c[v] = c[o1] + c[o2] - c[o] + residual[v] per axis for v < V (predictive_node.hpp), wrapping, the residuals
+// as read_planes leaves them (one array per axis). One pass; returns whether a result lies outside
+// [-kMaxCoarse, kMaxCoarse).
+bool predict_positions(const int64_t* residual, uint32_t V, const uint32_t* o, uint64_t* c) {
+  const int64_t *rx = residual, *ry = rx + V, *rz = ry + V;
   uint64_t shifted = 0;  // OR of c + kMaxCoarse: in range while below 2 kMaxCoarse
   for (uint32_t v = 0; v < V; ++v, o += 3) {
     const uint64_t *x = c + 3 * size_t(o[0]), *y = c + 3 * size_t(o[1]), *z = c + 3 * size_t(o[2]);
     uint64_t* to = c + 3 * size_t(v);
-    to[0] = x[0] + y[0] - z[0] + planar_residual<Width>(px + v, stride, width);
-    to[1] = x[1] + y[1] - z[1] + planar_residual<Width>(py + v, stride, width);
-    to[2] = x[2] + y[2] - z[2] + planar_residual<Width>(pz + v, stride, width);
+    to[0] = x[0] + y[0] - z[0] + uint64_t(rx[v]);
+    to[1] = x[1] + y[1] - z[1] + uint64_t(ry[v]);
+    to[2] = x[2] + y[2] - z[2] + uint64_t(rz[v]);
     shifted |=
         (to[0] + uint64_t(kMaxCoarse)) | (to[1] + uint64_t(kMaxCoarse)) | (to[2] + uint64_t(kMaxCoarse));
   }
@@ -140,11 +126,10 @@ void decode_predicted_vertices(const PredictiveNode& p, std::span<const uint32_t
   c.resize(3 * (size_t(V) + 1));
   uint64_t* cu = reinterpret_cast<uint64_t*>(c.data());
   for (int a = 0; a < 3; ++a) cu[3 * size_t(V) + a] = uint64_t(p.cmin[a]);
-  const uint8_t* planes = p.position_planes.data();
-  const bool out_of_range = p.position_bytes == 1 ? predict_positions<1>(planes, V, predictors.data(), cu)
-                            : p.position_bytes == 2
-                                ? predict_positions<2>(planes, V, predictors.data(), cu)
-                                : predict_positions<0>(planes, V, predictors.data(), cu, p.position_bytes);
+  thread_local std::vector<int64_t> residual;
+  residual.resize(3 * size_t(V));
+  read_planes(p.position_planes.data(), V, 3, p.position_bytes, residual.data());
+  const bool out_of_range = predict_positions(residual.data(), V, predictors.data(), cu);
   if (out_of_range) throw Error(where + ": predicted position out of the grid's range");
   // Decoded into scratch and copied (no zero-fill of m.positions first); one spare entry for
   // predicted_normals.
