@@ -17,12 +17,13 @@ class Front {
     uint32_t a, b, o, prev, next, state;
   };
 
-  // A front for T triangles in `storage` (reused between calls): its position lives in the Front, a local of
-  // the caller, so that the compiler keeps it in registers.
-  Front(std::vector<Edge>& storage, size_t triangles) : edges_(storage) {
+  // A front for T triangles in `storage` (reused between calls): its edges pointer and size live in the
+  // Front, a local of the caller, so that the compiler keeps them in registers.
+  Front(std::vector<Edge>& storage, size_t triangles) {
     // A piece start adds 3 edges, every other triangle at most 2: no more than 3T edges, whatever the
     // symbols.
-    if (edges_.size() < 3 * triangles) edges_.resize(3 * triangles);
+    if (storage.size() < 3 * triangles) storage.resize(3 * triangles);
+    edges_ = storage.data();
   }
   // The first pending edge at or after e (edges are processed in creation order), or size() when none is.
   uint32_t gate(uint32_t e) const {
@@ -95,7 +96,7 @@ class Front {
     edges_[after].prev = x;
   }
 
-  std::vector<Edge>& edges_;
+  Edge* edges_;
   uint32_t size_ = 0;
 };
 
