@@ -120,8 +120,8 @@ void decode_predicted_vertices(const PredictiveNode& p, std::span<const uint32_t
   Mesh& m = out.mesh;
   const LockedStream locked = LockedStream::parse(p.locked_stream, V, p.shift, where);
   // c[v] = c[o1] + c[o2] - c[o] + residual, with entry V holding cmin, the residuals read from their planes
-  // in the same pass. The arithmetic wraps (unsigned), so hostile residuals cannot overflow; the results are
-  // range-checked after.
+  // first (one vectorized pass). The arithmetic wraps (unsigned), so hostile residuals cannot overflow; the
+  // results are range-checked in the same pass.
   thread_local std::vector<int64_t> c;
   c.resize(3 * (size_t(V) + 1));
   uint64_t* cu = reinterpret_cast<uint64_t*>(c.data());
