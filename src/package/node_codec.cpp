@@ -9,11 +9,12 @@ namespace lodstream::package {
 
 // Codec 1 until a smaller codec decodes at the 25 M triangles per second per core that DESIGN.md requires.
 // bench_package (refined_elephant meshlets, finest level, zstd 9): codec 1 4.48 B/tri, codec 2 3.15, codec 3
-// 2.81; whole bakes: codec 3 stores 31 % fewer bytes than codec 1 (refined_elephant 9.92 -> 6.84 B per input
-// triangle). Decode (checksum + zstd + codec), codec 3 at about 0.71-0.78x codec 1 in the same loaded runs
-// (codec 2 about 0.6x); callgrind: 471 instructions per triangle vs codec 1's 326 (meshoptimizer's decoders
-// are SIMD), of which the traversal 117 and the predicted normals about 175. Codec 3 is at the floor only if
-// codec 1 decodes at 33 M/s or more on the machine at hand.
+// 2.81; whole bakes: codec 3 stores 23-31 % fewer bytes than codec 1 (refined_elephant 9.96 -> 6.90 B per
+// input triangle, city 10.21 -> 7.84). Decode (checksum + zstd + codec): codec 3 at 0.91x codec 1 in the same
+// loaded run (codec only 0.93x). Callgrind, instructions per decoded triangle: codec only 233 vs codec 1's
+// 253, with checksum and zstd 326 vs 326; codec 1's SIMD decoders retire more per cycle, codec 3 pays a
+// data-dependent branch per connectivity symbol and zstd's Huffman stage over its residual planes (about 27 %
+// more zstd work than codec 1's pages). Codec 3 is at the floor where codec 1 decodes at 27.5 M/s or more.
 const NodeCodec& default_node_codec() {
   return node_codec(MeshoptCodec::kId);
 }

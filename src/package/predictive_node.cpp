@@ -18,6 +18,24 @@ constexpr uint32_t kMaxPositionBytes = 5, kMaxNormalBytes = 3;
 // hostile residuals (< 2^40) overflows int64.
 constexpr int64_t kMaxCoarse = int64_t(1) << 32;
 
+// c[v] = c[o1] + c[o2] - c[o] + residual[v] per axis for v < V (predictive_node.hpp), wrapping, the residuals
+// as read_planes leaves them (one array per axis). One pass; returns whether a result lies outside
+// [-kMaxCoarse, kMaxCoarse).
+bool predict_positions(const int64_t* residual, uint32_t V, const uint32_t* o, uint64_t* c) {
+  const int64_t *rx = residual, *ry = rx + V, *rz = ry + V;
+  uint64_t shifted = 0;  // OR of c + kMaxCoarse: in range while below 2 kMaxCoarse
+  for (uint32_t v = 0; v < V; ++v, o += 3) {
+    const uint64_t *x = c + 3 * size_t(o[0]), *y = c + 3 * size_t(o[1]), *z = c + 3 * size_t(o[2]);
+    uint64_t* to = c + 3 * size_t(v);
+    to[0] = x[0] + y[0] - z[0] + uint64_t(rx[v]);
+    to[1] = x[1] + y[1] - z[1] + uint64_t(ry[v]);
+    to[2] = x[2] + y[2] - z[2] + uint64_t(rz[v]);
+    shifted |=
+        (to[0] + uint64_t(kMaxCoarse)) | (to[1] + uint64_t(kMaxCoarse)) | (to[2] + uint64_t(kMaxCoarse));
+  }
+  return shifted >= 2 * uint64_t(kMaxCoarse);
+}
+
 }  // namespace
 
 PredictiveNode PredictiveNode::parse(std::span<const uint8_t> bytes, uint8_t format, uint32_t known_flags,
@@ -66,7 +84,8 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
   }
   r.position_bytes = bytes_for(largest);
   if (g.mesh->has_normals()) {
-    std::vector<glm::vec3> decoded(V), sum;
+    std::vector<glm::vec3> decoded(V + 1);  // predicted_normals reads one past the last
+    std::vector<NormalSum> sum;
     decode_positions(n.c, LockedStream::parse(locked_stream, V, g.position_shift, "node codec"), grid,
                      decoded.data());
     predicted_normals(indices, g.first_vertex, n.index_end, decoded.data(), uint32_t(V), sum);
@@ -100,34 +119,29 @@ void decode_predicted_vertices(const PredictiveNode& p, std::span<const uint32_t
   const uint32_t V = p.vertices;
   Mesh& m = out.mesh;
   const LockedStream locked = LockedStream::parse(p.locked_stream, V, p.shift, where);
-  // c[v] = c[o1] + c[o2] - c[o] + residual, with entry V holding cmin. The arithmetic wraps (unsigned), so
-  // hostile residuals cannot overflow; the results are range-checked after.
-  thread_local std::vector<int64_t> residual, c;
-  residual.resize(3 * size_t(V)), c.resize(3 * (size_t(V) + 1));
-  read_planes(p.position_planes.data(), V, 3, p.position_bytes, residual.data());
-  const int64_t *rx = residual.data(), *ry = rx + V, *rz = ry + V;
+  // c[v] = c[o1] + c[o2] - c[o] + residual, with entry V holding cmin, the residuals read from their planes
+  // first (one vectorized pass). The arithmetic wraps (unsigned), so hostile residuals cannot overflow; the
+  // results are range-checked in the same pass.
+  thread_local std::vector<int64_t> c;
+  c.resize(3 * (size_t(V) + 1));
   uint64_t* cu = reinterpret_cast<uint64_t*>(c.data());
   for (int a = 0; a < 3; ++a) cu[3 * size_t(V) + a] = uint64_t(p.cmin[a]);
-  const uint32_t* o = predictors.data();
-  for (uint32_t v = 0; v < V; ++v, o += 3) {
-    const uint64_t *x = cu + 3 * size_t(o[0]), *y = cu + 3 * size_t(o[1]), *z = cu + 3 * size_t(o[2]);
-    uint64_t* to = cu + 3 * size_t(v);
-    to[0] = x[0] + y[0] - z[0] + uint64_t(rx[v]);
-    to[1] = x[1] + y[1] - z[1] + uint64_t(ry[v]);
-    to[2] = x[2] + y[2] - z[2] + uint64_t(rz[v]);
-  }
-  bool out_of_range = false;
-  for (size_t i = 0; i < 3 * size_t(V); ++i)
-    out_of_range |= cu[i] + uint64_t(kMaxCoarse) > 2 * uint64_t(kMaxCoarse);
+  thread_local std::vector<int64_t> residual;
+  residual.resize(3 * size_t(V));
+  read_planes(p.position_planes.data(), V, 3, p.position_bytes, residual.data());
+  const bool out_of_range = predict_positions(residual.data(), V, predictors.data(), cu);
   if (out_of_range) throw Error(where + ": predicted position out of the grid's range");
-  m.positions.resize(V);
-  decode_positions(std::span(c).first(3 * size_t(V)), locked, grid, m.positions.data());
+  // Decoded into scratch and copied (no zero-fill of m.positions first); one spare entry for
+  // predicted_normals.
+  thread_local std::vector<glm::vec3> positions;
+  positions.resize(size_t(V) + 1);
+  decode_positions(std::span(c).first(3 * size_t(V)), locked, grid, positions.data());
+  m.positions.assign(positions.begin(), positions.begin() + V);
 
   if (p.flags & kHasNormals) {
-    thread_local std::vector<glm::vec3> sum;
-    predicted_normals(m.indices, p.first_vertex, p.index_end, m.positions.data(), V, sum);
-    m.normals.resize(V);
-    decode_predicted_normals(sum, p.normal_planes.data(), p.normal_bytes, p.normal_bits, m.normals.data());
+    thread_local std::vector<NormalSum> sum;
+    predicted_normals(m.indices, p.first_vertex, p.index_end, positions.data(), V, sum);
+    decode_predicted_normals(sum, V, p.normal_planes.data(), p.normal_bytes, p.normal_bits, m.normals);
   }
   decode_attribute_stream(p.attribute_stream, p.flags, V, p.uv_min, p.uv_extent, out, where);
 }

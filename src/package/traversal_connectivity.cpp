@@ -17,17 +17,20 @@ class Front {
     uint32_t a, b, o, prev, next, state;
   };
 
-  void reset(size_t triangles) {
+  // A front for T triangles in `storage` (reused between calls): its edges pointer and size live in the
+  // Front, a local of the caller, so that the compiler keeps them in registers.
+  Front(std::vector<Edge>& storage, size_t triangles) {
     // A piece start adds 3 edges, every other triangle at most 2: no more than 3T edges, whatever the
     // symbols.
-    if (edges_.size() < 3 * triangles) edges_.resize(3 * triangles);
-    size_ = gate_ = 0;
+    if (storage.size() < 3 * triangles) storage.resize(3 * triangles);
+    edges_ = storage.data();
   }
-  // The next edge to process, or kNone.
-  uint32_t gate() {
-    while (gate_ < size_ && edges_[gate_].state != kPending) ++gate_;
-    return gate_ < size_ ? uint32_t(gate_) : kNone;
+  // The first pending edge at or after e (edges are processed in creation order), or size() when none is.
+  uint32_t gate(uint32_t e) const {
+    while (e < size_ && edges_[e].state != kPending) ++e;
+    return e;
   }
+  uint32_t size() const { return size_; }
   const Edge& edge(uint32_t e) const { return edges_[e]; }
   // p of the gate's kLeft, n of its kRight (kNone unless its loop has 3 edges or more), and whether its loop
   // has exactly 3 (kEnd).
@@ -45,7 +48,7 @@ class Front {
   }
 
   void start(uint32_t v0, uint32_t v1, uint32_t v2) {
-    const uint32_t at = uint32_t(size_);
+    const uint32_t at = size_;
     push(v0, v1, v2, at + 2, at + 1);
     push(v1, v2, v0, at, at + 2);
     push(v2, v0, v1, at + 1, at);
@@ -53,7 +56,7 @@ class Front {
   // kVertex and kSplit: the gate a -> b becomes a -> c, c -> b.
   void attach(uint32_t e, uint32_t c) {
     const uint32_t a = edges_[e].a, b = edges_[e].b, prev = edges_[e].prev, next = edges_[e].next;
-    const uint32_t x = uint32_t(size_), y = x + 1;
+    const uint32_t x = size_, y = x + 1;
     push(a, c, b, prev, y);
     push(c, b, a, x, next);
     edges_[prev].next = x;  // a loop has 2 edges or more: prev and next are not the gate
@@ -87,14 +90,14 @@ class Front {
   }
   // A new edge a -> b (third corner o) between `before` and `after`.
   void link(uint32_t before, uint32_t after, uint32_t a, uint32_t b, uint32_t o) {
-    const uint32_t x = uint32_t(size_);
+    const uint32_t x = size_;
     push(a, b, o, before, after);
     edges_[before].next = x;
     edges_[after].prev = x;
   }
 
-  std::vector<Edge> edges_;
-  size_t size_ = 0, gate_ = 0;
+  Edge* edges_;
+  uint32_t size_ = 0;
 };
 
 void put_varint(std::vector<uint8_t>& out, uint32_t v) {
@@ -128,13 +131,14 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V) {
   };
   auto emit = [&](uint32_t a, uint32_t b, uint32_t c) { code.indices.insert(code.indices.end(), {a, b, c}); };
 
-  Front front;
-  front.reset(T);
+  std::vector<Front::Edge> edges;
+  Front front(edges, T);
   uint32_t scan = 0;  // triangles below it are encoded
   uint32_t done = 0;  // triangles emitted
+  uint32_t e = 0;     // the gate
   while (done < T) {
-    const uint32_t e = front.gate();
-    if (e == kNone) {
+    e = front.gate(e);
+    if (e == front.size()) {
       while (encoded[scan]) ++scan;
       encoded[scan] = 1;
       uint32_t corner[3];
@@ -204,15 +208,17 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
                       uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where) {
   ByteReader refs(references, where);
   auto fail = [&](const char* what) { throw Error(where + ": corrupted connectivity (" + what + ")"); };
-  thread_local Front front;
-  front.reset(T);
+  thread_local std::vector<Front::Edge> edges;
+  Front front(edges, T);
   uint32_t next = 0;  // the next new vertex
-  size_t s = 0;
+  const uint8_t* symbol = symbols.data();
+  const uint8_t* const symbols_end = symbol + symbols.size();
   uint32_t* out = indices;
   const uint32_t* const end = indices + 3 * size_t(T);
+  uint32_t e = 0;  // the gate
   while (out != end) {
-    const uint32_t e = front.gate();
-    if (e == kNone) {
+    e = front.gate(e);
+    if (e == front.size()) {
       uint32_t corner[3];
       for (int k = 0; k < 3; ++k) {
         const uint64_t r = refs.varint();
@@ -231,11 +237,11 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
       out += 3;
       continue;
     }
-    if (s == symbols.size()) fail("symbols end early");
+    if (symbol == symbols_end) fail("symbols end early");
     const Front::Edge& g = front.edge(e);
     const uint32_t a = g.a, b = g.b;
     uint32_t c;
-    switch (symbols[s++]) {
+    switch (*symbol++) {
       case kVertex:
         if (next == V) fail("more vertices than the node holds");
         c = next++;
@@ -265,15 +271,16 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
         break;
       }
       case kBoundary:
-        front.done(e);
+        front.done(e++);  // the gate is done: the next one lies past it
         continue;
       default:
         fail("unknown symbol");
     }
     out[0] = b, out[1] = a, out[2] = c;
     out += 3;
+    ++e;
   }
-  if (s != symbols.size()) fail("symbols left over");
+  if (symbol != symbols_end) fail("symbols left over");
   if (!refs.at_end()) fail("references left over");
   for (; next < V; ++next) {
     const uint32_t from = next > 0 ? next - 1 : V;
