@@ -23,7 +23,7 @@
 namespace lodstream::package {
 
 inline constexpr std::array<uint8_t, 8> kMagic = {0x89, 'L', 'O', 'D', 'S', '\r', '\n', 0x1a};
-inline constexpr uint32_t kFormatVersion = 1;
+inline constexpr uint32_t kFormatVersion = 2;  // 2: node records coded against their run (index.hpp)
 inline constexpr size_t kHeaderSize = 64;
 
 // Hard limits a reader enforces before allocating: no valid writer output exceeds them.
