@@ -71,8 +71,9 @@ class ContentHasher {
   void* state_;
 };
 
-// zstd frame of `raw` at `level` (1..22). Throws lodstream::Error if zstd fails.
-std::vector<uint8_t> zstd_compress(std::span<const uint8_t> raw, int level);
+// zstd frame of `raw` at `level` (1..22), with matches of at least `min_match` bytes (3..7; 0 = the level's
+// own). Throws lodstream::Error if zstd fails.
+std::vector<uint8_t> zstd_compress(std::span<const uint8_t> raw, int level, int min_match = 0);
 // Decompresses one zstd frame that must hold exactly `raw_size` bytes (checked against the frame header
 // before allocating, and after). `context` names the file and part for the error message.
 std::vector<uint8_t> zstd_decompress(std::span<const uint8_t> frame, uint32_t raw_size,
