@@ -214,8 +214,7 @@ void write_nodes(ByteWriter& w, std::span<const NodeRecord> nodes, uint32_t firs
   }
 }
 std::vector<NodeRecord> read_nodes(ByteReader& r, const RootIndex& root, uint32_t first_id, size_t count) {
-  std::vector<NodeRecord> nodes;
-  nodes.reserve(count);
+  std::vector<NodeRecord> nodes;  // grown as records parse (no reserve: a hostile count allocates nothing)
   RecordRun run;
   run.first_id = first_id;
   for (uint32_t i = 0; i < count; ++i) {
