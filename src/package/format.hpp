@@ -23,7 +23,7 @@
 namespace lodstream::package {
 
 inline constexpr std::array<uint8_t, 8> kMagic = {0x89, 'L', 'O', 'D', 'S', '\r', '\n', 0x1a};
-inline constexpr uint32_t kFormatVersion = 1;
+inline constexpr uint32_t kFormatVersion = 2;  // 2: node records coded against their run (index.hpp)
 inline constexpr size_t kHeaderSize = 64;
 
 // Hard limits a reader enforces before allocating: no valid writer output exceeds them.
@@ -71,8 +71,9 @@ class ContentHasher {
   void* state_;
 };
 
-// zstd frame of `raw` at `level` (1..22). Throws lodstream::Error if zstd fails.
-std::vector<uint8_t> zstd_compress(std::span<const uint8_t> raw, int level);
+// zstd frame of `raw` at `level` (1..22), with matches of at least `min_match` bytes (3..7; 0 = the level's
+// own). Throws lodstream::Error if zstd fails.
+std::vector<uint8_t> zstd_compress(std::span<const uint8_t> raw, int level, int min_match = 0);
 // Decompresses one zstd frame that must hold exactly `raw_size` bytes (checked against the frame header
 // before allocating, and after). `context` names the file and part for the error message.
 std::vector<uint8_t> zstd_decompress(std::span<const uint8_t> frame, uint32_t raw_size,

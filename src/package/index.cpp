@@ -1,5 +1,7 @@
 #include "package/index.hpp"
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "core/error.hpp"
@@ -10,8 +12,9 @@ namespace lodstream::package {
 
 namespace {
 
-// Smallest serialized node record: kind and encoding, 8 one-byte varints, 10 floats, 3 empty lists.
-constexpr size_t kMinNodeRecordBytes = 2 + 8 + 40 + 3;
+// Smallest serialized node record (index.hpp, "Node records"): head, 3 field deltas, page, offset, size,
+// triangles, vertices, the object count and the two pair codes, with both link lists implied.
+constexpr size_t kMinNodeRecordBytes = 12;
 
 void write_sphere(ByteWriter& w, const Sphere& s) {
   w.f32(s.center.x), w.f32(s.center.y), w.f32(s.center.z), w.f32(s.radius);
@@ -41,66 +44,184 @@ Range read_range(ByteReader& r, uint32_t max_raw, const char* what) {
   return range;
 }
 
-void write_ids(ByteWriter& w, const std::vector<uint32_t>& ids, uint32_t self) {
+// A list of node ids (index.hpp, "Node records"): varint count, then each id as an svarint delta from the
+// previous one plus 1 (the first from `base`), so that runs of consecutive ids are runs of zero bytes.
+void write_ids(ByteWriter& w, const std::vector<uint32_t>& ids, uint32_t base) {
   w.varint(ids.size());
-  for (uint32_t id : ids) w.svarint(int64_t(id) - int64_t(self));
+  int64_t previous = int64_t(base) - 1;
+  for (uint32_t id : ids) w.svarint(int64_t(id) - previous - 1), previous = id;
 }
-std::vector<uint32_t> read_ids(ByteReader& r, uint32_t self, uint64_t limit, const char* what) {
+std::vector<uint32_t> read_ids(ByteReader& r, uint32_t base, uint64_t limit, const char* what) {
   std::vector<uint32_t> ids(r.count(1, what));
+  int64_t previous = int64_t(base) - 1;
   for (uint32_t& id : ids) {
-    const int64_t delta = r.svarint();  // id - self; checked before adding so that nothing overflows
-    if (delta < -int64_t(self) || delta >= int64_t(limit) - int64_t(self)) {
-      r.fail(std::string(what) + " id " + std::to_string(self) + " + (" + std::to_string(delta) +
-             ") out of range (" + std::to_string(limit) + ")");
-    }
-    id = static_cast<uint32_t>(int64_t(self) + delta);
+    const int64_t delta = r.svarint();  // checked before adding so that nothing overflows
+    if (delta < -(previous + 1) || delta >= int64_t(limit) - (previous + 1))
+      r.fail(std::string(what) + " id out of range (" + std::to_string(limit) + " nodes)");
+    id = static_cast<uint32_t>(previous + 1 + delta);
+    previous = id;
   }
   return ids;
 }
 
-void write_node(ByteWriter& w, const NodeRecord& n, uint32_t id) {
-  w.u8(static_cast<uint8_t>(n.kind));
-  w.u8(static_cast<uint8_t>(n.encoding));
-  w.varint(n.representation), w.varint(n.material), w.varint(n.level);
-  w.varint(n.page), w.varint(n.offset), w.varint(n.size);
-  w.varint(n.triangles), w.varint(n.vertices);
-  w.f32(n.error);
-  write_sphere(w, n.sphere);
-  w.f32(n.parent_error);
-  write_sphere(w, n.parent_sphere);
-  write_ids(w, n.children, id);
-  write_ids(w, n.parents, id);
-  w.varint(n.objects.size());
-  for (uint32_t o : n.objects) w.varint(o);
+// previous + delta, which must be < limit.
+uint32_t read_delta(ByteReader& r, uint32_t previous, uint64_t limit, const char* what) {
+  const int64_t delta = r.svarint();
+  if (delta < -int64_t(previous) || delta >= int64_t(limit) - int64_t(previous))
+    r.fail(std::string(what) + " out of range");
+  return static_cast<uint32_t>(int64_t(previous) + delta);
 }
 
-NodeRecord read_node(ByteReader& r, const RootIndex& root, uint32_t id) {
+// An (error, sphere) pair: a node's own, or its parents'.
+struct ErrorPair {
+  float error = 0.0f;
+  Sphere sphere;
+  bool operator==(const ErrorPair& o) const {  // bit for bit (verify compares stored pairs exactly)
+    return std::bit_cast<uint32_t>(error) == std::bit_cast<uint32_t>(o.error) &&
+           std::bit_cast<uint32_t>(sphere.radius) == std::bit_cast<uint32_t>(o.sphere.radius) &&
+           std::bit_cast<uint32_t>(sphere.center.x) == std::bit_cast<uint32_t>(o.sphere.center.x) &&
+           std::bit_cast<uint32_t>(sphere.center.y) == std::bit_cast<uint32_t>(o.sphere.center.y) &&
+           std::bit_cast<uint32_t>(sphere.center.z) == std::bit_cast<uint32_t>(o.sphere.center.z);
+  }
+};
+ErrorPair own_pair(const NodeRecord& n) {
+  return {n.error, n.sphere};
+}
+ErrorPair parent_pair(const NodeRecord& n) {
+  return {n.parent_error, n.parent_sphere};
+}
+
+// What a run of node records (the root index's, or one index page's) is coded against: its records so far
+// and the distinct pairs they stored, in order of first appearance. Cost: O(distinct pairs) per pair coded.
+struct RecordRun {
+  uint32_t first_id = 0;
+  std::span<const NodeRecord> done;  // records first_id .. first_id + done.size() - 1
+  std::vector<ErrorPair> pairs;
+
+  const NodeRecord& previous() const {
+    static const NodeRecord none;  // every field 0
+    return done.empty() ? none : done.back();
+  }
+  // The parents' pair can be taken from parents[0] when that record is already in this run.
+  const NodeRecord* first_parent(const NodeRecord& n) const {
+    if (n.parents.empty() || n.parents[0] < first_id || n.parents[0] - first_id >= done.size())
+      return nullptr;
+    return &done[n.parents[0] - first_id];
+  }
+  // Pair code: 0 = a literal (error f32, sphere 4 f32) that joins the table, k >= 1 = the k-th latest pair of
+  // the table; `skip` codes below it are taken by the caller.
+  void write_pair(ByteWriter& w, const ErrorPair& p, uint64_t skip) {
+    const auto it = std::find(pairs.rbegin(), pairs.rend(), p);
+    if (it != pairs.rend()) {
+      w.varint(skip + 1 + uint64_t(it - pairs.rbegin()));
+      return;
+    }
+    w.varint(skip);
+    w.f32(p.error);
+    write_sphere(w, p.sphere);
+    pairs.push_back(p);
+  }
+  ErrorPair read_pair(ByteReader& r, uint64_t code) {
+    if (code > 0) {
+      if (code > pairs.size()) r.fail("error pair reference out of range");
+      return pairs[pairs.size() - code];
+    }
+    ErrorPair p;
+    p.error = read_error(r);
+    p.sphere = read_sphere(r);
+    pairs.push_back(p);
+    return p;
+  }
+};
+
+enum : uint8_t { kSameChildren = 8, kSameParents = 16 };
+
+void write_node(ByteWriter& w, const NodeRecord& n, uint32_t id, RecordRun& run) {
+  const NodeRecord& prev = run.previous();
+  const bool same_children = !run.done.empty() && n.children == prev.children;
+  const bool same_parents = !run.done.empty() && n.parents == prev.parents;
+  w.u8(static_cast<uint8_t>(uint8_t(n.kind) | uint8_t(n.encoding) << 2 | (same_children ? kSameChildren : 0) |
+                            (same_parents ? kSameParents : 0)));
+  w.svarint(int64_t(n.representation) - prev.representation);
+  w.svarint(int64_t(n.material) - prev.material);
+  w.svarint(int64_t(n.level) - prev.level);
+  w.svarint(int64_t(n.page) - prev.page);
+  w.svarint(int64_t(n.offset) - (n.page == prev.page ? int64_t(prev.offset) + prev.size : 0));
+  w.varint(n.size);
+  w.varint(n.triangles), w.varint(n.vertices);
+  if (!same_children) write_ids(w, n.children, id);
+  if (!same_parents) write_ids(w, n.parents, id);
+  write_ids(w, n.objects, 0);
+  run.write_pair(w, own_pair(n), 0);
+  const NodeRecord* parent = run.first_parent(n);
+  if (parent && own_pair(*parent) == parent_pair(n)) {
+    w.varint(0);
+  } else {
+    run.write_pair(w, parent_pair(n), 1);
+  }
+}
+
+NodeRecord read_node(ByteReader& r, const RootIndex& root, uint32_t id, RecordRun& run) {
+  const NodeRecord& prev = run.previous();
   NodeRecord n;
-  uint8_t kind = r.u8(), encoding = r.u8();
-  if (kind > uint8_t(NodeKind::imposter)) r.fail("node " + std::to_string(id) + ": unknown kind");
-  if (encoding > uint8_t(NodeEncoding::raw)) r.fail("node " + std::to_string(id) + ": unknown encoding");
-  n.kind = NodeKind(kind), n.encoding = NodeEncoding(encoding);
-  n.representation = r.index(root.scene.representations.size(), "representation");
-  n.material = r.index(root.scene.materials.size(), "material");
-  n.level = r.index(1u << 16, "level");
-  n.page = r.index(root.pages.size(), "page");
-  uint64_t offset = r.varint(), size = r.varint();
-  if (offset > root.pages[n.page].raw_size || size > root.pages[n.page].raw_size - offset) {
+  const uint8_t head = r.u8();
+  if (head & ~uint8_t(3 | 4 | kSameChildren | kSameParents))
+    r.fail("node " + std::to_string(id) + ": unknown record flags");
+  n.kind = NodeKind(head & 3), n.encoding = NodeEncoding((head >> 2) & 1);
+  if ((head & (kSameChildren | kSameParents)) && run.done.empty())
+    r.fail("node " + std::to_string(id) + ": refers to a previous record that this run does not have");
+  n.representation = read_delta(r, prev.representation, root.scene.representations.size(), "representation");
+  n.material = read_delta(r, prev.material, root.scene.materials.size(), "material");
+  n.level = read_delta(r, prev.level, 1u << 16, "level");
+  n.page = read_delta(r, prev.page, root.pages.size(), "page");
+  const int64_t base = n.page == prev.page ? int64_t(prev.offset) + prev.size : 0;
+  const int64_t delta = r.svarint();  // checked before adding so that nothing overflows
+  const int64_t offset = delta < -base || delta > int64_t(UINT32_MAX) ? -1 : base + delta;
+  const uint64_t size = r.varint();
+  if (offset < 0 || uint64_t(offset) > root.pages[n.page].raw_size ||
+      size > root.pages[n.page].raw_size - uint64_t(offset)) {
     r.fail("node " + std::to_string(id) + ": bytes [" + std::to_string(offset) + ", +" +
            std::to_string(size) + ") outside page " + std::to_string(n.page));
   }
   n.offset = uint32_t(offset), n.size = uint32_t(size);
   n.triangles = r.index(uint64_t(UINT32_MAX) + 1, "triangle count");
   n.vertices = r.index(uint64_t(UINT32_MAX) + 1, "vertex count");
-  n.error = read_error(r);
-  n.sphere = read_sphere(r);
-  n.parent_error = read_error(r);
-  n.parent_sphere = read_sphere(r);
-  n.children = read_ids(r, id, root.node_count, "child");
-  n.parents = read_ids(r, id, root.node_count, "parent");
-  n.objects.resize(r.count(1, "object"));
-  for (uint32_t& o : n.objects) o = r.index(root.scene.objects.size(), "object");
+  n.children = head & kSameChildren ? prev.children : read_ids(r, id, root.node_count, "child");
+  n.parents = head & kSameParents ? prev.parents : read_ids(r, id, root.node_count, "parent");
+  n.objects = read_ids(r, 0, root.scene.objects.size(), "object");
+  const ErrorPair own = run.read_pair(r, r.varint());
+  n.error = own.error, n.sphere = own.sphere;
+  const uint64_t code = r.varint();
+  ErrorPair parents;
+  if (code == 0) {
+    const NodeRecord* parent = run.first_parent(n);
+    if (!parent) r.fail("node " + std::to_string(id) + ": parents' pair refers to a record outside this run");
+    parents = own_pair(*parent);
+  } else {
+    parents = run.read_pair(r, code - 1);
+  }
+  n.parent_error = parents.error, n.parent_sphere = parents.sphere;
   return n;
+}
+
+// The records of ids first_id.., coded as one run.
+void write_nodes(ByteWriter& w, std::span<const NodeRecord> nodes, uint32_t first_id) {
+  RecordRun run;
+  run.first_id = first_id;
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    run.done = nodes.first(i);
+    write_node(w, nodes[i], first_id + uint32_t(i), run);
+  }
+}
+std::vector<NodeRecord> read_nodes(ByteReader& r, const RootIndex& root, uint32_t first_id, size_t count) {
+  std::vector<NodeRecord> nodes;  // grown as records parse (no reserve: a hostile count allocates nothing)
+  RecordRun run;
+  run.first_id = first_id;
+  for (uint32_t i = 0; i < count; ++i) {
+    run.done = nodes;
+    nodes.push_back(read_node(r, root, first_id + i, run));
+  }
+  return nodes;
 }
 
 }  // namespace
@@ -147,7 +268,7 @@ std::vector<uint8_t> serialize_root(const RootIndex& root) {
     w.varint(p.first_node), w.varint(p.node_count);
   }
   w.varint(root.root_nodes.size());
-  for (uint32_t id = 0; id < root.root_nodes.size(); ++id) write_node(w, root.root_nodes[id], id);
+  write_nodes(w, root.root_nodes, 0);
   return std::move(w.bytes);
 }
 
@@ -218,15 +339,14 @@ RootIndex parse_root(std::span<const uint8_t> raw, const std::string& context) {
     throw Error(context + ": index pages cover " + std::to_string(next) + " nodes, the index declares " +
                 std::to_string(root.node_count));
   }
-  root.root_nodes.reserve(root_nodes);
-  for (uint32_t id = 0; id < root_nodes; ++id) root.root_nodes.push_back(read_node(r, root, id));
+  root.root_nodes = read_nodes(r, root, 0, root_nodes);
   r.expect_end();
   return root;
 }
 
 std::vector<uint8_t> serialize_nodes(std::span<const NodeRecord> nodes, uint32_t first_id) {
   ByteWriter w;
-  for (size_t i = 0; i < nodes.size(); ++i) write_node(w, nodes[i], first_id + uint32_t(i));
+  write_nodes(w, nodes, first_id);
   return std::move(w.bytes);
 }
 
@@ -234,9 +354,7 @@ std::vector<NodeRecord> parse_nodes(std::span<const uint8_t> raw, const RootInde
                                     uint32_t count, const std::string& context) {
   ByteReader r(raw, context);
   if (count > raw.size() / kMinNodeRecordBytes) r.fail("more node records than the page can hold");
-  std::vector<NodeRecord> nodes;
-  nodes.reserve(count);
-  for (uint32_t i = 0; i < count; ++i) nodes.push_back(read_node(r, root, first_id + i));
+  std::vector<NodeRecord> nodes = read_nodes(r, root, first_id, count);
   r.expect_end();
   return nodes;
 }

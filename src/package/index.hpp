@@ -2,6 +2,19 @@
 // representations, objects), the page / index-page / blob tables and the node records of ids [0, root_nodes);
 // the other node records live in index pages of consecutive ids, fetched on demand. Serialized with varints
 // and zstd-compressed; parse_* validates every count, index and float against the tables it refers to.
+//
+// Node records: the root index's records and each index page's are one run each, coded against the run's
+// previous record (zeros before the first) so that each run decodes on its own. A record is: u8 head (kind in
+// bits 0-1, encoding in bit 2, bit 3 = children and bit 4 = parents equal to the previous record's and not
+// stored); svarint deltas of representation, material, level and page from the previous record's; svarint
+// offset minus the previous record's end when on the same page (else minus 0); varint size, triangles and
+// vertices; the children, parents and objects id lists (varint count, then each id as an svarint delta from
+// the previous id + 1, the first of a link list from the record's own id, of objects from 0); then the own
+// and the parents' (error, sphere) pairs, which siblings share: a pair is a literal (f32 error, f32 centre x
+// y z, f32 radius) that joins the run's table of distinct pairs, or a reference to the k-th latest pair of
+// that table; the parents' pair may also be "the own pair of parents[0]" when that record is earlier in the
+// run. Exact floats throughout: verify compares a node's parents' pair with its parents' own pair bit for
+// bit.
 #pragma once
 
 #include <cstdint>
