@@ -6,6 +6,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <array>
@@ -166,9 +167,7 @@ class Simplifier {
   std::vector<uint32_t> offsets_, faces_;              // vertex -> faces (CSR), rebuilt each pass
   std::vector<Candidate> slots_;
   std::vector<Ranked> order_, sorted_;
-  std::vector<float> bucket_;    // goal_cost's candidate costs in one histogram bucket
-  std::vector<uint32_t> dirty_;  // vertices of the faces around touched vertices, this pass
-  std::vector<uint8_t> vertex_mark_;
+  std::vector<float> bucket_;  // goal_cost's candidate costs in one histogram bucket
   // Regions of the collapse loop's parallel part (region_of): runs of region_vertices_ vertex numbers in
   // Morton order (about kRegionVertices alive vertices, at least kMinRegions regions on a smaller mesh; the
   // run grows as the mesh shrinks), shifted by region_shift_, which turns each pass so that no band of the
@@ -277,7 +276,7 @@ class Simplifier {
       const glm::vec3 q = glm::clamp(pos_[v], 0.0f, 1.0f) * 2097151.0f;  // pos_ is in [0, 1]^3
       code[v] = {spread(uint64_t(q.x)) | spread(uint64_t(q.y)) << 1 | spread(uint64_t(q.z)) << 2, v};
     }
-    std::sort(code.begin(), code.end());  // ties (wedges share a position) by old number
+    tbb::parallel_sort(code.begin(), code.end());  // ties (wedges share a position) by old number
     std::vector<uint32_t> renumbered(m);
     for (uint32_t i = 0; i < m; ++i) renumbered[code[i].second] = i;
     auto permute = [&](auto& values) {
@@ -354,36 +353,10 @@ class Simplifier {
     const size_t m = source_.size();
     open_out_.assign(m, kNone), open_in_.assign(m, kNone);
     std::vector<uint8_t> open_count(m, 0), complex(m, 0);
-    std::vector<uint32_t> outs, ins;
-    for (uint32_t v = 0; v < m; ++v) {
-      fan(v, outs, ins);
-      const size_t deg = outs.size();
-      if (deg == 0) continue;
-      if (deg > 256) {
-        complex[v] = 1;
-        continue;
-      }
-      uint32_t n_open_out = 0, n_open_in = 0, start = 0;
-      for (size_t i = 0; i < deg; ++i) {
-        if (std::count(outs.begin(), outs.end(), outs[i]) > 1) complex[v] = 1;
-        if (std::find(ins.begin(), ins.end(), outs[i]) == ins.end())
-          ++n_open_out, open_out_[v] = outs[i], start = uint32_t(i);
-        if (std::find(outs.begin(), outs.end(), ins[i]) == outs.end()) ++n_open_in, open_in_[v] = ins[i];
-      }
-      if (n_open_out > 1 || n_open_in > 1 || n_open_out != n_open_in) complex[v] = 1;
-      open_count[v] = uint8_t(std::min<uint32_t>(n_open_out, 2));
-      if (complex[v]) continue;
-      // Walk the fan from the face after the open edge (or any face): face g follows f when g.out == f.in.
-      size_t visited = 1, cur = start;
-      while (visited < deg) {
-        size_t next = deg;
-        for (size_t i = 0; i < deg; ++i)
-          if (outs[i] == ins[cur]) next = i;
-        if (next == deg || next == start) break;
-        cur = next, ++visited;
-      }
-      if (visited != deg) complex[v] = 1;
-    }
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 4096), [&](const auto& r) {
+      thread_local std::vector<uint32_t> outs, ins;
+      for (uint32_t v = r.begin(); v < r.end(); ++v) classify_fan(v, outs, ins, open_count, complex);
+    });
     for (uint32_t v = 0; v < m; ++v) {
       if (kind_[v] == kLocked || complex[v]) {
         kind_[v] = kLocked;
@@ -402,6 +375,41 @@ class Simplifier {
     // A seam vertex whose partner was locked by the user is locked too.
     for (uint32_t v = 0; v < m; ++v)
       if (kind_[v] == kSeam && kind_[wedge_[v]] != kSeam) kind_[v] = kLocked;
+  }
+
+  // classify's first step for one vertex: its open edges (open_out_, open_in_, open_count) and whether its
+  // fan is complex (a directed edge twice, more than one open edge, or faces not forming one disc or fan).
+  // Writes only v's entries, so vertices run in parallel.
+  void classify_fan(uint32_t v, std::vector<uint32_t>& outs, std::vector<uint32_t>& ins,
+                    std::vector<uint8_t>& open_count, std::vector<uint8_t>& complex) {
+    fan(v, outs, ins);
+    const size_t deg = outs.size();
+    if (deg == 0) return;
+    if (deg > 256) {
+      complex[v] = 1;
+      return;
+    }
+
+    uint32_t n_open_out = 0, n_open_in = 0, start = 0;
+    for (size_t i = 0; i < deg; ++i) {
+      if (std::count(outs.begin(), outs.end(), outs[i]) > 1) complex[v] = 1;
+      if (std::find(ins.begin(), ins.end(), outs[i]) == ins.end())
+        ++n_open_out, open_out_[v] = outs[i], start = uint32_t(i);
+      if (std::find(outs.begin(), outs.end(), ins[i]) == outs.end()) ++n_open_in, open_in_[v] = ins[i];
+    }
+    if (n_open_out > 1 || n_open_in > 1 || n_open_out != n_open_in) complex[v] = 1;
+    open_count[v] = uint8_t(std::min<uint32_t>(n_open_out, 2));
+    if (complex[v]) return;
+    // Walk the fan from the face after the open edge (or any face): face g follows f when g.out == f.in.
+    size_t visited = 1, cur = start;
+    while (visited < deg) {
+      size_t next = deg;
+      for (size_t i = 0; i < deg; ++i)
+        if (outs[i] == ins[cur]) next = i;
+      if (next == deg || next == start) break;
+      cur = next, ++visited;
+    }
+    if (visited != deg) complex[v] = 1;
   }
 
   // Border and seam vertices: their single open edge out and in, this pass (kNone when not single).
@@ -423,45 +431,86 @@ class Simplifier {
     });
   }
 
+  // Adds face f's plane quadric and attribute gradients to its corners in [lo, hi) (build_quadrics); s and
+  // gradient: room for 3 x channels_ values and channels_ gradients.
+  void add_face(uint32_t f, uint32_t lo, uint32_t hi, float* s, AttributeTerm* gradient) {
+    const uint32_t v0 = indices_[3 * size_t(f)], v1 = indices_[3 * size_t(f) + 1],
+                   v2 = indices_[3 * size_t(f) + 2];
+    const glm::vec3 p0 = pos_[v0], e1 = pos_[v1] - p0, e2 = pos_[v2] - p0;
+    const glm::vec3 n = glm::cross(e1, e2);
+    const float len = glm::length(n);
+    if (!(len > 0)) return;
+    const float area = 0.5f * len;
+    Quadric face;  // relative to p0
+    face.add_plane(n / len, 0.0f, area);
+    face.w = area;
+    if (channels_ > 0) {
+      float *s0 = s, *s1 = s + channels_, *s2 = s + 2 * channels_;
+      channel_values(v0, s0), channel_values(v1, s1), channel_values(v2, s2);
+      // s(p) = g.(p - p0) + s0 with g = (s1 - s0) ge1 + (s2 - s0) ge2 (the face's gradient).
+      const glm::vec3 ge1 = glm::cross(e2, n) / (len * len), ge2 = glm::cross(n, e1) / (len * len);
+      for (int j = 0; j < channels_; ++j) {
+        gradient[j] = {(s1[j] - s0[j]) * ge1 + (s2[j] - s0[j]) * ge2, s0[j]};
+        face.add_plane(gradient[j].g, gradient[j].d, area);
+      }
+    }
+    for (uint32_t v : {v0, v1, v2}) {  // relative to each corner's own origin (origin_of)
+      if (v < lo || v >= hi) continue;
+      const glm::vec3 d = pos_[v] - p0;
+      quadric_[v].add_shifted(face, glm::dvec3(d));
+      for (int j = 0; j < channels_; ++j) {
+        attr_[v * size_t(channels_) + j].g += area * gradient[j].g;
+        attr_[v * size_t(channels_) + j].d += area * (gradient[j].d + glm::dot(gradient[j].g, d));
+      }
+    }
+  }
+
   // Face plane quadrics (area-weighted), attribute gradients (Hoppe 99) and boundary/seam penalty planes.
   // Each face's planes (position and every channel) are summed once, relative to its first corner, then
   // shifted to each corner's origin (Quadric::add_shifted): one shift per corner instead of 1 + channels
-  // planes per corner. O(T (channels + 1)).
+  // planes per corner. O(T (channels + 1)), on both cores.
   void build_quadrics() {
     const size_t m = source_.size();
     choose_channels();
     quadric_.assign(m, Quadric{});
     attr_.assign(m * size_t(channels_), AttributeTerm{});
-    std::vector<float> s0(channels_), s1(channels_), s2(channels_);
-    std::vector<AttributeTerm> gradient(channels_);
-    for (size_t f = 0; f < indices_.size(); f += 3) {
-      uint32_t v0 = indices_[f], v1 = indices_[f + 1], v2 = indices_[f + 2];
-      glm::vec3 p0 = pos_[v0], e1 = pos_[v1] - p0, e2 = pos_[v2] - p0;
-      glm::vec3 n = glm::cross(e1, e2);
-      float len = glm::length(n);
-      if (!(len > 0)) continue;
-      float area = 0.5f * len;
-      Quadric face;  // relative to p0
-      face.add_plane(n / len, 0.0f, area);
-      face.w = area;
-      if (channels_ > 0) {
-        channel_values(v0, s0.data()), channel_values(v1, s1.data()), channel_values(v2, s2.data());
-        // s(p) = g.(p - p0) + s0 with g = (s1 - s0) ge1 + (s2 - s0) ge2 (the face's gradient).
-        const glm::vec3 ge1 = glm::cross(e2, n) / (len * len), ge2 = glm::cross(n, e1) / (len * len);
-        for (int j = 0; j < channels_; ++j) {
-          gradient[j] = {(s1[j] - s0[j]) * ge1 + (s2[j] - s0[j]) * ge2, s0[j]};
-          face.add_plane(gradient[j].g, gradient[j].d, area);
-        }
+    // Vertex ranges, one per chunk of faces (faces are sorted by their smallest vertex, sort_faces): a
+    // chunk's faces add to their corners in its range; a face with a corner in a later range is also listed
+    // for that range, which adds it before its own faces. Every vertex then sums its faces in face order, as
+    // one loop over the faces would, and the chunks run in parallel.
+    constexpr uint32_t kChunks = 64;
+    std::vector<uint32_t> first_vertex(kChunks + 1), first_face(kChunks + 1);
+    auto key = [&](size_t f) {
+      return std::min({indices_[3 * f], indices_[3 * f + 1], indices_[3 * f + 2]});
+    };
+    const size_t faces = indices_.size() / 3;
+    for (uint32_t k = 0; k <= kChunks; ++k) {
+      first_vertex[k] = uint32_t(uint64_t(m) * k / kChunks);
+      size_t lo = 0, hi = faces;  // the first face whose key is >= first_vertex[k]
+      while (lo < hi) {
+        const size_t mid = (lo + hi) / 2;
+        if (key(mid) < first_vertex[k])
+          lo = mid + 1;
+        else
+          hi = mid;
       }
-      for (uint32_t v : {v0, v1, v2}) {  // relative to each corner's own origin (origin_of)
-        const glm::vec3 d = pos_[v] - p0;
-        quadric_[v].add_shifted(face, glm::dvec3(d));
-        for (int j = 0; j < channels_; ++j) {
-          attr_[v * size_t(channels_) + j].g += area * gradient[j].g;
-          attr_[v * size_t(channels_) + j].d += area * (gradient[j].d + glm::dot(gradient[j].g, d));
-        }
-      }
+      first_face[k] = uint32_t(lo);
     }
+    std::vector<std::vector<uint32_t>> straddling(kChunks);  // faces with a corner in a later range
+    tbb::parallel_for(uint32_t(0), kChunks, [&](uint32_t k) {
+      for (uint32_t f = first_face[k]; f < first_face[k + 1]; ++f)
+        if (std::max({indices_[3 * f], indices_[3 * f + 1], indices_[3 * f + 2]}) >= first_vertex[k + 1])
+          straddling[k].push_back(f);
+    });
+    tbb::parallel_for(uint32_t(0), kChunks, [&](uint32_t k) {
+      std::vector<float> s(3 * size_t(channels_));
+      std::vector<AttributeTerm> gradient(channels_);
+      const uint32_t lo = first_vertex[k], hi = first_vertex[k + 1];
+      for (uint32_t earlier = 0; earlier < k; ++earlier)
+        for (uint32_t f : straddling[earlier]) add_face(f, lo, hi, s.data(), gradient.data());
+      for (uint32_t f = first_face[k]; f < first_face[k + 1]; ++f)
+        add_face(f, lo, hi, s.data(), gradient.data());
+    });
     // Penalty planes through open edges (borders and both sides of seams), perpendicular to their face.
     // Manifold vertices have none.
     std::vector<uint32_t> outs, ins;
@@ -651,36 +700,23 @@ class Simplifier {
   // Candidates live per face corner (slots_[3f + k]: the edge from corner k to corner k + 1), so that a
   // pass re-evaluates only edges with an end touched by the previous pass: an edge whose ends kept their
   // quadrics, positions and faces keeps its cost and allowed direction (open edges and seam twins only
-  // change at touched vertices). Such an edge lies in a face of its touched end, so only the vertices of
-  // the faces around touched vertices are visited (O(touched) per pass instead of every corner), in parallel.
+  // change at touched vertices). Every vertex is visited in parallel and reads its neighbours' touched_
+  // (O(T / cores) per pass; listing the neighbours of touched vertices first was a serial O(V) scan per pass,
+  // 3 % of the wall time on elephant_1m); only vertices with such an edge walk their fan.
   size_t run_pass(size_t target) {
     const size_t m = source_.size();
     const bool all = slots_.size() != indices_.size();
     if (all) slots_.assign(indices_.size(), Candidate{std::numeric_limits<float>::infinity(), kNone, kNone});
-    dirty_.clear();
-    if (all) {
-      dirty_.resize(m);
-      for (uint32_t v = 0; v < m; ++v) dirty_[v] = v;
-    } else {
-      vertex_mark_.assign(m, 0);
-      for (uint32_t v = 0; v < m; ++v)
-        if (touched_[v])
-          for (uint32_t s = offsets_[v]; s < offsets_[v + 1]; ++s)
-            for (uint32_t k = 0; k < 3; ++k)
-              if (uint32_t u = indices_[3 * size_t(faces_[s]) + k]; !vertex_mark_[u])
-                vertex_mark_[u] = 1, dirty_.push_back(u);
-    }
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, dirty_.size(), 256), [&](const auto& r) {
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 1024), [&](const auto& r) {
       thread_local std::vector<uint32_t> outs, ins;
-      for (size_t n = r.begin(); n < r.end(); ++n) {
-        const uint32_t i = dirty_[n];
-        fan(i, outs, ins);  // outs[s - offsets_[i]]: the far end of i's edge in its s-th face (all alive)
-        for (uint32_t s = offsets_[i]; s < offsets_[i + 1]; ++s) {
-          const uint32_t j = outs[s - offsets_[i]];
-          if (!all && !touched_[i] && !touched_[j]) continue;
+      for (uint32_t i = r.begin(); i < r.end(); ++i) {
+        bool fanned = false;
+        for (uint32_t s = offsets_[i]; s < offsets_[i + 1]; ++s) {  // faces are all alive (compact_faces)
           const uint32_t* t = &indices_[3 * size_t(faces_[s])];
-          const uint32_t k = t[0] == i ? 0 : (t[1] == i ? 1 : 2);
-          bool twin = std::find(ins.begin(), ins.end(), j) != ins.end();
+          const uint32_t k = t[0] == i ? 0 : (t[1] == i ? 1 : 2), j = t[(k + 1) % 3];
+          if (!all && !touched_[i] && !touched_[j]) continue;
+          if (!fanned) fan(i, outs, ins), fanned = true;
+          const bool twin = std::find(ins.begin(), ins.end(), j) != ins.end();
           slots_[3 * size_t(faces_[s]) + k] =
               (twin && i > j) ? Candidate{std::numeric_limits<float>::infinity(), kNone, kNone}
                               : evaluate(i, j);
@@ -696,22 +732,39 @@ class Simplifier {
     for (bool limited : {true, false}) {
       const size_t goal = (alive_triangles_ - target + 1) / 2;
       const float limit = limited ? 1.5f * goal_cost(goal) : std::numeric_limits<float>::infinity();
-      // The candidates under the limit, scattered from slot order by i -> i * P mod n (P prime > n, so a
-      // permutation): the radix sort keeps this order among equal costs, so that flat regions (all costs
-      // equal) collapse spread out rather than row by row in face order, the same way on every run.
-      order_.clear();
-      for (size_t i = 0; i < slots_.size(); ++i)
-        if (const Candidate& c = slots_[i]; c.a != kNone && std::isfinite(c.cost) && c.cost <= limit)
-          order_.push_back({c.cost, uint32_t(i)});
-      constexpr uint64_t kScatter = 2654435761u;  // prime, above any candidate count
-      sorted_.resize(order_.size());
-      for (size_t i = 0; i < order_.size(); ++i) sorted_[i * kScatter % order_.size()] = order_[i];
-      order_.swap(sorted_);
+      gather_candidates(limit);
       radix_sort_by_cost();
       collapsed = collapse_in_order(limit, target);
       if (collapsed > 0 || std::isinf(limit)) break;
     }
     return collapsed;
+  }
+
+  // Valid candidates in slots_ are visited in blocks of kSlotBlock slots, in parallel.
+  static constexpr size_t kSlotBlock = size_t(1) << 16;
+  static bool valid(const Candidate& c) { return c.a != kNone && std::isfinite(c.cost); }
+
+  // The candidates under `limit` into order_, scattered from slot order by i -> i * P mod n (P prime > n, so
+  // a permutation): the radix sort keeps this order among equal costs, so that flat regions (all costs equal)
+  // collapse spread out rather than row by row in face order, the same way on every run. Blocks of slots
+  // count theirs, then write from their prefix sum: O(T / cores).
+  void gather_candidates(float limit) {
+    constexpr uint64_t kScatter = 2654435761u;  // prime, above any candidate count
+    const size_t blocks = (slots_.size() + kSlotBlock - 1) / kSlotBlock;
+    std::vector<size_t> start(blocks + 1, 0);
+    auto block = [&](size_t b, auto&& f) {
+      for (size_t i = b * kSlotBlock, e = std::min(slots_.size(), i + kSlotBlock); i < e; ++i)
+        if (const Candidate& c = slots_[i]; valid(c) && c.cost <= limit) f(c, i);
+    };
+    tbb::parallel_for(size_t(0), blocks,
+                      [&](size_t b) { block(b, [&](const Candidate&, size_t) { ++start[b + 1]; }); });
+    for (size_t b = 0; b < blocks; ++b) start[b + 1] += start[b];
+    const size_t n = start[blocks];
+    order_.resize(n);
+    tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+      uint64_t k = start[b];
+      block(b, [&](const Candidate& c, size_t i) { order_[k++ * kScatter % n] = {c.cost, uint32_t(i)}; });
+    });
   }
 
   // The collapse loop over order_ (cost order, up to `limit`, until the target): independent collapses,
@@ -838,23 +891,37 @@ class Simplifier {
   // The cost of rank `goal` (0-based) among the valid candidates in slots_, or +inf when there are no more
   // than `goal` of them: a radix select on the float bits (costs are >= 0, so their bits order like them),
   // a 4096-bucket histogram of the top 12 bits, then nth_element within the one bucket that holds the rank.
-  // Two scans of slots_ and a sort of one bucket, instead of a selection over every candidate.
+  // Two scans of slots_ (blocks in parallel) and a sort of one bucket, instead of a selection over every
+  // candidate.
   float goal_cost(size_t goal) {
     auto bits = [](float cost) {
       uint32_t u;
       std::memcpy(&u, &cost, 4);
       return u;
     };
+    const size_t blocks = (slots_.size() + kSlotBlock - 1) / kSlotBlock;
+    tbb::enumerable_thread_specific<std::vector<uint32_t>> counts(std::vector<uint32_t>(4096, 0));
+    tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+      std::vector<uint32_t>& count = counts.local();
+      for (size_t i = b * kSlotBlock, e = std::min(slots_.size(), i + kSlotBlock); i < e; ++i)
+        if (valid(slots_[i])) ++count[bits(slots_[i].cost) >> 20];
+    });
     std::vector<uint32_t> count(4096, 0);
-    size_t valid = 0;
-    for (const Candidate& c : slots_)
-      if (c.a != kNone && std::isfinite(c.cost)) ++count[bits(c.cost) >> 20], ++valid;
-    if (goal >= valid) return std::numeric_limits<float>::infinity();
+    for (const auto& c : counts)
+      for (size_t k = 0; k < 4096; ++k) count[k] += c[k];
+    size_t total = 0;
+    for (uint32_t c : count) total += c;
+    if (goal >= total) return std::numeric_limits<float>::infinity();
     uint32_t bucket = 0;
     while (goal >= count[bucket]) goal -= count[bucket++];
-    bucket_.clear();
-    for (const Candidate& c : slots_)
-      if (c.a != kNone && std::isfinite(c.cost) && bits(c.cost) >> 20 == bucket) bucket_.push_back(c.cost);
+    tbb::enumerable_thread_specific<std::vector<float>> found;
+    tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+      std::vector<float>& f = found.local();
+      for (size_t i = b * kSlotBlock, e = std::min(slots_.size(), i + kSlotBlock); i < e; ++i)
+        if (valid(slots_[i]) && bits(slots_[i].cost) >> 20 == bucket) f.push_back(slots_[i].cost);
+    });
+    bucket_.clear();  // in any order: the value of rank `goal` does not depend on it
+    for (const auto& f : found) bucket_.insert(bucket_.end(), f.begin(), f.end());
     std::nth_element(bucket_.begin(), bucket_.begin() + goal, bucket_.end());
     return bucket_[goal];
   }
