@@ -48,8 +48,9 @@ struct Plan {
 // One changed face for vertical_bound.
 struct Corners {
   glm::dvec3 p[3];
-  glm::dvec2 y[3];
+  glm::dvec2 y[3], ny[3];  // projected before and after (ny: x for the moving corners; faces that stay)
   double h[3], r[3];
+  double area, new_area;  // twice the projected areas, before and after
   bool moving[3];
   bool dies;
 };
@@ -1140,15 +1141,16 @@ class Simplifier {
     const double hx = glm::dot(n, xd);
     for (Corners& c : sc.old) {
       for (int k = 0; k < 3; ++k) c.y[k] = proj(c.p[k]), c.h[k] = glm::dot(n, c.p[k]);
-      if (!(cross2(c.y[1] - c.y[0], c.y[2] - c.y[0]) > 0)) return kInf;
+      c.area = cross2(c.y[1] - c.y[0], c.y[2] - c.y[0]);
+      if (!(c.area > 0)) return kInf;
       if (c.dies) continue;
-      glm::dvec2 y[3];
-      for (int k = 0; k < 3; ++k) y[k] = c.moving[k] ? yx : c.y[k];
-      if (!(cross2(y[1] - y[0], y[2] - y[0]) > 0)) return kInf;
+      for (int k = 0; k < 3; ++k) c.ny[k] = c.moving[k] ? yx : c.y[k];
+      c.new_area = cross2(c.ny[1] - c.ny[0], c.ny[2] - c.ny[0]);
+      if (!(c.new_area > 0)) return kInf;
     }
-    // Barycentric coordinates of q in triangle y (true when inside, with a little tolerance).
-    auto inside = [&](const glm::dvec2* y, glm::dvec2 q, double* l) {
-      double area = cross2(y[1] - y[0], y[2] - y[0]);
+    // Barycentric coordinates of q in triangle y of twice the area `area` (true when inside, with a little
+    // tolerance).
+    auto inside = [&](const glm::dvec2* y, double area, glm::dvec2 q, double* l) {
       l[0] = cross2(y[1] - q, y[2] - q) / area;
       l[1] = cross2(y[2] - q, y[0] - q) / area;
       l[2] = 1 - l[0] - l[1];
@@ -1159,7 +1161,7 @@ class Simplifier {
     bool found = false;
     for (const Corners& c : sc.old) {
       double l[3];
-      if (!inside(c.y, yx, l)) continue;
+      if (!inside(c.y, c.area, yx, l)) continue;
       need = std::abs(hx - (l[0] * c.h[0] + l[1] * c.h[1] + l[2] * c.h[2])) + l[0] * c.r[0] + l[1] * c.r[1] +
              l[2] * c.r[2];
       found = true;
@@ -1180,10 +1182,8 @@ class Simplifier {
       found = false;
       for (const Corners& c : sc.old) {
         if (c.dies) continue;
-        glm::dvec2 y[3];
-        for (int k = 0; k < 3; ++k) y[k] = c.moving[k] ? yx : c.y[k];
         double l[3];
-        if (!inside(y, yv, l)) continue;
+        if (!inside(c.ny, c.new_area, yv, l)) continue;
         double h = 0, rest = 0, mu_x = 0;
         for (int k = 0; k < 3; ++k) {
           h += l[k] * (c.moving[k] ? hx : c.h[k]);
