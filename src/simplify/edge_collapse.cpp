@@ -69,6 +69,7 @@ struct Scratch {
   std::vector<uint32_t> na, nb, apex, removed;
   std::vector<Corners> old;
   std::vector<Segment> old_edges, spokes;  // spokes: direction from x, origin unused
+  std::vector<double> spoke_x, spoke_y;    // the spokes' directions, for the crossing loop's first test
   size_t removed_triangles = 0;
   double bound = 0.0;  // the largest radius its collapses gave (the mesh's bound when run serially)
   bool error_limited = false;
@@ -1209,18 +1210,25 @@ class Simplifier {
         if (!c.dies && c.moving[(i + 2) % 3])  // the new edge x -> ring vertex i (once per spoke)
           sc.spokes.push_back({{}, c.y[i] - yx, c.h[i], 0.0, c.r[i], 0.0});
       }
+    sc.spoke_x.clear(), sc.spoke_y.clear();
+    for (const Segment& e : sc.spokes)
+      sc.spoke_x.push_back(e.direction.x), sc.spoke_y.push_back(e.direction.y);
+    const size_t spokes = sc.spokes.size();
     for (const Segment& o : sc.old_edges) {
       const glm::dvec2 rel = o.origin - yx;
-      // s = cross2(rel, od) / den, t = cross2(rel, nd) / den, both strictly inside (0, 1); sn is the same for
-      // every spoke, so its sign fixes den's.
-      const double sn = cross2(rel, o.direction);
+      // s = cross2(rel, od) / den, t = cross2(rel, nd) / den, both strictly inside (0, 1), with den =
+      // cross2(nd, od). sn is the same for every spoke, so its sign fixes den's: negating od, sn and tn
+      // (exact) makes it positive and leaves s and t as they are, so the first test is one comparison
+      // (spoke ends on the other side of the old edge's line than x).
+      const double sign = cross2(rel, o.direction) > 0 ? 1.0 : -1.0;
+      const double sn = sign * cross2(rel, o.direction), dx = sign * o.direction.x, dy = sign * o.direction.y;
       if (sn == 0) continue;
-      for (const Segment& e : sc.spokes) {
-        const double den = cross2(e.direction, o.direction);
-        if (sn > 0 ? den <= sn : den >= sn) continue;
-        if (std::abs(den) < 1e-30) continue;
-        const double tn = cross2(rel, e.direction);
-        if (sn > 0 ? (tn <= 0 || tn >= den) : (tn >= 0 || tn <= den)) continue;
+      for (size_t k = 0; k < spokes; ++k) {
+        const double den = sc.spoke_x[k] * dy - sc.spoke_y[k] * dx;
+        if (den <= sn || den < 1e-30) continue;
+        const Segment& e = sc.spokes[k];
+        const double tn = sign * cross2(rel, e.direction);
+        if (tn <= 0 || tn >= den) continue;
         const double s = sn / den, t = tn / den;
         if (!(s > 0 && s < 1 && t > 0 && t < 1)) continue;
         const double gap = std::abs((1 - s) * hx + s * e.h0 - ((1 - t) * o.h0 + t * o.h1));
