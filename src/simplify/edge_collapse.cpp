@@ -15,6 +15,7 @@
 #include <cstring>
 
 #include "simplify/cluster.hpp"
+#include "simplify/counting_sort.hpp"
 #include "simplify/quadric.hpp"
 #include "simplify/simplify.hpp"
 
@@ -842,27 +843,27 @@ class Simplifier {
   uint32_t region_of(uint32_t v) const { return (v + region_shift_) / region_vertices_; }
 
   // Groups the pass's candidates by region into sorted_ as (cost, order_ index), in cost order within each
-  // region (a counting sort; candidates whose ends lie in two regions are left out) and sets region_start_;
-  // pending_ = 1 (for the serial part) for every candidate until a region takes it. Turns region_shift_.
+  // region (a counting_sort on both cores; candidates whose ends lie in two regions are left out) and sets
+  // region_start_; pending_ = 1 (for the serial part) for every candidate until a region takes it. Turns
+  // region_shift_.
   void group_by_region() {
     const size_t shrink = welded_triangles_ / std::max<size_t>(alive_triangles_, 1);
     const size_t first = std::clamp<size_t>(source_.size() / kMinRegions, 1, kRegionVertices);
     region_vertices_ = uint32_t(first * std::clamp<size_t>(shrink, 1, 1024));
     region_shift_ = (region_shift_ + region_vertices_ / 3 + 1) % region_vertices_;
     const uint32_t regions = region_of(uint32_t(source_.size())) + 1;
-    region_start_.assign(regions + 1, 0);
     sorted_.resize(order_.size());
     auto region = [&](size_t i) {
       const Candidate& c = slots_[order_[i].slot];
       const uint32_t ra = region_of(c.a);
       return ra == region_of(c.b) ? ra : kAnyRegion;
     };
-    for (size_t i = 0; i < order_.size(); ++i)
-      if (uint32_t r = region(i); r != kAnyRegion) ++region_start_[r + 1];
-    for (uint32_t r = 0; r < regions; ++r) region_start_[r + 1] += region_start_[r];
-    std::vector<uint32_t> fill(region_start_.begin(), region_start_.end() - 1);
-    for (size_t i = 0; i < order_.size(); ++i)
-      if (uint32_t r = region(i); r != kAnyRegion) sorted_[fill[r]++] = {order_[i].cost, uint32_t(i)};
+    counting_sort(
+        order_.size(), regions, region,
+        [&](size_t i, uint32_t position) {
+          sorted_[position] = {order_[i].cost, uint32_t(i)};
+        },
+        &region_start_);
     pending_.assign(order_.size(), 1);
   }
 
@@ -929,24 +930,18 @@ class Simplifier {
   }
 
   // Sorts order_ by cost: LSD radix sort on the float bits (costs are >= 0, so their bits order like them),
-  // 11 + 11 + 10 bits.
+  // 11 + 11 + 10 bits, each digit a counting_sort on both cores.
   void radix_sort_by_cost() {
     sorted_.resize(order_.size());
     std::vector<Ranked>*src = &order_, *dst = &sorted_;
     for (int shift : {0, 11, 22}) {
-      uint32_t count[2048] = {};
-      auto digit = [shift](const Ranked& c) {
+      auto digit = [&, shift](size_t i) {
         uint32_t u;
-        std::memcpy(&u, &c.cost, 4);
+        std::memcpy(&u, &(*src)[i].cost, 4);
         return (u >> shift) & 2047u;
       };
-      for (const Ranked& c : *src) ++count[digit(c)];
-      uint32_t sum = 0;
-      for (uint32_t& n : count) {
-        uint32_t k = n;
-        n = sum, sum += k;
-      }
-      for (const Ranked& c : *src) (*dst)[count[digit(c)]++] = c;
+      counting_sort(src->size(), 2048, digit,
+                    [&](size_t i, uint32_t position) { (*dst)[position] = (*src)[i]; });
       std::swap(src, dst);
     }
     if (src != &order_) order_.swap(sorted_);
