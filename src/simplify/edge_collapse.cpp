@@ -68,6 +68,7 @@ constexpr uint32_t kAnyRegion = UINT32_MAX;
 struct Scratch {
   uint32_t region = kAnyRegion;  // collapses must keep every face they read inside this region
   std::vector<uint32_t> na, nb, apex, removed;
+  std::vector<uint32_t> star_a, star_b;  // the alive faces around a's and b's wedges (for_faces order)
   std::vector<Corners> old;
   std::vector<Segment> old_edges, spokes;  // spokes: direction from x, origin unused
   std::vector<double> spoke_x, spoke_y;    // the spokes' directions, for the crossing loop's first test
@@ -439,6 +440,8 @@ class Simplifier {
   void add_face(uint32_t f, uint32_t lo, uint32_t hi, float* s, AttributeTerm* gradient) {
     const uint32_t v0 = indices_[3 * size_t(f)], v1 = indices_[3 * size_t(f) + 1],
                    v2 = indices_[3 * size_t(f) + 2];
+    auto mine = [&](uint32_t v) { return v >= lo && v < hi; };
+    if (!mine(v0) && !mine(v1) && !mine(v2)) return;
     const glm::vec3 p0 = pos_[v0], e1 = pos_[v1] - p0, e2 = pos_[v2] - p0;
     const glm::vec3 n = glm::cross(e1, e2);
     const float len = glm::length(n);
@@ -458,7 +461,7 @@ class Simplifier {
       }
     }
     for (uint32_t v : {v0, v1, v2}) {  // relative to each corner's own origin (origin_of)
-      if (v < lo || v >= hi) continue;
+      if (!mine(v)) continue;
       const glm::vec3 d = pos_[v] - p0;
       quadric_[v].add_shifted(face, glm::dvec3(d));
       for (int j = 0; j < channels_; ++j) {
@@ -481,7 +484,7 @@ class Simplifier {
     // chunk's faces add to their corners in its range; a face with a corner in a later range is also listed
     // for that range, which adds it before its own faces. Every vertex then sums its faces in face order, as
     // one loop over the faces would, and the chunks run in parallel.
-    constexpr uint32_t kChunks = 64;
+    constexpr uint32_t kChunks = 16;
     std::vector<uint32_t> first_vertex(kChunks + 1), first_face(kChunks + 1);
     auto key = [&](size_t f) {
       return std::min({indices_[3 * f], indices_[3 * f + 1], indices_[3 * f + 2]});
@@ -961,13 +964,14 @@ class Simplifier {
 
   // Validity (link condition, boundary pinch, lost surface, normal change), bound, then the collapse. The
   // topological checks come first: they do not need the placement, which `place` computes only for the
-  // collapses that pass them. With a region in `s`, a collapse whose faces (those around a and b) are not
+  // collapses that pass them. The faces around a and b are walked once (into s.star_a, s.star_b); the
+  // later steps read those lists. With a region in `s`, a collapse whose faces (those around a and b) are not
   // all inside it is left alone (kOutsideRegion): two threads then never read or write the same face or
   // vertex. A rejected collapse sets its slot to +inf until an end is touched (rejected_slot).
   Outcome try_collapse(Plan& p, Scratch& s) {
     const uint32_t pa = pid_[p.a], pb = pid_[p.b];
 
-    s.na.clear(), s.nb.clear(), s.apex.clear(), s.removed.clear();
+    s.na.clear(), s.nb.clear(), s.apex.clear(), s.removed.clear(), s.star_a.clear(), s.star_b.clear();
     size_t kept_faces = 0;
     bool inside = true;
     auto in_region = [&](const uint32_t* t) {
@@ -975,6 +979,7 @@ class Simplifier {
              (region_of(t[0]) == s.region && region_of(t[1]) == s.region && region_of(t[2]) == s.region);
     };
     for_faces(p.a, [&](uint32_t f) {
+      s.star_a.push_back(f);
       const uint32_t* t = &indices_[3 * size_t(f)];
       inside = inside && in_region(t);
       uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
@@ -989,6 +994,7 @@ class Simplifier {
       }
     });
     for_faces(p.b, [&](uint32_t f) {
+      s.star_b.push_back(f);
       const uint32_t* t = &indices_[3 * size_t(f)];
       inside = inside && in_region(t);
       uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
@@ -1039,8 +1045,9 @@ class Simplifier {
       if (!(l0 > 1e-30f)) return;  // already degenerate in the input: nothing to flip
       if (!(l1 > 1e-6f * l0) || glm::dot(n0, n1) <= cos_max * l0 * l1) ok = false;
     };
-    for_faces(p.a, check);
-    if (p.move) for_faces(p.b, check);
+    for (uint32_t f : s.star_a) check(f);
+    if (p.move)
+      for (uint32_t f : s.star_b) check(f);
     if (!ok) return rejected_slot(p, s);
     const double r_new = std::min(r_natural, vertical_bound(p, x, s, r_natural));
     if (r_new > max_error_) {
@@ -1050,13 +1057,14 @@ class Simplifier {
 
     // Apply.
     for (uint32_t f : s.removed) indices_[3 * size_t(f)] = kNone;
-    for_faces(p.a, [&](uint32_t f) {
+    for (uint32_t f : s.star_a) {
       uint32_t* t = &indices_[3 * size_t(f)];
+      if (t[0] == kNone) continue;  // removed just now
       for (int k = 0; k < 3; ++k) {
         if (t[k] == p.a) t[k] = p.b;
         if (p.a2 != kNone && t[k] == p.a2) t[k] = p.b2;
       }
-    });
+    }
     s.removed_triangles += s.removed.size();
     merge(p.a, p.b, p);
     if (p.a2 != kNone) merge(p.a2, p.b2, p);
@@ -1118,12 +1126,12 @@ class Simplifier {
       nsum += glm::cross(c.p[1] - c.p[0], c.p[2] - c.p[0]);
       sc.old.push_back(c);
     };
-    for_faces(p.a, gather);
+    for (uint32_t f : sc.star_a) gather(f);
     if (p.move)
-      for_faces(p.b, [&](uint32_t f) {
+      for (uint32_t f : sc.star_b) {
         const uint32_t* t = &indices_[3 * size_t(f)];
         if (pid_[t[0]] != pa && pid_[t[1]] != pa && pid_[t[2]] != pa) gather(f);
-      });
+      }
     const double len = glm::length(nsum);
     if (!(len > 0)) return kInf;
     const glm::dvec3 n = nsum / len;
