@@ -190,7 +190,11 @@ class Simplifier {
   // ---- set-up ------------------------------------------------------------------------------------------
 
   // Welds exact duplicates (same position and attributes) and links vertices that share a position into
-  // wedge rings. Hash table with linear probing over positions.
+  // wedge rings, numbered as one loop over the input would: a welded vertex per first input vertex of its
+  // position and attributes, in input order; each ring from the position's first wedge to its last, then
+  // back in input order (the first one's successor is the newest). The vertices are sorted by (position
+  // hash, index) on both cores; each then finds the first earlier one of its position and of its position
+  // and attributes among those of its hash (O(wedges) each, as a ring walk).
   void weld() {
     const size_t n = in_.vertex_count();
     Bounds box = in_.bounds();
@@ -199,33 +203,77 @@ class Simplifier {
     scale_ = extent > 0 ? extent : 1.0f;
     max_error_ = (opt_.max_error * (1 - 1e-6) - 1e-6 * double(scale_)) / (double(scale_) * (1 + 1e-5));
 
-    size_t cap = 1;
-    while (cap < 2 * n + 2) cap <<= 1;
-    std::vector<uint32_t> table(cap, kNone);
-    weld_remap_.assign(n, kNone);
     const bool hn = in_.has_normals(), hu = in_.has_uvs(), hc = in_.has_colors();
     auto same_attributes = [&](uint32_t i, uint32_t j) {
       return (!hn || in_.normals[i] == in_.normals[j]) && (!hu || in_.uvs[i] == in_.uvs[j]) &&
              (!hc || in_.colors[i] == in_.colors[j]);
     };
-    for (uint32_t v = 0; v < n; ++v) {
-      const glm::vec3& p = in_.positions[v];
-      size_t h = hash_bits(&p.x, 3) & (cap - 1);
-      while (table[h] != kNone && in_.positions[source_[table[h]]] != p) h = (h + 1) & (cap - 1);
-      if (table[h] == kNone) {
-        table[h] = add_vertex(v, kNone);
-        weld_remap_[v] = table[h];
-        continue;
+    std::vector<std::pair<uint32_t, uint32_t>> sorted(n);  // (position hash, input vertex)
+    tbb::parallel_for(size_t(0), n, [&](size_t v) {
+      sorted[v] = {hash_bits(&in_.positions[v].x, 3), uint32_t(v)};
+    });
+    tbb::parallel_sort(sorted.begin(), sorted.end());
+    std::vector<uint32_t> run(n);  // where the run of sorted[i]'s hash begins
+    for (size_t i = 0; i < n; ++i)
+      run[i] = i > 0 && sorted[i].first == sorted[i - 1].first ? run[i - 1] : uint32_t(i);
+    // Per input vertex: the first input vertex at its position, and the first with its position and
+    // attributes (its welded vertex's source). Positions compare with == (NaN never equal, as in a hash-table
+    // weld).
+    std::vector<uint32_t> first_at(n), source(n);
+    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+      const uint32_t v = sorted[i].second;
+      uint32_t at = v, same = v;
+      for (size_t j = run[i]; j < i; ++j) {
+        const uint32_t u = sorted[j].second;
+        if (in_.positions[u] != in_.positions[v]) continue;
+        if (at == v) at = u;
+        if (same_attributes(u, v)) {
+          same = u;
+          break;
+        }
       }
-      uint32_t first = table[h], w = first;
-      do {
-        if (same_attributes(source_[w], v)) break;
-        w = wedge_[w];
-      } while (w != first);
-      weld_remap_[v] = same_attributes(source_[w], v) ? w : add_vertex(v, first);
-    }
-    renumber_spatially();
+      first_at[v] = at, source[v] = same;
+    });
+    weld_remap_.assign(n, kNone);
+    source_.clear();
+    for (uint32_t v = 0; v < n; ++v)
+      if (source[v] == v) weld_remap_[v] = uint32_t(source_.size()), source_.push_back(v);
+    for (uint32_t v = 0; v < n; ++v) weld_remap_[v] = weld_remap_[source[v]];
     const size_t m = source_.size();
+    pos_.resize(m), wedge_.resize(m), pid_.resize(m);
+    if (in_.has_normals()) nrm_.resize(m);
+    if (in_.has_uvs()) uv_.resize(m);
+    if (in_.has_colors()) col_.resize(m);
+    tbb::parallel_for(size_t(0), m, [&](size_t k) {
+      const uint32_t v = source_[k];
+      pos_[k] = (in_.positions[v] - origin_) / scale_;
+      if (hn) nrm_[k] = in_.normals[v];
+      if (hu) uv_[k] = in_.uvs[v];
+      if (hc) col_[k] = in_.colors[v];
+      pid_[k] = weld_remap_[first_at[v]];
+    });
+    // Rings: a wedge links to the one before it at its position; the first, to the last.
+    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+      const uint32_t v = sorted[i].second;
+      if (source[v] != v) return;
+      auto wedge_at = [&](size_t j) {
+        const uint32_t u = sorted[j].second;
+        return source[u] == u && first_at[u] == first_at[v];
+      };
+      uint32_t link = v;
+      if (first_at[v] != v) {
+        for (size_t j = i; j-- > run[i];)
+          if (wedge_at(j)) {
+            link = sorted[j].second;
+            break;
+          }
+      } else {
+        for (size_t j = i + 1; j < n && sorted[j].first == sorted[i].first; ++j)
+          if (wedge_at(j)) link = sorted[j].second;
+      }
+      wedge_[weld_remap_[v]] = weld_remap_[link];
+    });
+    renumber_spatially();
     kind_.assign(m, kManifold);
     touched_.assign(m, 1);  // every cost is evaluated in the first pass
     moved_.assign(m, 0);
@@ -293,24 +341,6 @@ class Simplifier {
     for (uint32_t& v : wedge_) v = renumbered[v];
     for (uint32_t& v : pid_) v = renumbered[v];
     for (uint32_t& v : weld_remap_) v = renumbered[v];
-  }
-
-  uint32_t add_vertex(uint32_t input, uint32_t ring) {
-    uint32_t v = uint32_t(source_.size());
-    source_.push_back(input);
-    pos_.push_back((in_.positions[input] - origin_) / scale_);
-    if (in_.has_normals()) nrm_.push_back(in_.normals[input]);
-    if (in_.has_uvs()) uv_.push_back(in_.uvs[input]);
-    if (in_.has_colors()) col_.push_back(in_.colors[input]);
-    if (ring == kNone) {
-      wedge_.push_back(v);
-      pid_.push_back(v);
-    } else {
-      wedge_.push_back(wedge_[ring]);
-      wedge_[ring] = v;
-      pid_.push_back(ring);
-    }
-    return v;
   }
 
   // Drops dead faces; their corners' cached candidates move with them.
