@@ -6,6 +6,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <array>
@@ -14,6 +15,7 @@
 #include <cstring>
 
 #include "simplify/cluster.hpp"
+#include "simplify/counting_sort.hpp"
 #include "simplify/quadric.hpp"
 #include "simplify/simplify.hpp"
 
@@ -47,8 +49,9 @@ struct Plan {
 // One changed face for vertical_bound.
 struct Corners {
   glm::dvec3 p[3];
-  glm::dvec2 y[3];
+  glm::dvec2 y[3], ny[3];  // projected before and after (ny: x for the moving corners; faces that stay)
   double h[3], r[3];
+  double area, new_area;  // twice the projected areas, before and after
   bool moving[3];
   bool dies;
 };
@@ -65,8 +68,10 @@ constexpr uint32_t kAnyRegion = UINT32_MAX;
 struct Scratch {
   uint32_t region = kAnyRegion;  // collapses must keep every face they read inside this region
   std::vector<uint32_t> na, nb, apex, removed;
+  std::vector<uint32_t> star_a, star_b;  // the alive faces around a's and b's wedges (for_faces order)
   std::vector<Corners> old;
   std::vector<Segment> old_edges, spokes;  // spokes: direction from x, origin unused
+  std::vector<double> spoke_x, spoke_y;    // the spokes' directions, for the crossing loop's first test
   size_t removed_triangles = 0;
   double bound = 0.0;  // the largest radius its collapses gave (the mesh's bound when run serially)
   bool error_limited = false;
@@ -166,9 +171,7 @@ class Simplifier {
   std::vector<uint32_t> offsets_, faces_;              // vertex -> faces (CSR), rebuilt each pass
   std::vector<Candidate> slots_;
   std::vector<Ranked> order_, sorted_;
-  std::vector<float> bucket_;    // goal_cost's candidate costs in one histogram bucket
-  std::vector<uint32_t> dirty_;  // vertices of the faces around touched vertices, this pass
-  std::vector<uint8_t> vertex_mark_;
+  std::vector<float> bucket_;  // goal_cost's candidate costs in one histogram bucket
   // Regions of the collapse loop's parallel part (region_of): runs of region_vertices_ vertex numbers in
   // Morton order (about kRegionVertices alive vertices, at least kMinRegions regions on a smaller mesh; the
   // run grows as the mesh shrinks), shifted by region_shift_, which turns each pass so that no band of the
@@ -187,7 +190,11 @@ class Simplifier {
   // ---- set-up ------------------------------------------------------------------------------------------
 
   // Welds exact duplicates (same position and attributes) and links vertices that share a position into
-  // wedge rings. Hash table with linear probing over positions.
+  // wedge rings, numbered as one loop over the input would: a welded vertex per first input vertex of its
+  // position and attributes, in input order; each ring from the position's first wedge to its last, then
+  // back in input order (the first one's successor is the newest). The vertices are sorted by (position
+  // hash, index) on both cores; each then finds the first earlier one of its position and of its position
+  // and attributes among those of its hash (O(wedges) each, as a ring walk).
   void weld() {
     const size_t n = in_.vertex_count();
     Bounds box = in_.bounds();
@@ -196,33 +203,77 @@ class Simplifier {
     scale_ = extent > 0 ? extent : 1.0f;
     max_error_ = (opt_.max_error * (1 - 1e-6) - 1e-6 * double(scale_)) / (double(scale_) * (1 + 1e-5));
 
-    size_t cap = 1;
-    while (cap < 2 * n + 2) cap <<= 1;
-    std::vector<uint32_t> table(cap, kNone);
-    weld_remap_.assign(n, kNone);
     const bool hn = in_.has_normals(), hu = in_.has_uvs(), hc = in_.has_colors();
     auto same_attributes = [&](uint32_t i, uint32_t j) {
       return (!hn || in_.normals[i] == in_.normals[j]) && (!hu || in_.uvs[i] == in_.uvs[j]) &&
              (!hc || in_.colors[i] == in_.colors[j]);
     };
-    for (uint32_t v = 0; v < n; ++v) {
-      const glm::vec3& p = in_.positions[v];
-      size_t h = hash_bits(&p.x, 3) & (cap - 1);
-      while (table[h] != kNone && in_.positions[source_[table[h]]] != p) h = (h + 1) & (cap - 1);
-      if (table[h] == kNone) {
-        table[h] = add_vertex(v, kNone);
-        weld_remap_[v] = table[h];
-        continue;
+    std::vector<std::pair<uint32_t, uint32_t>> sorted(n);  // (position hash, input vertex)
+    tbb::parallel_for(size_t(0), n, [&](size_t v) {
+      sorted[v] = {hash_bits(&in_.positions[v].x, 3), uint32_t(v)};
+    });
+    tbb::parallel_sort(sorted.begin(), sorted.end());
+    std::vector<uint32_t> run(n);  // where the run of sorted[i]'s hash begins
+    for (size_t i = 0; i < n; ++i)
+      run[i] = i > 0 && sorted[i].first == sorted[i - 1].first ? run[i - 1] : uint32_t(i);
+    // Per input vertex: the first input vertex at its position, and the first with its position and
+    // attributes (its welded vertex's source). Positions compare with == (NaN never equal, as in a hash-table
+    // weld).
+    std::vector<uint32_t> first_at(n), source(n);
+    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+      const uint32_t v = sorted[i].second;
+      uint32_t at = v, same = v;
+      for (size_t j = run[i]; j < i; ++j) {
+        const uint32_t u = sorted[j].second;
+        if (in_.positions[u] != in_.positions[v]) continue;
+        if (at == v) at = u;
+        if (same_attributes(u, v)) {
+          same = u;
+          break;
+        }
       }
-      uint32_t first = table[h], w = first;
-      do {
-        if (same_attributes(source_[w], v)) break;
-        w = wedge_[w];
-      } while (w != first);
-      weld_remap_[v] = same_attributes(source_[w], v) ? w : add_vertex(v, first);
-    }
-    renumber_spatially();
+      first_at[v] = at, source[v] = same;
+    });
+    weld_remap_.assign(n, kNone);
+    source_.clear();
+    for (uint32_t v = 0; v < n; ++v)
+      if (source[v] == v) weld_remap_[v] = uint32_t(source_.size()), source_.push_back(v);
+    for (uint32_t v = 0; v < n; ++v) weld_remap_[v] = weld_remap_[source[v]];
     const size_t m = source_.size();
+    pos_.resize(m), wedge_.resize(m), pid_.resize(m);
+    if (in_.has_normals()) nrm_.resize(m);
+    if (in_.has_uvs()) uv_.resize(m);
+    if (in_.has_colors()) col_.resize(m);
+    tbb::parallel_for(size_t(0), m, [&](size_t k) {
+      const uint32_t v = source_[k];
+      pos_[k] = (in_.positions[v] - origin_) / scale_;
+      if (hn) nrm_[k] = in_.normals[v];
+      if (hu) uv_[k] = in_.uvs[v];
+      if (hc) col_[k] = in_.colors[v];
+      pid_[k] = weld_remap_[first_at[v]];
+    });
+    // Rings: a wedge links to the one before it at its position; the first, to the last.
+    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+      const uint32_t v = sorted[i].second;
+      if (source[v] != v) return;
+      auto wedge_at = [&](size_t j) {
+        const uint32_t u = sorted[j].second;
+        return source[u] == u && first_at[u] == first_at[v];
+      };
+      uint32_t link = v;
+      if (first_at[v] != v) {
+        for (size_t j = i; j-- > run[i];)
+          if (wedge_at(j)) {
+            link = sorted[j].second;
+            break;
+          }
+      } else {
+        for (size_t j = i + 1; j < n && sorted[j].first == sorted[i].first; ++j)
+          if (wedge_at(j)) link = sorted[j].second;
+      }
+      wedge_[weld_remap_[v]] = weld_remap_[link];
+    });
+    renumber_spatially();
     kind_.assign(m, kManifold);
     touched_.assign(m, 1);  // every cost is evaluated in the first pass
     moved_.assign(m, 0);
@@ -277,7 +328,7 @@ class Simplifier {
       const glm::vec3 q = glm::clamp(pos_[v], 0.0f, 1.0f) * 2097151.0f;  // pos_ is in [0, 1]^3
       code[v] = {spread(uint64_t(q.x)) | spread(uint64_t(q.y)) << 1 | spread(uint64_t(q.z)) << 2, v};
     }
-    std::sort(code.begin(), code.end());  // ties (wedges share a position) by old number
+    tbb::parallel_sort(code.begin(), code.end());  // ties (wedges share a position) by old number
     std::vector<uint32_t> renumbered(m);
     for (uint32_t i = 0; i < m; ++i) renumbered[code[i].second] = i;
     auto permute = [&](auto& values) {
@@ -290,24 +341,6 @@ class Simplifier {
     for (uint32_t& v : wedge_) v = renumbered[v];
     for (uint32_t& v : pid_) v = renumbered[v];
     for (uint32_t& v : weld_remap_) v = renumbered[v];
-  }
-
-  uint32_t add_vertex(uint32_t input, uint32_t ring) {
-    uint32_t v = uint32_t(source_.size());
-    source_.push_back(input);
-    pos_.push_back((in_.positions[input] - origin_) / scale_);
-    if (in_.has_normals()) nrm_.push_back(in_.normals[input]);
-    if (in_.has_uvs()) uv_.push_back(in_.uvs[input]);
-    if (in_.has_colors()) col_.push_back(in_.colors[input]);
-    if (ring == kNone) {
-      wedge_.push_back(v);
-      pid_.push_back(v);
-    } else {
-      wedge_.push_back(wedge_[ring]);
-      wedge_[ring] = v;
-      pid_.push_back(ring);
-    }
-    return v;
   }
 
   // Drops dead faces; their corners' cached candidates move with them.
@@ -354,36 +387,10 @@ class Simplifier {
     const size_t m = source_.size();
     open_out_.assign(m, kNone), open_in_.assign(m, kNone);
     std::vector<uint8_t> open_count(m, 0), complex(m, 0);
-    std::vector<uint32_t> outs, ins;
-    for (uint32_t v = 0; v < m; ++v) {
-      fan(v, outs, ins);
-      const size_t deg = outs.size();
-      if (deg == 0) continue;
-      if (deg > 256) {
-        complex[v] = 1;
-        continue;
-      }
-      uint32_t n_open_out = 0, n_open_in = 0, start = 0;
-      for (size_t i = 0; i < deg; ++i) {
-        if (std::count(outs.begin(), outs.end(), outs[i]) > 1) complex[v] = 1;
-        if (std::find(ins.begin(), ins.end(), outs[i]) == ins.end())
-          ++n_open_out, open_out_[v] = outs[i], start = uint32_t(i);
-        if (std::find(outs.begin(), outs.end(), ins[i]) == outs.end()) ++n_open_in, open_in_[v] = ins[i];
-      }
-      if (n_open_out > 1 || n_open_in > 1 || n_open_out != n_open_in) complex[v] = 1;
-      open_count[v] = uint8_t(std::min<uint32_t>(n_open_out, 2));
-      if (complex[v]) continue;
-      // Walk the fan from the face after the open edge (or any face): face g follows f when g.out == f.in.
-      size_t visited = 1, cur = start;
-      while (visited < deg) {
-        size_t next = deg;
-        for (size_t i = 0; i < deg; ++i)
-          if (outs[i] == ins[cur]) next = i;
-        if (next == deg || next == start) break;
-        cur = next, ++visited;
-      }
-      if (visited != deg) complex[v] = 1;
-    }
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 4096), [&](const auto& r) {
+      thread_local std::vector<uint32_t> outs, ins;
+      for (uint32_t v = r.begin(); v < r.end(); ++v) classify_fan(v, outs, ins, open_count, complex);
+    });
     for (uint32_t v = 0; v < m; ++v) {
       if (kind_[v] == kLocked || complex[v]) {
         kind_[v] = kLocked;
@@ -402,6 +409,41 @@ class Simplifier {
     // A seam vertex whose partner was locked by the user is locked too.
     for (uint32_t v = 0; v < m; ++v)
       if (kind_[v] == kSeam && kind_[wedge_[v]] != kSeam) kind_[v] = kLocked;
+  }
+
+  // classify's first step for one vertex: its open edges (open_out_, open_in_, open_count) and whether its
+  // fan is complex (a directed edge twice, more than one open edge, or faces not forming one disc or fan).
+  // Writes only v's entries, so vertices run in parallel.
+  void classify_fan(uint32_t v, std::vector<uint32_t>& outs, std::vector<uint32_t>& ins,
+                    std::vector<uint8_t>& open_count, std::vector<uint8_t>& complex) {
+    fan(v, outs, ins);
+    const size_t deg = outs.size();
+    if (deg == 0) return;
+    if (deg > 256) {
+      complex[v] = 1;
+      return;
+    }
+
+    uint32_t n_open_out = 0, n_open_in = 0, start = 0;
+    for (size_t i = 0; i < deg; ++i) {
+      if (std::count(outs.begin(), outs.end(), outs[i]) > 1) complex[v] = 1;
+      if (std::find(ins.begin(), ins.end(), outs[i]) == ins.end())
+        ++n_open_out, open_out_[v] = outs[i], start = uint32_t(i);
+      if (std::find(outs.begin(), outs.end(), ins[i]) == outs.end()) ++n_open_in, open_in_[v] = ins[i];
+    }
+    if (n_open_out > 1 || n_open_in > 1 || n_open_out != n_open_in) complex[v] = 1;
+    open_count[v] = uint8_t(std::min<uint32_t>(n_open_out, 2));
+    if (complex[v]) return;
+    // Walk the fan from the face after the open edge (or any face): face g follows f when g.out == f.in.
+    size_t visited = 1, cur = start;
+    while (visited < deg) {
+      size_t next = deg;
+      for (size_t i = 0; i < deg; ++i)
+        if (outs[i] == ins[cur]) next = i;
+      if (next == deg || next == start) break;
+      cur = next, ++visited;
+    }
+    if (visited != deg) complex[v] = 1;
   }
 
   // Border and seam vertices: their single open edge out and in, this pass (kNone when not single).
@@ -423,45 +465,88 @@ class Simplifier {
     });
   }
 
+  // Adds face f's plane quadric and attribute gradients to its corners in [lo, hi) (build_quadrics); s and
+  // gradient: room for 3 x channels_ values and channels_ gradients.
+  void add_face(uint32_t f, uint32_t lo, uint32_t hi, float* s, AttributeTerm* gradient) {
+    const uint32_t v0 = indices_[3 * size_t(f)], v1 = indices_[3 * size_t(f) + 1],
+                   v2 = indices_[3 * size_t(f) + 2];
+    auto mine = [&](uint32_t v) { return v >= lo && v < hi; };
+    if (!mine(v0) && !mine(v1) && !mine(v2)) return;
+    const glm::vec3 p0 = pos_[v0], e1 = pos_[v1] - p0, e2 = pos_[v2] - p0;
+    const glm::vec3 n = glm::cross(e1, e2);
+    const float len = glm::length(n);
+    if (!(len > 0)) return;
+    const float area = 0.5f * len;
+    Quadric face;  // relative to p0
+    face.add_plane(n / len, 0.0f, area);
+    face.w = area;
+    if (channels_ > 0) {
+      float *s0 = s, *s1 = s + channels_, *s2 = s + 2 * channels_;
+      channel_values(v0, s0), channel_values(v1, s1), channel_values(v2, s2);
+      // s(p) = g.(p - p0) + s0 with g = (s1 - s0) ge1 + (s2 - s0) ge2 (the face's gradient).
+      const glm::vec3 ge1 = glm::cross(e2, n) / (len * len), ge2 = glm::cross(n, e1) / (len * len);
+      for (int j = 0; j < channels_; ++j) {
+        gradient[j] = {(s1[j] - s0[j]) * ge1 + (s2[j] - s0[j]) * ge2, s0[j]};
+        face.add_plane(gradient[j].g, gradient[j].d, area);
+      }
+    }
+    for (uint32_t v : {v0, v1, v2}) {  // relative to each corner's own origin (origin_of)
+      if (!mine(v)) continue;
+      const glm::vec3 d = pos_[v] - p0;
+      quadric_[v].add_shifted(face, glm::dvec3(d));
+      for (int j = 0; j < channels_; ++j) {
+        attr_[v * size_t(channels_) + j].g += area * gradient[j].g;
+        attr_[v * size_t(channels_) + j].d += area * (gradient[j].d + glm::dot(gradient[j].g, d));
+      }
+    }
+  }
+
   // Face plane quadrics (area-weighted), attribute gradients (Hoppe 99) and boundary/seam penalty planes.
   // Each face's planes (position and every channel) are summed once, relative to its first corner, then
   // shifted to each corner's origin (Quadric::add_shifted): one shift per corner instead of 1 + channels
-  // planes per corner. O(T (channels + 1)).
+  // planes per corner. O(T (channels + 1)), on both cores.
   void build_quadrics() {
     const size_t m = source_.size();
     choose_channels();
     quadric_.assign(m, Quadric{});
     attr_.assign(m * size_t(channels_), AttributeTerm{});
-    std::vector<float> s0(channels_), s1(channels_), s2(channels_);
-    std::vector<AttributeTerm> gradient(channels_);
-    for (size_t f = 0; f < indices_.size(); f += 3) {
-      uint32_t v0 = indices_[f], v1 = indices_[f + 1], v2 = indices_[f + 2];
-      glm::vec3 p0 = pos_[v0], e1 = pos_[v1] - p0, e2 = pos_[v2] - p0;
-      glm::vec3 n = glm::cross(e1, e2);
-      float len = glm::length(n);
-      if (!(len > 0)) continue;
-      float area = 0.5f * len;
-      Quadric face;  // relative to p0
-      face.add_plane(n / len, 0.0f, area);
-      face.w = area;
-      if (channels_ > 0) {
-        channel_values(v0, s0.data()), channel_values(v1, s1.data()), channel_values(v2, s2.data());
-        // s(p) = g.(p - p0) + s0 with g = (s1 - s0) ge1 + (s2 - s0) ge2 (the face's gradient).
-        const glm::vec3 ge1 = glm::cross(e2, n) / (len * len), ge2 = glm::cross(n, e1) / (len * len);
-        for (int j = 0; j < channels_; ++j) {
-          gradient[j] = {(s1[j] - s0[j]) * ge1 + (s2[j] - s0[j]) * ge2, s0[j]};
-          face.add_plane(gradient[j].g, gradient[j].d, area);
-        }
+    // Vertex ranges, one per chunk of faces (faces are sorted by their smallest vertex, sort_faces): a
+    // chunk's faces add to their corners in its range; a face with a corner in a later range is also listed
+    // for that range, which adds it before its own faces. Every vertex then sums its faces in face order, as
+    // one loop over the faces would, and the chunks run in parallel.
+    constexpr uint32_t kChunks = 16;
+    std::vector<uint32_t> first_vertex(kChunks + 1), first_face(kChunks + 1);
+    auto key = [&](size_t f) {
+      return std::min({indices_[3 * f], indices_[3 * f + 1], indices_[3 * f + 2]});
+    };
+    const size_t faces = indices_.size() / 3;
+    for (uint32_t k = 0; k <= kChunks; ++k) {
+      first_vertex[k] = uint32_t(uint64_t(m) * k / kChunks);
+      size_t lo = 0, hi = faces;  // the first face whose key is >= first_vertex[k]
+      while (lo < hi) {
+        const size_t mid = (lo + hi) / 2;
+        if (key(mid) < first_vertex[k])
+          lo = mid + 1;
+        else
+          hi = mid;
       }
-      for (uint32_t v : {v0, v1, v2}) {  // relative to each corner's own origin (origin_of)
-        const glm::vec3 d = pos_[v] - p0;
-        quadric_[v].add_shifted(face, glm::dvec3(d));
-        for (int j = 0; j < channels_; ++j) {
-          attr_[v * size_t(channels_) + j].g += area * gradient[j].g;
-          attr_[v * size_t(channels_) + j].d += area * (gradient[j].d + glm::dot(gradient[j].g, d));
-        }
-      }
+      first_face[k] = uint32_t(lo);
     }
+    std::vector<std::vector<uint32_t>> straddling(kChunks);  // faces with a corner in a later range
+    tbb::parallel_for(uint32_t(0), kChunks, [&](uint32_t k) {
+      for (uint32_t f = first_face[k]; f < first_face[k + 1]; ++f)
+        if (std::max({indices_[3 * f], indices_[3 * f + 1], indices_[3 * f + 2]}) >= first_vertex[k + 1])
+          straddling[k].push_back(f);
+    });
+    tbb::parallel_for(uint32_t(0), kChunks, [&](uint32_t k) {
+      std::vector<float> s(3 * size_t(channels_));
+      std::vector<AttributeTerm> gradient(channels_);
+      const uint32_t lo = first_vertex[k], hi = first_vertex[k + 1];
+      for (uint32_t earlier = 0; earlier < k; ++earlier)
+        for (uint32_t f : straddling[earlier]) add_face(f, lo, hi, s.data(), gradient.data());
+      for (uint32_t f = first_face[k]; f < first_face[k + 1]; ++f)
+        add_face(f, lo, hi, s.data(), gradient.data());
+    });
     // Penalty planes through open edges (borders and both sides of seams), perpendicular to their face.
     // Manifold vertices have none.
     std::vector<uint32_t> outs, ins;
@@ -651,36 +736,23 @@ class Simplifier {
   // Candidates live per face corner (slots_[3f + k]: the edge from corner k to corner k + 1), so that a
   // pass re-evaluates only edges with an end touched by the previous pass: an edge whose ends kept their
   // quadrics, positions and faces keeps its cost and allowed direction (open edges and seam twins only
-  // change at touched vertices). Such an edge lies in a face of its touched end, so only the vertices of
-  // the faces around touched vertices are visited (O(touched) per pass instead of every corner), in parallel.
+  // change at touched vertices). Every vertex is visited in parallel and reads its neighbours' touched_
+  // (O(T / cores) per pass; listing the neighbours of touched vertices first was a serial O(V) scan per pass,
+  // 3 % of the wall time on elephant_1m); only vertices with such an edge walk their fan.
   size_t run_pass(size_t target) {
     const size_t m = source_.size();
     const bool all = slots_.size() != indices_.size();
     if (all) slots_.assign(indices_.size(), Candidate{std::numeric_limits<float>::infinity(), kNone, kNone});
-    dirty_.clear();
-    if (all) {
-      dirty_.resize(m);
-      for (uint32_t v = 0; v < m; ++v) dirty_[v] = v;
-    } else {
-      vertex_mark_.assign(m, 0);
-      for (uint32_t v = 0; v < m; ++v)
-        if (touched_[v])
-          for (uint32_t s = offsets_[v]; s < offsets_[v + 1]; ++s)
-            for (uint32_t k = 0; k < 3; ++k)
-              if (uint32_t u = indices_[3 * size_t(faces_[s]) + k]; !vertex_mark_[u])
-                vertex_mark_[u] = 1, dirty_.push_back(u);
-    }
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, dirty_.size(), 256), [&](const auto& r) {
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 1024), [&](const auto& r) {
       thread_local std::vector<uint32_t> outs, ins;
-      for (size_t n = r.begin(); n < r.end(); ++n) {
-        const uint32_t i = dirty_[n];
-        fan(i, outs, ins);  // outs[s - offsets_[i]]: the far end of i's edge in its s-th face (all alive)
-        for (uint32_t s = offsets_[i]; s < offsets_[i + 1]; ++s) {
-          const uint32_t j = outs[s - offsets_[i]];
-          if (!all && !touched_[i] && !touched_[j]) continue;
+      for (uint32_t i = r.begin(); i < r.end(); ++i) {
+        bool fanned = false;
+        for (uint32_t s = offsets_[i]; s < offsets_[i + 1]; ++s) {  // faces are all alive (compact_faces)
           const uint32_t* t = &indices_[3 * size_t(faces_[s])];
-          const uint32_t k = t[0] == i ? 0 : (t[1] == i ? 1 : 2);
-          bool twin = std::find(ins.begin(), ins.end(), j) != ins.end();
+          const uint32_t k = t[0] == i ? 0 : (t[1] == i ? 1 : 2), j = t[(k + 1) % 3];
+          if (!all && !touched_[i] && !touched_[j]) continue;
+          if (!fanned) fan(i, outs, ins), fanned = true;
+          const bool twin = std::find(ins.begin(), ins.end(), j) != ins.end();
           slots_[3 * size_t(faces_[s]) + k] =
               (twin && i > j) ? Candidate{std::numeric_limits<float>::infinity(), kNone, kNone}
                               : evaluate(i, j);
@@ -696,22 +768,39 @@ class Simplifier {
     for (bool limited : {true, false}) {
       const size_t goal = (alive_triangles_ - target + 1) / 2;
       const float limit = limited ? 1.5f * goal_cost(goal) : std::numeric_limits<float>::infinity();
-      // The candidates under the limit, scattered from slot order by i -> i * P mod n (P prime > n, so a
-      // permutation): the radix sort keeps this order among equal costs, so that flat regions (all costs
-      // equal) collapse spread out rather than row by row in face order, the same way on every run.
-      order_.clear();
-      for (size_t i = 0; i < slots_.size(); ++i)
-        if (const Candidate& c = slots_[i]; c.a != kNone && std::isfinite(c.cost) && c.cost <= limit)
-          order_.push_back({c.cost, uint32_t(i)});
-      constexpr uint64_t kScatter = 2654435761u;  // prime, above any candidate count
-      sorted_.resize(order_.size());
-      for (size_t i = 0; i < order_.size(); ++i) sorted_[i * kScatter % order_.size()] = order_[i];
-      order_.swap(sorted_);
+      gather_candidates(limit);
       radix_sort_by_cost();
       collapsed = collapse_in_order(limit, target);
       if (collapsed > 0 || std::isinf(limit)) break;
     }
     return collapsed;
+  }
+
+  // Valid candidates in slots_ are visited in blocks of kSlotBlock slots, in parallel.
+  static constexpr size_t kSlotBlock = size_t(1) << 16;
+  static bool valid(const Candidate& c) { return c.a != kNone && std::isfinite(c.cost); }
+
+  // The candidates under `limit` into order_, scattered from slot order by i -> i * P mod n (P prime > n, so
+  // a permutation): the radix sort keeps this order among equal costs, so that flat regions (all costs equal)
+  // collapse spread out rather than row by row in face order, the same way on every run. Blocks of slots
+  // count theirs, then write from their prefix sum: O(T / cores).
+  void gather_candidates(float limit) {
+    constexpr uint64_t kScatter = 2654435761u;  // prime, above any candidate count
+    const size_t blocks = (slots_.size() + kSlotBlock - 1) / kSlotBlock;
+    std::vector<size_t> start(blocks + 1, 0);
+    auto block = [&](size_t b, auto&& f) {
+      for (size_t i = b * kSlotBlock, e = std::min(slots_.size(), i + kSlotBlock); i < e; ++i)
+        if (const Candidate& c = slots_[i]; valid(c) && c.cost <= limit) f(c, i);
+    };
+    tbb::parallel_for(size_t(0), blocks,
+                      [&](size_t b) { block(b, [&](const Candidate&, size_t) { ++start[b + 1]; }); });
+    for (size_t b = 0; b < blocks; ++b) start[b + 1] += start[b];
+    const size_t n = start[blocks];
+    order_.resize(n);
+    tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+      uint64_t k = start[b];
+      block(b, [&](const Candidate& c, size_t i) { order_[k++ * kScatter % n] = {c.cost, uint32_t(i)}; });
+    });
   }
 
   // The collapse loop over order_ (cost order, up to `limit`, until the target): independent collapses,
@@ -787,27 +876,27 @@ class Simplifier {
   uint32_t region_of(uint32_t v) const { return (v + region_shift_) / region_vertices_; }
 
   // Groups the pass's candidates by region into sorted_ as (cost, order_ index), in cost order within each
-  // region (a counting sort; candidates whose ends lie in two regions are left out) and sets region_start_;
-  // pending_ = 1 (for the serial part) for every candidate until a region takes it. Turns region_shift_.
+  // region (a counting_sort on both cores; candidates whose ends lie in two regions are left out) and sets
+  // region_start_; pending_ = 1 (for the serial part) for every candidate until a region takes it. Turns
+  // region_shift_.
   void group_by_region() {
     const size_t shrink = welded_triangles_ / std::max<size_t>(alive_triangles_, 1);
     const size_t first = std::clamp<size_t>(source_.size() / kMinRegions, 1, kRegionVertices);
     region_vertices_ = uint32_t(first * std::clamp<size_t>(shrink, 1, 1024));
     region_shift_ = (region_shift_ + region_vertices_ / 3 + 1) % region_vertices_;
     const uint32_t regions = region_of(uint32_t(source_.size())) + 1;
-    region_start_.assign(regions + 1, 0);
     sorted_.resize(order_.size());
     auto region = [&](size_t i) {
       const Candidate& c = slots_[order_[i].slot];
       const uint32_t ra = region_of(c.a);
       return ra == region_of(c.b) ? ra : kAnyRegion;
     };
-    for (size_t i = 0; i < order_.size(); ++i)
-      if (uint32_t r = region(i); r != kAnyRegion) ++region_start_[r + 1];
-    for (uint32_t r = 0; r < regions; ++r) region_start_[r + 1] += region_start_[r];
-    std::vector<uint32_t> fill(region_start_.begin(), region_start_.end() - 1);
-    for (size_t i = 0; i < order_.size(); ++i)
-      if (uint32_t r = region(i); r != kAnyRegion) sorted_[fill[r]++] = {order_[i].cost, uint32_t(i)};
+    counting_sort(
+        order_.size(), regions, region,
+        [&](size_t i, uint32_t position) {
+          sorted_[position] = {order_[i].cost, uint32_t(i)};
+        },
+        &region_start_);
     pending_.assign(order_.size(), 1);
   }
 
@@ -838,46 +927,54 @@ class Simplifier {
   // The cost of rank `goal` (0-based) among the valid candidates in slots_, or +inf when there are no more
   // than `goal` of them: a radix select on the float bits (costs are >= 0, so their bits order like them),
   // a 4096-bucket histogram of the top 12 bits, then nth_element within the one bucket that holds the rank.
-  // Two scans of slots_ and a sort of one bucket, instead of a selection over every candidate.
+  // Two scans of slots_ (blocks in parallel) and a sort of one bucket, instead of a selection over every
+  // candidate.
   float goal_cost(size_t goal) {
     auto bits = [](float cost) {
       uint32_t u;
       std::memcpy(&u, &cost, 4);
       return u;
     };
+    const size_t blocks = (slots_.size() + kSlotBlock - 1) / kSlotBlock;
+    tbb::enumerable_thread_specific<std::vector<uint32_t>> counts(std::vector<uint32_t>(4096, 0));
+    tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+      std::vector<uint32_t>& count = counts.local();
+      for (size_t i = b * kSlotBlock, e = std::min(slots_.size(), i + kSlotBlock); i < e; ++i)
+        if (valid(slots_[i])) ++count[bits(slots_[i].cost) >> 20];
+    });
     std::vector<uint32_t> count(4096, 0);
-    size_t valid = 0;
-    for (const Candidate& c : slots_)
-      if (c.a != kNone && std::isfinite(c.cost)) ++count[bits(c.cost) >> 20], ++valid;
-    if (goal >= valid) return std::numeric_limits<float>::infinity();
+    for (const auto& c : counts)
+      for (size_t k = 0; k < 4096; ++k) count[k] += c[k];
+    size_t total = 0;
+    for (uint32_t c : count) total += c;
+    if (goal >= total) return std::numeric_limits<float>::infinity();
     uint32_t bucket = 0;
     while (goal >= count[bucket]) goal -= count[bucket++];
-    bucket_.clear();
-    for (const Candidate& c : slots_)
-      if (c.a != kNone && std::isfinite(c.cost) && bits(c.cost) >> 20 == bucket) bucket_.push_back(c.cost);
+    tbb::enumerable_thread_specific<std::vector<float>> found;
+    tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+      std::vector<float>& f = found.local();
+      for (size_t i = b * kSlotBlock, e = std::min(slots_.size(), i + kSlotBlock); i < e; ++i)
+        if (valid(slots_[i]) && bits(slots_[i].cost) >> 20 == bucket) f.push_back(slots_[i].cost);
+    });
+    bucket_.clear();  // in any order: the value of rank `goal` does not depend on it
+    for (const auto& f : found) bucket_.insert(bucket_.end(), f.begin(), f.end());
     std::nth_element(bucket_.begin(), bucket_.begin() + goal, bucket_.end());
     return bucket_[goal];
   }
 
   // Sorts order_ by cost: LSD radix sort on the float bits (costs are >= 0, so their bits order like them),
-  // 11 + 11 + 10 bits.
+  // 11 + 11 + 10 bits, each digit a counting_sort on both cores.
   void radix_sort_by_cost() {
     sorted_.resize(order_.size());
     std::vector<Ranked>*src = &order_, *dst = &sorted_;
     for (int shift : {0, 11, 22}) {
-      uint32_t count[2048] = {};
-      auto digit = [shift](const Ranked& c) {
+      auto digit = [&, shift](size_t i) {
         uint32_t u;
-        std::memcpy(&u, &c.cost, 4);
+        std::memcpy(&u, &(*src)[i].cost, 4);
         return (u >> shift) & 2047u;
       };
-      for (const Ranked& c : *src) ++count[digit(c)];
-      uint32_t sum = 0;
-      for (uint32_t& n : count) {
-        uint32_t k = n;
-        n = sum, sum += k;
-      }
-      for (const Ranked& c : *src) (*dst)[count[digit(c)]++] = c;
+      counting_sort(src->size(), 2048, digit,
+                    [&](size_t i, uint32_t position) { (*dst)[position] = (*src)[i]; });
       std::swap(src, dst);
     }
     if (src != &order_) order_.swap(sorted_);
@@ -897,13 +994,14 @@ class Simplifier {
 
   // Validity (link condition, boundary pinch, lost surface, normal change), bound, then the collapse. The
   // topological checks come first: they do not need the placement, which `place` computes only for the
-  // collapses that pass them. With a region in `s`, a collapse whose faces (those around a and b) are not
+  // collapses that pass them. The faces around a and b are walked once (into s.star_a, s.star_b); the
+  // later steps read those lists. With a region in `s`, a collapse whose faces (those around a and b) are not
   // all inside it is left alone (kOutsideRegion): two threads then never read or write the same face or
   // vertex. A rejected collapse sets its slot to +inf until an end is touched (rejected_slot).
   Outcome try_collapse(Plan& p, Scratch& s) {
     const uint32_t pa = pid_[p.a], pb = pid_[p.b];
 
-    s.na.clear(), s.nb.clear(), s.apex.clear(), s.removed.clear();
+    s.na.clear(), s.nb.clear(), s.apex.clear(), s.removed.clear(), s.star_a.clear(), s.star_b.clear();
     size_t kept_faces = 0;
     bool inside = true;
     auto in_region = [&](const uint32_t* t) {
@@ -911,6 +1009,7 @@ class Simplifier {
              (region_of(t[0]) == s.region && region_of(t[1]) == s.region && region_of(t[2]) == s.region);
     };
     for_faces(p.a, [&](uint32_t f) {
+      s.star_a.push_back(f);
       const uint32_t* t = &indices_[3 * size_t(f)];
       inside = inside && in_region(t);
       uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
@@ -925,6 +1024,7 @@ class Simplifier {
       }
     });
     for_faces(p.b, [&](uint32_t f) {
+      s.star_b.push_back(f);
       const uint32_t* t = &indices_[3 * size_t(f)];
       inside = inside && in_region(t);
       uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
@@ -975,8 +1075,9 @@ class Simplifier {
       if (!(l0 > 1e-30f)) return;  // already degenerate in the input: nothing to flip
       if (!(l1 > 1e-6f * l0) || glm::dot(n0, n1) <= cos_max * l0 * l1) ok = false;
     };
-    for_faces(p.a, check);
-    if (p.move) for_faces(p.b, check);
+    for (uint32_t f : s.star_a) check(f);
+    if (p.move)
+      for (uint32_t f : s.star_b) check(f);
     if (!ok) return rejected_slot(p, s);
     const double r_new = std::min(r_natural, vertical_bound(p, x, s, r_natural));
     if (r_new > max_error_) {
@@ -986,13 +1087,14 @@ class Simplifier {
 
     // Apply.
     for (uint32_t f : s.removed) indices_[3 * size_t(f)] = kNone;
-    for_faces(p.a, [&](uint32_t f) {
+    for (uint32_t f : s.star_a) {
       uint32_t* t = &indices_[3 * size_t(f)];
+      if (t[0] == kNone) continue;  // removed just now
       for (int k = 0; k < 3; ++k) {
         if (t[k] == p.a) t[k] = p.b;
         if (p.a2 != kNone && t[k] == p.a2) t[k] = p.b2;
       }
-    });
+    }
     s.removed_triangles += s.removed.size();
     merge(p.a, p.b, p);
     if (p.a2 != kNone) merge(p.a2, p.b2, p);
@@ -1054,12 +1156,12 @@ class Simplifier {
       nsum += glm::cross(c.p[1] - c.p[0], c.p[2] - c.p[0]);
       sc.old.push_back(c);
     };
-    for_faces(p.a, gather);
+    for (uint32_t f : sc.star_a) gather(f);
     if (p.move)
-      for_faces(p.b, [&](uint32_t f) {
+      for (uint32_t f : sc.star_b) {
         const uint32_t* t = &indices_[3 * size_t(f)];
         if (pid_[t[0]] != pa && pid_[t[1]] != pa && pid_[t[2]] != pa) gather(f);
-      });
+      }
     const double len = glm::length(nsum);
     if (!(len > 0)) return kInf;
     const glm::dvec3 n = nsum / len;
@@ -1073,15 +1175,16 @@ class Simplifier {
     const double hx = glm::dot(n, xd);
     for (Corners& c : sc.old) {
       for (int k = 0; k < 3; ++k) c.y[k] = proj(c.p[k]), c.h[k] = glm::dot(n, c.p[k]);
-      if (!(cross2(c.y[1] - c.y[0], c.y[2] - c.y[0]) > 0)) return kInf;
+      c.area = cross2(c.y[1] - c.y[0], c.y[2] - c.y[0]);
+      if (!(c.area > 0)) return kInf;
       if (c.dies) continue;
-      glm::dvec2 y[3];
-      for (int k = 0; k < 3; ++k) y[k] = c.moving[k] ? yx : c.y[k];
-      if (!(cross2(y[1] - y[0], y[2] - y[0]) > 0)) return kInf;
+      for (int k = 0; k < 3; ++k) c.ny[k] = c.moving[k] ? yx : c.y[k];
+      c.new_area = cross2(c.ny[1] - c.ny[0], c.ny[2] - c.ny[0]);
+      if (!(c.new_area > 0)) return kInf;
     }
-    // Barycentric coordinates of q in triangle y (true when inside, with a little tolerance).
-    auto inside = [&](const glm::dvec2* y, glm::dvec2 q, double* l) {
-      double area = cross2(y[1] - y[0], y[2] - y[0]);
+    // Barycentric coordinates of q in triangle y of twice the area `area` (true when inside, with a little
+    // tolerance).
+    auto inside = [&](const glm::dvec2* y, double area, glm::dvec2 q, double* l) {
       l[0] = cross2(y[1] - q, y[2] - q) / area;
       l[1] = cross2(y[2] - q, y[0] - q) / area;
       l[2] = 1 - l[0] - l[1];
@@ -1092,7 +1195,7 @@ class Simplifier {
     bool found = false;
     for (const Corners& c : sc.old) {
       double l[3];
-      if (!inside(c.y, yx, l)) continue;
+      if (!inside(c.y, c.area, yx, l)) continue;
       need = std::abs(hx - (l[0] * c.h[0] + l[1] * c.h[1] + l[2] * c.h[2])) + l[0] * c.r[0] + l[1] * c.r[1] +
              l[2] * c.r[2];
       found = true;
@@ -1113,10 +1216,8 @@ class Simplifier {
       found = false;
       for (const Corners& c : sc.old) {
         if (c.dies) continue;
-        glm::dvec2 y[3];
-        for (int k = 0; k < 3; ++k) y[k] = c.moving[k] ? yx : c.y[k];
         double l[3];
-        if (!inside(y, yv, l)) continue;
+        if (!inside(c.ny, c.new_area, yv, l)) continue;
         double h = 0, rest = 0, mu_x = 0;
         for (int k = 0; k < 3; ++k) {
           h += l[k] * (c.moving[k] ? hx : c.h[k]);
@@ -1142,18 +1243,25 @@ class Simplifier {
         if (!c.dies && c.moving[(i + 2) % 3])  // the new edge x -> ring vertex i (once per spoke)
           sc.spokes.push_back({{}, c.y[i] - yx, c.h[i], 0.0, c.r[i], 0.0});
       }
+    sc.spoke_x.clear(), sc.spoke_y.clear();
+    for (const Segment& e : sc.spokes)
+      sc.spoke_x.push_back(e.direction.x), sc.spoke_y.push_back(e.direction.y);
+    const size_t spokes = sc.spokes.size();
     for (const Segment& o : sc.old_edges) {
       const glm::dvec2 rel = o.origin - yx;
-      // s = cross2(rel, od) / den, t = cross2(rel, nd) / den, both strictly inside (0, 1); sn is the same for
-      // every spoke, so its sign fixes den's.
-      const double sn = cross2(rel, o.direction);
+      // s = cross2(rel, od) / den, t = cross2(rel, nd) / den, both strictly inside (0, 1), with den =
+      // cross2(nd, od). sn is the same for every spoke, so its sign fixes den's: negating od, sn and tn
+      // (exact) makes it positive and leaves s and t as they are, so the first test is one comparison
+      // (spoke ends on the other side of the old edge's line than x).
+      const double sign = cross2(rel, o.direction) > 0 ? 1.0 : -1.0;
+      const double sn = sign * cross2(rel, o.direction), dx = sign * o.direction.x, dy = sign * o.direction.y;
       if (sn == 0) continue;
-      for (const Segment& e : sc.spokes) {
-        const double den = cross2(e.direction, o.direction);
-        if (sn > 0 ? den <= sn : den >= sn) continue;
-        if (std::abs(den) < 1e-30) continue;
-        const double tn = cross2(rel, e.direction);
-        if (sn > 0 ? (tn <= 0 || tn >= den) : (tn >= 0 || tn <= den)) continue;
+      for (size_t k = 0; k < spokes; ++k) {
+        const double den = sc.spoke_x[k] * dy - sc.spoke_y[k] * dx;
+        if (den <= sn || den < 1e-30) continue;
+        const Segment& e = sc.spokes[k];
+        const double tn = sign * cross2(rel, e.direction);
+        if (tn <= 0 || tn >= den) continue;
         const double s = sn / den, t = tn / den;
         if (!(s > 0 && s < 1 && t > 0 && t < 1)) continue;
         const double gap = std::abs((1 - s) * hx + s * e.h0 - ((1 - t) * o.h0 + t * o.h1));

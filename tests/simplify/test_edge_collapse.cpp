@@ -1,6 +1,7 @@
 // Quadric edge collapse: topology, boundaries, seams, locks, flips, odd input, targets, and the two-sided
 // error bound against a brute-force sampled Hausdorff distance.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <set>
 
@@ -132,6 +133,34 @@ TEST(EdgeCollapse, ParallelRegionsGiveOneResultAndKeepTheGuarantees) {
   }
   EXPECT_LE(h_parallel, 1.25 * h_serial) << h_serial;
   EXPECT_LE(bound_parallel, 1.5 * bound_serial) << bound_serial;
+}
+
+TEST(EdgeCollapse, OneThreadGivesTheResultOfAll) {
+  // The weld, the quadrics, the classification and each pass's scans and sorts run on all cores in blocks;
+  // the result must not depend on how many threads there are. A UV sphere (seams: wedge rings) with every
+  // vertex also repeated exactly (duplicates to weld), large enough for several blocks of candidates.
+  Mesh in = lumpy(uv_sphere(1.0f, 200, 400), 3);
+  const size_t n = in.vertex_count();
+  for (size_t v = 0; v < n; ++v) {
+    in.positions.push_back(in.positions[v]), in.normals.push_back(in.normals[v]);
+    in.uvs.push_back(in.uvs[v]);
+  }
+  for (size_t c = 0; c < in.indices.size(); c += 6)
+    in.indices[c] += uint32_t(n);  // every other face's first corner
+  const Options o = with_target(in.triangle_count() / 20);
+  const auto all = simplify_mesh(in, o);
+  simplify::Result one;
+  {
+    tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+    one = simplify_mesh(in, o);
+  }
+  for (size_t v = 0; v < n; ++v) ASSERT_EQ(all.weld_remap[v], all.weld_remap[v + n]) << v;
+  EXPECT_EQ(all.weld_remap, one.weld_remap);
+  EXPECT_EQ(all.mesh.indices, one.mesh.indices);
+  EXPECT_EQ(all.mesh.positions, one.mesh.positions);
+  EXPECT_EQ(all.mesh.uvs, one.mesh.uvs);
+  EXPECT_EQ(all.vertex_error, one.vertex_error);
+  EXPECT_TRUE(all.target_reached);
 }
 
 TEST(EdgeCollapse, NoTriangleFlips) {
