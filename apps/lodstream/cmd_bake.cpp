@@ -633,9 +633,9 @@ const bool registered = register_command(
        sub.add_option("-o,--output", args->output, "the package to write (.lods)")->required();
        sub.add_option("--normal-bits", args->normal_bits, "octahedral normal bits per component (4..16)");
        sub.add_option("--codec", args->codec,
-                      "node codec: 1 = meshoptimizer's codecs (default), 2 = predicted positions and normals "
-                      "(about 24 % smaller, decodes at about 0.6x the speed), 3 = 2 with edge-front "
-                      "connectivity (about 31 % smaller than 1, decodes at about 0.7x)");
+                      "node codec: 3 = edge-front connectivity, predicted positions and normals (default; "
+                      "23-31 % smaller than 1, decodes at about 0.9x its speed), 1 = meshoptimizer's codecs, "
+                      "2 = 3's predictions with meshoptimizer's index codec");
        sub.add_option("--max-grid-bits", args->max_grid_bits,
                       "finest grid: at most 2^-N of a mesh's diagonal (14..20, default 20), fewer when its "
                       "vertices stay apart with fewer");
