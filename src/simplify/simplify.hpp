@@ -89,10 +89,10 @@ struct Result {
   std::vector<uint32_t> weld_remap;  // input vertex -> welded vertex (Collapse numbering)
 };
 
-// Simplifies `mesh`. Cost: O(T log T) time over a few passes, using both cores for cost evaluation and the
-// collapse loop; memory about 150 bytes per input triangle (elephant_1m: 200 B/tri peak for the whole
-// `lodstream simplify`, import and export included). Never throws on odd input (non-manifold, degenerate,
-// empty).
+// Simplifies `mesh`. Cost: O(T log T) time over a few passes, using every core for the set-up (weld,
+// quadrics, classification, sorts), cost evaluation and the collapse loop; memory about 150 bytes per input
+// triangle (elephant_1m: 191 B/tri peak for the whole `lodstream simplify`, import and export included).
+// Never throws on odd input (non-manifold, degenerate, empty).
 Result simplify_mesh(const Mesh& mesh, const Options& options);
 
 }  // namespace lodstream::simplify
