@@ -1,4 +1,4 @@
-// The node codecs on their own (every test runs on codec 1 and codec 2): octahedral normals, empty and
+// The node codecs on their own (every test runs on codecs 1, 2 and 3): octahedral normals, empty and
 // oversized nodes, progressive-mesh chunks, wide position ranges, attributes, locked vertices, and robustness
 // against corrupted node bytes.
 #include <gtest/gtest.h>
