@@ -8,8 +8,8 @@
 namespace lodstream::package {
 
 // Codec 3: the smallest of the three, and above the 25 M triangles per second per core that DESIGN.md
-// requires of decoding. Whole bakes store 23-31 % fewer bytes than with codec 1 (refined_elephant 9.78
-// -> 6.57 B per input triangle, city 10.21 -> 7.84). bench_package (refined_elephant meshlets, finest level,
+// requires of decoding. Whole bakes store 23-31 % fewer bytes than with codec 1 (refined_elephant 9.93
+// -> 6.68 B per input triangle, city 10.21 -> 7.84). bench_package (refined_elephant meshlets, finest level,
 // zstd 9; idle machine, medians of 7), decode with checksum + zstd: codec 3 34.3 M tri/s, codec 1 37.4
 // (0.92x); codec only 45.6 vs 51.9. Callgrind, instructions per decoded triangle: codec only 233 vs codec 1's
 // 253, with checksum and zstd 326 vs 326; codec 1's SIMD decoders retire more per cycle, codec 3 pays a
