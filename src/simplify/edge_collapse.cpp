@@ -48,6 +48,7 @@ struct Plan {
 
 // One changed face for vertical_bound.
 struct Corners {
+  Corners() {}  // members left unset: vertical_bound fills each record in place before reading it
   glm::dvec3 p[3];
   glm::dvec2 y[3], ny[3];  // projected before and after (ny: x for the moving corners; faces that stay)
   double h[3], r[3];
@@ -1144,17 +1145,17 @@ class Simplifier {
     glm::dvec3 nsum(0.0);
     auto gather = [&](uint32_t f) {
       const uint32_t* t = &indices_[3 * size_t(f)];
-      Corners c;
+      Corners& c = sc.old.emplace_back();  // filled in place: no copy of the 236-byte record
       int moving = 0;
       for (int k = 0; k < 3; ++k) {
+        const uint32_t q = pid_[t[k]];
         c.p[k] = glm::dvec3(pos_[t[k]]);
         c.r[k] = radius_[t[k]];
-        c.moving[k] = pid_[t[k]] == pa || pid_[t[k]] == pb;
+        c.moving[k] = q == pa || q == pb;
         moving += c.moving[k];
       }
       c.dies = moving > 1;
       nsum += glm::cross(c.p[1] - c.p[0], c.p[2] - c.p[0]);
-      sc.old.push_back(c);
     };
     for (uint32_t f : sc.star_a) gather(f);
     if (p.move)
@@ -1234,18 +1235,20 @@ class Simplifier {
     }
     // Old edges at a or b against new edges at x: both lists once, then every pair (division-free rejection
     // first: most pairs do not cross).
-    sc.old_edges.clear(), sc.spokes.clear();
+    sc.old_edges.clear(), sc.spokes.clear(), sc.spoke_x.clear(), sc.spoke_y.clear();
+    constexpr int kNext[3] = {1, 2, 0};
     for (const Corners& c : sc.old)
       for (int i = 0; i < 3; ++i) {
-        const int j = (i + 1) % 3;
-        if (c.moving[i])  // each edge at a or b leaves a or b in exactly one of its faces
-          sc.old_edges.push_back({c.y[i], c.y[j] - c.y[i], c.h[i], c.h[j], c.r[i], c.r[j]});
-        if (!c.dies && c.moving[(i + 2) % 3])  // the new edge x -> ring vertex i (once per spoke)
-          sc.spokes.push_back({{}, c.y[i] - yx, c.h[i], 0.0, c.r[i], 0.0});
+        if (!c.moving[i]) continue;
+        const int j = kNext[i];
+        // Each edge at a or b leaves a or b in exactly one of its faces; a face that stays has one moving
+        // corner i, and its new edge x -> ring vertex j is that face's spoke (once per spoke).
+        sc.old_edges.push_back({c.y[i], c.y[j] - c.y[i], c.h[i], c.h[j], c.r[i], c.r[j]});
+        if (c.dies) continue;
+        const glm::dvec2 d = c.y[j] - yx;
+        sc.spokes.push_back({{}, d, c.h[j], 0.0, c.r[j], 0.0});
+        sc.spoke_x.push_back(d.x), sc.spoke_y.push_back(d.y);
       }
-    sc.spoke_x.clear(), sc.spoke_y.clear();
-    for (const Segment& e : sc.spokes)
-      sc.spoke_x.push_back(e.direction.x), sc.spoke_y.push_back(e.direction.y);
     const size_t spokes = sc.spokes.size();
     for (const Segment& o : sc.old_edges) {
       const glm::dvec2 rel = o.origin - yx;
