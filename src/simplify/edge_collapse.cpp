@@ -1143,9 +1143,12 @@ class Simplifier {
     const uint32_t pa = pid_[p.a], pb = pid_[p.b];
     sc.old.clear();
     glm::dvec3 nsum(0.0);
-    auto gather = [&](uint32_t f) {
-      const uint32_t* t = &indices_[3 * size_t(f)];
-      Corners& c = sc.old.emplace_back();  // filled in place: no copy of the 236-byte record
+    // a's faces, then (when x moves) b's that are not also a's: one loop, each record filled in place.
+    const size_t na = sc.star_a.size(), nab = na + (p.move ? sc.star_b.size() : 0);
+    for (size_t i = 0; i < nab; ++i) {
+      const uint32_t* t = &indices_[3 * size_t(i < na ? sc.star_a[i] : sc.star_b[i - na])];
+      if (i >= na && (pid_[t[0]] == pa || pid_[t[1]] == pa || pid_[t[2]] == pa)) continue;
+      Corners& c = sc.old.emplace_back();
       int moving = 0;
       for (int k = 0; k < 3; ++k) {
         const uint32_t q = pid_[t[k]];
@@ -1156,13 +1159,7 @@ class Simplifier {
       }
       c.dies = moving > 1;
       nsum += glm::cross(c.p[1] - c.p[0], c.p[2] - c.p[0]);
-    };
-    for (uint32_t f : sc.star_a) gather(f);
-    if (p.move)
-      for (uint32_t f : sc.star_b) {
-        const uint32_t* t = &indices_[3 * size_t(f)];
-        if (pid_[t[0]] != pa && pid_[t[1]] != pa && pid_[t[2]] != pa) gather(f);
-      }
+    }
     const double len = glm::length(nsum);
     if (!(len > 0)) return kInf;
     const glm::dvec3 n = nsum / len;
