@@ -54,6 +54,7 @@ struct Corners {
   double h[3], r[3];
   double area, new_area;  // twice the projected areas, before and after
   bool moving[3];
+  int last_moving;  // the last moving corner (every face has one: it holds a or b); a face that stays has one
   bool dies;
 };
 // A projected edge for vertical_bound: origin + t direction, heights and radii at its ends.
@@ -1156,6 +1157,7 @@ class Simplifier {
         c.r[k] = radius_[t[k]];
         c.moving[k] = q == pa || q == pb;
         moving += c.moving[k];
+        if (c.moving[k]) c.last_moving = k;
       }
       c.dies = moving > 1;
       nsum += glm::cross(c.p[1] - c.p[0], c.p[2] - c.p[0]);
@@ -1176,7 +1178,8 @@ class Simplifier {
       c.area = cross2(c.y[1] - c.y[0], c.y[2] - c.y[0]);
       if (!(c.area > 0)) return kInf;
       if (c.dies) continue;
-      for (int k = 0; k < 3; ++k) c.ny[k] = c.moving[k] ? yx : c.y[k];
+      for (int k = 0; k < 3; ++k) c.ny[k] = c.y[k];
+      c.ny[c.last_moving] = yx;
       c.new_area = cross2(c.ny[1] - c.ny[0], c.ny[2] - c.ny[0]);
       if (!(c.new_area > 0)) return kInf;
     }
@@ -1234,18 +1237,24 @@ class Simplifier {
     // first: most pairs do not cross).
     sc.old_edges.clear(), sc.spokes.clear(), sc.spoke_x.clear(), sc.spoke_y.clear();
     constexpr int kNext[3] = {1, 2, 0};
-    for (const Corners& c : sc.old)
-      for (int i = 0; i < 3; ++i) {
-        if (!c.moving[i]) continue;
+    // Each edge at a or b leaves a or b in exactly one of its faces; a face that stays has one moving corner
+    // i, and its new edge x -> ring vertex j is that face's spoke (once per spoke).
+    for (const Corners& c : sc.old) {
+      auto old_edge = [&](int i) {
         const int j = kNext[i];
-        // Each edge at a or b leaves a or b in exactly one of its faces; a face that stays has one moving
-        // corner i, and its new edge x -> ring vertex j is that face's spoke (once per spoke).
         sc.old_edges.push_back({c.y[i], c.y[j] - c.y[i], c.h[i], c.h[j], c.r[i], c.r[j]});
-        if (c.dies) continue;
-        const glm::dvec2 d = c.y[j] - yx;
-        sc.spokes.push_back({{}, d, c.h[j], 0.0, c.r[j], 0.0});
-        sc.spoke_x.push_back(d.x), sc.spoke_y.push_back(d.y);
+      };
+      if (c.dies) {
+        for (int i = 0; i < 3; ++i)
+          if (c.moving[i]) old_edge(i);
+        continue;
       }
+      const int i = c.last_moving, j = kNext[i];
+      old_edge(i);
+      const glm::dvec2 d = c.y[j] - yx;
+      sc.spokes.push_back({{}, d, c.h[j], 0.0, c.r[j], 0.0});
+      sc.spoke_x.push_back(d.x), sc.spoke_y.push_back(d.y);
+    }
     const size_t spokes = sc.spokes.size();
     for (const Segment& o : sc.old_edges) {
       const glm::dvec2 rel = o.origin - yx;
