@@ -48,11 +48,13 @@ struct Plan {
 
 // One changed face for vertical_bound.
 struct Corners {
+  Corners() {}  // members left unset: vertical_bound fills each record in place before reading it
   glm::dvec3 p[3];
   glm::dvec2 y[3], ny[3];  // projected before and after (ny: x for the moving corners; faces that stay)
   double h[3], r[3];
   double area, new_area;  // twice the projected areas, before and after
   bool moving[3];
+  int last_moving;  // the last moving corner (every face has one: it holds a or b); a face that stays has one
   bool dies;
 };
 // A projected edge for vertical_bound: origin + t direction, heights and radii at its ends.
@@ -1142,26 +1144,24 @@ class Simplifier {
     const uint32_t pa = pid_[p.a], pb = pid_[p.b];
     sc.old.clear();
     glm::dvec3 nsum(0.0);
-    auto gather = [&](uint32_t f) {
-      const uint32_t* t = &indices_[3 * size_t(f)];
-      Corners c;
+    // a's faces, then (when x moves) b's that are not also a's: one loop, each record filled in place.
+    const size_t na = sc.star_a.size(), nab = na + (p.move ? sc.star_b.size() : 0);
+    for (size_t i = 0; i < nab; ++i) {
+      const uint32_t* t = &indices_[3 * size_t(i < na ? sc.star_a[i] : sc.star_b[i - na])];
+      if (i >= na && (pid_[t[0]] == pa || pid_[t[1]] == pa || pid_[t[2]] == pa)) continue;
+      Corners& c = sc.old.emplace_back();
       int moving = 0;
       for (int k = 0; k < 3; ++k) {
+        const uint32_t q = pid_[t[k]];
         c.p[k] = glm::dvec3(pos_[t[k]]);
         c.r[k] = radius_[t[k]];
-        c.moving[k] = pid_[t[k]] == pa || pid_[t[k]] == pb;
+        c.moving[k] = q == pa || q == pb;
         moving += c.moving[k];
+        if (c.moving[k]) c.last_moving = k;
       }
       c.dies = moving > 1;
       nsum += glm::cross(c.p[1] - c.p[0], c.p[2] - c.p[0]);
-      sc.old.push_back(c);
-    };
-    for (uint32_t f : sc.star_a) gather(f);
-    if (p.move)
-      for (uint32_t f : sc.star_b) {
-        const uint32_t* t = &indices_[3 * size_t(f)];
-        if (pid_[t[0]] != pa && pid_[t[1]] != pa && pid_[t[2]] != pa) gather(f);
-      }
+    }
     const double len = glm::length(nsum);
     if (!(len > 0)) return kInf;
     const glm::dvec3 n = nsum / len;
@@ -1178,7 +1178,8 @@ class Simplifier {
       c.area = cross2(c.y[1] - c.y[0], c.y[2] - c.y[0]);
       if (!(c.area > 0)) return kInf;
       if (c.dies) continue;
-      for (int k = 0; k < 3; ++k) c.ny[k] = c.moving[k] ? yx : c.y[k];
+      for (int k = 0; k < 3; ++k) c.ny[k] = c.y[k];
+      c.ny[c.last_moving] = yx;
       c.new_area = cross2(c.ny[1] - c.ny[0], c.ny[2] - c.ny[0]);
       if (!(c.new_area > 0)) return kInf;
     }
@@ -1234,18 +1235,26 @@ class Simplifier {
     }
     // Old edges at a or b against new edges at x: both lists once, then every pair (division-free rejection
     // first: most pairs do not cross).
-    sc.old_edges.clear(), sc.spokes.clear();
-    for (const Corners& c : sc.old)
-      for (int i = 0; i < 3; ++i) {
-        const int j = (i + 1) % 3;
-        if (c.moving[i])  // each edge at a or b leaves a or b in exactly one of its faces
-          sc.old_edges.push_back({c.y[i], c.y[j] - c.y[i], c.h[i], c.h[j], c.r[i], c.r[j]});
-        if (!c.dies && c.moving[(i + 2) % 3])  // the new edge x -> ring vertex i (once per spoke)
-          sc.spokes.push_back({{}, c.y[i] - yx, c.h[i], 0.0, c.r[i], 0.0});
+    sc.old_edges.clear(), sc.spokes.clear(), sc.spoke_x.clear(), sc.spoke_y.clear();
+    constexpr int kNext[3] = {1, 2, 0};
+    // Each edge at a or b leaves a or b in exactly one of its faces; a face that stays has one moving corner
+    // i, and its new edge x -> ring vertex j is that face's spoke (once per spoke).
+    for (const Corners& c : sc.old) {
+      auto old_edge = [&](int i) {
+        const int j = kNext[i];
+        sc.old_edges.push_back({c.y[i], c.y[j] - c.y[i], c.h[i], c.h[j], c.r[i], c.r[j]});
+      };
+      if (c.dies) {
+        for (int i = 0; i < 3; ++i)
+          if (c.moving[i]) old_edge(i);
+        continue;
       }
-    sc.spoke_x.clear(), sc.spoke_y.clear();
-    for (const Segment& e : sc.spokes)
-      sc.spoke_x.push_back(e.direction.x), sc.spoke_y.push_back(e.direction.y);
+      const int i = c.last_moving, j = kNext[i];
+      old_edge(i);
+      const glm::dvec2 d = c.y[j] - yx;
+      sc.spokes.push_back({{}, d, c.h[j], 0.0, c.r[j], 0.0});
+      sc.spoke_x.push_back(d.x), sc.spoke_y.push_back(d.y);
+    }
     const size_t spokes = sc.spokes.size();
     for (const Segment& o : sc.old_edges) {
       const glm::dvec2 rel = o.origin - yx;
