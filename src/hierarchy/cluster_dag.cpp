@@ -39,8 +39,9 @@ uint64_t edge_key(uint32_t a, uint32_t b) {
 // Edges of a cluster used by exactly one of its triangles (by position id), as keys in no particular order
 // (the callers sort them with the cluster index). Vertices that share a position id (seams) are first merged
 // into one local vertex; each edge between local vertices is then counted (1, or 2 for more) in a per-thread
-// table of V x V cells of which only the touched ones are read back and cleared. Cost: O(V log V + T),
-// against O(T log T) for sorting the 3T edge keys (that sort was ~2 % of a bake).
+// table of V x V cells of which only the touched ones are read back and cleared (V <= max_cluster_vertices
+// <= 255: at most 64 KB per thread). Cost: O(V + T), against O(T log T) for sorting the 3T edge keys (that
+// sort was ~2 % of a bake).
 std::vector<uint64_t> cluster_boundary(const Mesh& mesh, const std::vector<uint32_t>& ids) {
   const size_t nv = ids.size();
   // Local vertex -> the first local vertex of its position id, through a per-thread open-addressing table of
