@@ -96,7 +96,8 @@ uint32_t hash_bits(const float* v, size_t n) {
 
 class Simplifier {
  public:
-  Simplifier(const Mesh& in, const Options& o) : in_(in), opt_(o) {}
+  Simplifier(const Mesh& in, const Options& o)
+      : in_(in), opt_(o), small_(in.triangle_count() <= kSmallTriangles) {}
 
   Result run() {
     Result result;
@@ -142,6 +143,21 @@ class Simplifier {
  private:
   const Mesh& in_;
   const Options& opt_;
+  // Meshes of at most kSmallTriangles (a DAG group: 512-1024 triangles, simplified while other groups keep
+  // the cores busy) run the set-up loops below in one plain loop each: there, TBB's tasks, per-thread copies
+  // and the 4096-bucket histogram of goal_cost cost more than the loops. The results are the same.
+  static constexpr size_t kSmallTriangles = 4096;
+  const bool small_;
+
+  // f(i) for i in [begin, end): on every core, or in order when small_.
+  template <class I, class F>
+  void for_each(I begin, I end, F&& f) const {
+    if (small_) {
+      for (I i = begin; i < end; ++i) f(i);
+    } else {
+      tbb::parallel_for(begin, end, f);
+    }
+  }
 
   // Welded vertices (input vertex -> welded) and their working data (normalized positions).
   std::vector<uint32_t> weld_remap_, source_;  // source_: welded vertex -> first input vertex
@@ -211,9 +227,7 @@ class Simplifier {
              (!hc || in_.colors[i] == in_.colors[j]);
     };
     std::vector<std::pair<uint32_t, uint32_t>> sorted(n);  // (position hash, input vertex)
-    tbb::parallel_for(size_t(0), n, [&](size_t v) {
-      sorted[v] = {hash_bits(&in_.positions[v].x, 3), uint32_t(v)};
-    });
+    for_each(size_t(0), n, [&](size_t v) { sorted[v] = {hash_bits(&in_.positions[v].x, 3), uint32_t(v)}; });
     tbb::parallel_sort(sorted.begin(), sorted.end());
     std::vector<uint32_t> run(n);  // where the run of sorted[i]'s hash begins
     for (size_t i = 0; i < n; ++i)
@@ -222,7 +236,7 @@ class Simplifier {
     // attributes (its welded vertex's source). Positions compare with == (NaN never equal, as in a hash-table
     // weld).
     std::vector<uint32_t> first_at(n), source(n);
-    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+    for_each(size_t(0), n, [&](size_t i) {
       const uint32_t v = sorted[i].second;
       uint32_t at = v, same = v;
       for (size_t j = run[i]; j < i; ++j) {
@@ -246,7 +260,7 @@ class Simplifier {
     if (in_.has_normals()) nrm_.resize(m);
     if (in_.has_uvs()) uv_.resize(m);
     if (in_.has_colors()) col_.resize(m);
-    tbb::parallel_for(size_t(0), m, [&](size_t k) {
+    for_each(size_t(0), m, [&](size_t k) {
       const uint32_t v = source_[k];
       pos_[k] = (in_.positions[v] - origin_) / scale_;
       if (hn) nrm_[k] = in_.normals[v];
@@ -255,7 +269,7 @@ class Simplifier {
       pid_[k] = weld_remap_[first_at[v]];
     });
     // Rings: a wedge links to the one before it at its position; the first, to the last.
-    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+    for_each(size_t(0), n, [&](size_t i) {
       const uint32_t v = sorted[i].second;
       if (source[v] != v) return;
       auto wedge_at = [&](size_t j) {
@@ -535,12 +549,12 @@ class Simplifier {
       first_face[k] = uint32_t(lo);
     }
     std::vector<std::vector<uint32_t>> straddling(kChunks);  // faces with a corner in a later range
-    tbb::parallel_for(uint32_t(0), kChunks, [&](uint32_t k) {
+    for_each(uint32_t(0), kChunks, [&](uint32_t k) {
       for (uint32_t f = first_face[k]; f < first_face[k + 1]; ++f)
         if (std::max({indices_[3 * f], indices_[3 * f + 1], indices_[3 * f + 2]}) >= first_vertex[k + 1])
           straddling[k].push_back(f);
     });
-    tbb::parallel_for(uint32_t(0), kChunks, [&](uint32_t k) {
+    for_each(uint32_t(0), kChunks, [&](uint32_t k) {
       std::vector<float> s(3 * size_t(channels_));
       std::vector<AttributeTerm> gradient(channels_);
       const uint32_t lo = first_vertex[k], hi = first_vertex[k + 1];
@@ -794,12 +808,12 @@ class Simplifier {
       for (size_t i = b * kSlotBlock, e = std::min(slots_.size(), i + kSlotBlock); i < e; ++i)
         if (const Candidate& c = slots_[i]; valid(c) && c.cost <= limit) f(c, i);
     };
-    tbb::parallel_for(size_t(0), blocks,
-                      [&](size_t b) { block(b, [&](const Candidate&, size_t) { ++start[b + 1]; }); });
+    for_each(size_t(0), blocks,
+             [&](size_t b) { block(b, [&](const Candidate&, size_t) { ++start[b + 1]; }); });
     for (size_t b = 0; b < blocks; ++b) start[b + 1] += start[b];
     const size_t n = start[blocks];
     order_.resize(n);
-    tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+    for_each(size_t(0), blocks, [&](size_t b) {
       uint64_t k = start[b];
       block(b, [&](const Candidate& c, size_t i) { order_[k++ * kScatter % n] = {c.cost, uint32_t(i)}; });
     });
@@ -937,6 +951,15 @@ class Simplifier {
       std::memcpy(&u, &cost, 4);
       return u;
     };
+    if (small_) {  // one selection over the valid costs' bits: the same rank, the same value
+      bucket_.clear();
+      for (const Candidate& c : slots_)
+        if (valid(c)) bucket_.push_back(c.cost);
+      if (goal >= bucket_.size()) return std::numeric_limits<float>::infinity();
+      std::nth_element(bucket_.begin(), bucket_.begin() + goal, bucket_.end(),
+                       [&](float x, float y) { return bits(x) < bits(y); });
+      return bucket_[goal];
+    }
     const size_t blocks = (slots_.size() + kSlotBlock - 1) / kSlotBlock;
     tbb::enumerable_thread_specific<std::vector<uint32_t>> counts(std::vector<uint32_t>(4096, 0));
     tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
