@@ -55,8 +55,9 @@ struct DagOptions {
   // Called with clusters that are final (mesh, locked flags, error and sphere; the parent fields of roots are
   // set afterwards), each cluster exactly once, in an order that does not depend on thread timing, at the
   // same time as the next level's grouping (METIS, one core), so that work on them (encoding) fills the other
-  // core: the level-0 clusters with the first level's grouping, then the clusters of each group once every
-  // one of them has been consumed, the rest (roots, their siblings) once the build ends. Exception: a level-0
+  // core: four fifths of the level-0 clusters with the first level's grouping and the rest with the second's
+  // (no group is complete before the third), then the clusters of each group once every one of them has been
+  // consumed, the rest (roots, their siblings) once the build ends. Exception: a level-0
   // cluster's locked flags are set later, when a group consumes it (its mesh is exact, error 0). During a
   // call nothing modifies the DAG; the call may use every core (TBB).
   std::function<void(const ClusterDag&, std::span<const uint32_t>)> finished;

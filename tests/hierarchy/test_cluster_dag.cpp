@@ -217,7 +217,8 @@ Mesh tetrahedra_soup(int count) {
 }
 
 // DagOptions::finished hands over every cluster exactly once, already as the build leaves it, and most of
-// them while later levels are still being built (what lets the bake encode beside the grouping).
+// them while later levels are still being built (what lets the bake encode beside the grouping), level-0
+// clusters beside the second level's grouping too (no group is complete then).
 void check_finished(const Mesh& mesh) {
   struct Snapshot {
     std::vector<glm::vec3> positions;
@@ -227,10 +228,12 @@ void check_finished(const Mesh& mesh) {
     size_t dag_clusters;  // how many clusters the DAG had when this one was handed over
   };
   std::map<uint32_t, Snapshot> seen;
-  size_t calls = 0;
+  size_t calls = 0, level0_beside_level2 = 0;
   DagOptions options;
   options.finished = [&](const ClusterDag& dag, std::span<const uint32_t> clusters) {
     ++calls;
+    if (dag.levels == 2)
+      for (uint32_t c : clusters) level0_beside_level2 += dag.clusters[c].level == 0;
     for (uint32_t c : clusters) {
       const DagCluster& cluster = dag.clusters[c];
       const bool fresh = seen.emplace(c, Snapshot{cluster.mesh.positions, cluster.mesh.indices,
@@ -257,6 +260,7 @@ void check_finished(const Mesh& mesh) {
     early += s.dag_clusters < dag.clusters.size();
   }
   EXPECT_GE(early, dag.clusters.size() / 2) << "clusters should be handed over level by level";
+  EXPECT_GT(level0_beside_level2, 0u) << "the second level's grouping should have level-0 clusters beside it";
   // The same build without the callback is the same DAG.
   const ClusterDag plain = build_cluster_dag(mesh);
   ASSERT_EQ(plain.clusters.size(), dag.clusters.size());
