@@ -165,6 +165,14 @@ GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
   simplify::Options so;
   const Mesh& first = b.dag.clusters[members[0]].mesh;
   merged.material = first.material;
+  size_t vertices = 0, corners = 0;
+  for (uint32_t c : members)
+    vertices += b.dag.clusters[c].mesh.positions.size(), corners += b.dag.clusters[c].mesh.indices.size();
+  merged.positions.reserve(vertices), merged.indices.reserve(corners);
+  if (first.has_normals()) merged.normals.reserve(vertices);
+  if (first.has_uvs()) merged.uvs.reserve(vertices);
+  if (first.has_colors()) merged.colors.reserve(vertices);
+  merged_ids.reserve(vertices), so.locked.reserve(vertices);
   for (uint32_t c : members) {
     const Mesh& m = b.dag.clusters[c].mesh;
     const uint32_t base = uint32_t(merged.positions.size());
