@@ -97,19 +97,31 @@ std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> 
       }
     }
   }
-  tbb::parallel_sort(pairs.begin(), pairs.end());
 
-  // CSR graph with multiplicities as edge weights.
+  // CSR graph with multiplicities as edge weights: each cluster's neighbours in increasing order, a
+  // neighbour once with the number of pairs as its weight. The pairs are grouped by their first cluster (a
+  // counting sort) and each group, a few dozen, sorted: the order of one sort of all the pairs in O(P) rather
+  // than O(P log P).
   std::vector<idx_t> xadj(n + 1, 0), adjncy, adjwgt, vwgt(n);
-  for (size_t i = 0; i < pairs.size();) {
-    size_t j = i;
-    while (j < pairs.size() && pairs[j] == pairs[i]) ++j;
-    adjncy.push_back(idx_t(pairs[i].second));
-    adjwgt.push_back(idx_t(j - i));
-    ++xadj[pairs[i].first + 1];
-    i = j;
+  std::vector<uint32_t> start(n + 1, 0), neighbours(pairs.size());
+  for (const auto& p : pairs) ++start[p.first + 1];
+  for (size_t i = 0; i < n; ++i) start[i + 1] += start[i];
+  {
+    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+    for (const auto& p : pairs) neighbours[fill[p.first]++] = p.second;
   }
-  for (size_t i = 0; i < n; ++i) xadj[i + 1] += xadj[i];
+  pairs = {};
+  for (size_t c = 0; c < n; ++c) {
+    const auto begin = neighbours.begin() + start[c], end = neighbours.begin() + start[c + 1];
+    std::sort(begin, end);
+    for (auto i = begin; i != end;) {
+      const auto j = std::find_if(i, end, [&](uint32_t other) { return other != *i; });
+      adjncy.push_back(idx_t(*i));
+      adjwgt.push_back(idx_t(j - i));
+      i = j;
+    }
+    xadj[c + 1] = idx_t(adjncy.size());
+  }
   for (size_t i = 0; i < n; ++i) vwgt[i] = idx_t(std::max<uint32_t>(1, triangles[i]));
 
   idx_t nvtxs = idx_t(n), ncon = 1, nparts = idx_t((n + group_clusters - 1) / group_clusters), objval = 0;
