@@ -144,8 +144,10 @@ class Simplifier {
   const Mesh& in_;
   const Options& opt_;
   // Meshes of at most kSmallTriangles (a DAG group: 512-1024 triangles, simplified while other groups keep
-  // the cores busy) run the set-up loops below in one plain loop each: there, TBB's tasks, per-thread copies
-  // and the 4096-bucket histogram of goal_cost cost more than the loops. The results are the same.
+  // the cores busy) run weld's and build_quadrics' loops and gather_candidates' blocks in plain loops
+  // (for_each), and goal_cost as one selection: there, TBB's tasks, per-thread copies and goal_cost's
+  // 4096-bucket histograms cost more than the loops. (Loops with a grain of 1024 or more are one task there
+  // already.) The results are the same.
   static constexpr size_t kSmallTriangles = 4096;
   const bool small_;
 
