@@ -21,10 +21,16 @@ namespace {
 void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
                    size_t max_vertices, size_t max_triangles, std::vector<ClusterPart>& parts) {
   const size_t triangles = indices.size() / 3, vertices = positions.size();
-  // Corner k of triangle t counts unless it repeats an earlier corner (degenerate input).
+  // Corner k of triangle t counts unless it repeats an earlier corner (degenerate input; the DAG drops such
+  // triangles first, so there every corner counts without the per-corner test).
+  bool degenerate = false;
+  for (size_t t = 0; t < triangles && !degenerate; ++t) {
+    const uint32_t* c = &indices[3 * t];
+    degenerate = c[0] == c[1] || c[1] == c[2] || c[0] == c[2];
+  }
   auto distinct = [&](size_t t, int k) {
     const uint32_t* c = &indices[3 * t];
-    return k == 0 || (c[k] != c[0] && (k == 1 || c[2] != c[1]));
+    return !degenerate || k == 0 || (c[k] != c[0] && (k == 1 || c[2] != c[1]));
   };
   // Vertex -> triangles (CSR), and per vertex its unused triangles.
   std::vector<uint32_t> offsets(vertices + 1, 0), adjacent(indices.size()), remaining(vertices, 0);
