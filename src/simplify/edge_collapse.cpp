@@ -383,6 +383,16 @@ class Simplifier {
     }
   }
 
+  // Whether a face holds the directed edge j -> i, i.e. edge i -> j has a twin: one walk over i's faces
+  // (all alive after compact_faces), O(degree).
+  bool has_edge(uint32_t j, uint32_t i) const {
+    for (uint32_t s = offsets_[i]; s < offsets_[i + 1]; ++s) {
+      const uint32_t* t = &indices_[3 * size_t(faces_[s])];
+      if (t[0] == i ? t[2] == j : (t[1] == i ? t[0] == j : t[1] == j)) return true;
+    }
+    return false;
+  }
+
   // Vertex kinds (simplify.hpp): open edges, non-manifold edges (a directed edge twice) and fans (a vertex
   // whose faces do not form one disc or one open fan), then wedge rings.
   void classify() {
@@ -746,18 +756,14 @@ class Simplifier {
     const bool all = slots_.size() != indices_.size();
     if (all) slots_.assign(indices_.size(), Candidate{std::numeric_limits<float>::infinity(), kNone, kNone});
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 1024), [&](const auto& r) {
-      thread_local std::vector<uint32_t> outs, ins;
       for (uint32_t i = r.begin(); i < r.end(); ++i) {
-        bool fanned = false;
         for (uint32_t s = offsets_[i]; s < offsets_[i + 1]; ++s) {  // faces are all alive (compact_faces)
           const uint32_t* t = &indices_[3 * size_t(faces_[s])];
           const uint32_t k = t[0] == i ? 0 : (t[1] == i ? 1 : 2), j = t[(k + 1) % 3];
           if (!all && !touched_[i] && !touched_[j]) continue;
-          if (!fanned) fan(i, outs, ins), fanned = true;
-          const bool twin = std::find(ins.begin(), ins.end(), j) != ins.end();
           slots_[3 * size_t(faces_[s]) + k] =
-              (twin && i > j) ? Candidate{std::numeric_limits<float>::infinity(), kNone, kNone}
-                              : evaluate(i, j);
+              i > j && has_edge(j, i) ? Candidate{std::numeric_limits<float>::infinity(), kNone, kNone}
+                                      : evaluate(i, j);
         }
       }
     });
@@ -902,19 +908,38 @@ class Simplifier {
     pending_.assign(order_.size(), 1);
   }
 
-  // Candidates come in cost order, random in their region, so each try starts with cache misses: this loads
-  // the slot of the candidate kSlotAhead places on in the region's list (sorted_, before `end`), and the
-  // per-vertex data of the ends of the one kEndAhead on (its slot loaded earlier), so that their misses
-  // overlap the tries between.
+  // Candidates come in cost order, random in their region, so each try starts with cache misses on a chain of
+  // loads (order_ entry, slot, the ends' offsets_, their face lists, those faces' corners). This loads each
+  // link of the chain for a candidate further on in the region's list (sorted_, before `end`), the link
+  // before it having been loaded some tries earlier: order_ kOrderAhead places on, the slot kSlotAhead, the
+  // ends' per-vertex data kEndAhead, their face lists kFacesAhead and those faces' indices kCornersAhead, so
+  // that the misses overlap the tries between instead of stalling each one in turn.
   void prefetch(uint32_t k, uint32_t end) const {
-    constexpr uint32_t kSlotAhead = 16, kEndAhead = 8;
-    if (k + kSlotAhead < end) __builtin_prefetch(&slots_[order_[sorted_[k + kSlotAhead].slot].slot]);
+    constexpr uint32_t kOrderAhead = 32, kSlotAhead = 16, kEndAhead = 8, kFacesAhead = 4, kCornersAhead = 2;
+    auto candidate = [&](uint32_t ahead) -> const Candidate& {
+      return slots_[order_[sorted_[k + ahead].slot].slot];
+    };
+    if (k + kOrderAhead < end) __builtin_prefetch(&order_[sorted_[k + kOrderAhead].slot]);
+    if (k + kSlotAhead < end) __builtin_prefetch(&candidate(kSlotAhead));
     if (k + kEndAhead < end) {
-      const Candidate& c = slots_[order_[sorted_[k + kEndAhead].slot].slot];
+      const Candidate& c = candidate(kEndAhead);
       for (uint32_t v : {c.a, c.b}) {
         __builtin_prefetch(&touched_[v]), __builtin_prefetch(&offsets_[v]), __builtin_prefetch(&pos_[v]);
         __builtin_prefetch(&quadric_[v]), __builtin_prefetch(&radius_[v]), __builtin_prefetch(&pid_[v]);
+        __builtin_prefetch(&wedge_[v]);
       }
+    }
+    if (k + kFacesAhead < end) {
+      const Candidate& c = candidate(kFacesAhead);
+      for (uint32_t v : {c.a, c.b})
+        if (offsets_[v + 1] > offsets_[v])
+          __builtin_prefetch(&faces_[offsets_[v]]), __builtin_prefetch(&faces_[offsets_[v + 1] - 1]);
+    }
+    if (k + kCornersAhead < end) {
+      const Candidate& c = candidate(kCornersAhead);
+      for (uint32_t v : {c.a, c.b})
+        for (uint32_t s = offsets_[v]; s < offsets_[v + 1]; ++s)
+          __builtin_prefetch(&indices_[3 * size_t(faces_[s])]);
     }
   }
 
