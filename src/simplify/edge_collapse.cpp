@@ -65,12 +65,19 @@ struct Segment {
 
 constexpr uint32_t kAnyRegion = UINT32_MAX;
 
+// A face around a collapsing edge a -> b: bit k of at_a (at_b) is set when its corner k is at a's (b's)
+// position. try_collapse's first walk sets them; the normal check and vertical_bound read them.
+struct StarFace {
+  uint32_t face;
+  uint8_t at_a, at_b;
+};
+
 // What one thread of the collapse loop needs of its own: the collapse's neighbourhood, vertical_bound's
 // faces and edges, and what its collapses changed (merged into the mesh's totals after the loop).
 struct Scratch {
   uint32_t region = kAnyRegion;  // collapses must keep every face they read inside this region
   std::vector<uint32_t> na, nb, apex, removed;
-  std::vector<uint32_t> star_a, star_b;  // the alive faces around a's and b's wedges (for_faces order)
+  std::vector<StarFace> star_a, star_b;  // the alive faces around a's and b's wedges (for_faces order)
   std::vector<Corners> old;
   std::vector<Segment> old_edges, spokes;  // spokes: direction from x, origin unused
   std::vector<double> spoke_x, spoke_y;    // the spokes' directions, for the crossing loop's first test
@@ -1035,12 +1042,15 @@ class Simplifier {
       return s.region == kAnyRegion ||
              (region_of(t[0]) == s.region && region_of(t[1]) == s.region && region_of(t[2]) == s.region);
     };
+    auto at = [](const uint32_t* q, uint32_t v) {
+      return uint8_t((q[0] == v) | (q[1] == v) << 1 | (q[2] == v) << 2);
+    };
     for_faces(p.a, [&](uint32_t f) {
-      s.star_a.push_back(f);
       const uint32_t* t = &indices_[3 * size_t(f)];
       inside = inside && in_region(t);
       uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
-      if (q[0] == pb || q[1] == pb || q[2] == pb) {
+      const StarFace& star = s.star_a.emplace_back(StarFace{f, at(q, pa), at(q, pb)});
+      if (star.at_b) {
         s.removed.push_back(f);
         for (uint32_t x : q)
           if (x != pa && x != pb) s.apex.push_back(x);
@@ -1051,11 +1061,11 @@ class Simplifier {
       }
     });
     for_faces(p.b, [&](uint32_t f) {
-      s.star_b.push_back(f);
       const uint32_t* t = &indices_[3 * size_t(f)];
       inside = inside && in_region(t);
       uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
-      if (q[0] == pa || q[1] == pa || q[2] == pa) return;
+      const StarFace& star = s.star_b.emplace_back(StarFace{f, at(q, pa), at(q, pb)});
+      if (star.at_a) return;
       ++kept_faces;
       for (uint32_t x : q)
         if (x != pb) s.nb.push_back(x);
@@ -1087,24 +1097,22 @@ class Simplifier {
     // Normal change of every face that stays and moves.
     const float cos_max = std::cos(glm::radians(opt_.max_normal_change_deg));
     bool ok = true;
-    auto check = [&](uint32_t f) {
-      if (!ok) return;
-      const uint32_t* t = &indices_[3 * size_t(f)];
-      uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
-      if ((q[0] == pa || q[1] == pa || q[2] == pa) && (q[0] == pb || q[1] == pb || q[2] == pb)) return;
+    auto check = [&](const StarFace& star) {
+      if (!ok || (star.at_a && star.at_b)) return;
+      const uint32_t* t = &indices_[3 * size_t(star.face)];
       glm::vec3 p0 = pos_[t[0]], p1 = pos_[t[1]], p2 = pos_[t[2]];
       glm::vec3 n0 = glm::cross(p1 - p0, p2 - p0);
       glm::vec3 c[3] = {p0, p1, p2};
       for (int k = 0; k < 3; ++k)
-        if (q[k] == pa || q[k] == pb) c[k] = x;
+        if ((star.at_a | star.at_b) >> k & 1) c[k] = x;
       glm::vec3 n1 = glm::cross(c[1] - c[0], c[2] - c[0]);
       float l0 = glm::length(n0), l1 = glm::length(n1);
       if (!(l0 > 1e-30f)) return;  // already degenerate in the input: nothing to flip
       if (!(l1 > 1e-6f * l0) || glm::dot(n0, n1) <= cos_max * l0 * l1) ok = false;
     };
-    for (uint32_t f : s.star_a) check(f);
+    for (const StarFace& star : s.star_a) check(star);
     if (p.move)
-      for (uint32_t f : s.star_b) check(f);
+      for (const StarFace& star : s.star_b) check(star);
     if (!ok) return rejected_slot(p, s);
     const double r_new = std::min(r_natural, vertical_bound(p, x, s, r_natural));
     if (r_new > max_error_) {
@@ -1114,8 +1122,8 @@ class Simplifier {
 
     // Apply.
     for (uint32_t f : s.removed) indices_[3 * size_t(f)] = kNone;
-    for (uint32_t f : s.star_a) {
-      uint32_t* t = &indices_[3 * size_t(f)];
+    for (const StarFace& star : s.star_a) {
+      uint32_t* t = &indices_[3 * size_t(star.face)];
       if (t[0] == kNone) continue;  // removed just now
       for (int k = 0; k < 3; ++k) {
         if (t[k] == p.a) t[k] = p.b;
@@ -1166,21 +1174,20 @@ class Simplifier {
     constexpr double kInf = std::numeric_limits<double>::infinity();
     auto closed = [&](uint32_t v) { return kind_[v] == kManifold || kind_[v] == kSeam; };
     if (!closed(p.a) || (p.move && !closed(p.b))) return kInf;
-    const uint32_t pa = pid_[p.a], pb = pid_[p.b];
     sc.old.clear();
     glm::dvec3 nsum(0.0);
     // a's faces, then (when x moves) b's that are not also a's: one loop, each record filled in place.
     const size_t na = sc.star_a.size(), nab = na + (p.move ? sc.star_b.size() : 0);
     for (size_t i = 0; i < nab; ++i) {
-      const uint32_t* t = &indices_[3 * size_t(i < na ? sc.star_a[i] : sc.star_b[i - na])];
-      if (i >= na && (pid_[t[0]] == pa || pid_[t[1]] == pa || pid_[t[2]] == pa)) continue;
+      const StarFace& star = i < na ? sc.star_a[i] : sc.star_b[i - na];
+      if (i >= na && star.at_a) continue;
+      const uint32_t* t = &indices_[3 * size_t(star.face)];
       Corners& c = sc.old.emplace_back();
       int moving = 0;
       for (int k = 0; k < 3; ++k) {
-        const uint32_t q = pid_[t[k]];
         c.p[k] = glm::dvec3(pos_[t[k]]);
         c.r[k] = radius_[t[k]];
-        c.moving[k] = q == pa || q == pb;
+        c.moving[k] = (star.at_a | star.at_b) >> k & 1;
         moving += c.moving[k];
         if (c.moving[k]) c.last_moving = k;
       }
