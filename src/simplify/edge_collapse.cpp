@@ -509,10 +509,14 @@ class Simplifier {
         face.add_plane(gradient[j].g, gradient[j].d, area);
       }
     }
-    for (uint32_t v : {v0, v1, v2}) {  // relative to each corner's own origin (origin_of)
+    for (int k = 0; k < 3; ++k) {  // relative to each corner's own origin (origin_of)
+      const uint32_t v = k == 0 ? v0 : (k == 1 ? v1 : v2);
       if (!mine(v)) continue;
-      const glm::vec3 d = pos_[v] - p0;
-      quadric_[v].add_shifted(face, glm::dvec3(d));
+      const glm::vec3 d = k == 0 ? glm::vec3(0.0f) : (k == 1 ? e1 : e2);  // pos_[v] - p0
+      if (k == 0)
+        quadric_[v].add(face);  // the shift by 0
+      else
+        quadric_[v].add_shifted(face, glm::dvec3(d));
       for (int j = 0; j < channels_; ++j) {
         attr_[v * size_t(channels_) + j].g += area * gradient[j].g;
         attr_[v * size_t(channels_) + j].d += area * (gradient[j].d + glm::dot(gradient[j].g, d));
