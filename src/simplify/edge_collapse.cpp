@@ -761,7 +761,7 @@ class Simplifier {
   // quadrics, positions and faces keeps its cost and allowed direction (open edges and seam twins only
   // change at touched vertices). Every vertex is visited in parallel and reads its neighbours' touched_
   // (O(T / cores) per pass; listing the neighbours of touched vertices first was a serial O(V) scan per pass,
-  // 3 % of the wall time on elephant_1m); only vertices with such an edge walk their fan.
+  // 3 % of the wall time on elephant_1m). An edge with a twin is evaluated once, from its smaller end.
   size_t run_pass(size_t target) {
     const size_t m = source_.size();
     const bool all = slots_.size() != indices_.size();
