@@ -919,19 +919,40 @@ class Simplifier {
     pending_.assign(order_.size(), 1);
   }
 
-  // Candidates come in cost order, random in their region, so each try starts with cache misses: this loads
-  // the slot of the candidate kSlotAhead places on in the region's list (sorted_, before `end`), and the
-  // per-vertex data of the ends of the one kEndAhead on (its slot loaded earlier), so that their misses
-  // overlap the tries between.
-  void prefetch(uint32_t k, uint32_t end) const {
-    constexpr uint32_t kSlotAhead = 16, kEndAhead = 8;
-    if (k + kSlotAhead < end) __builtin_prefetch(&slots_[order_[sorted_[k + kSlotAhead].slot].slot]);
+  // Candidates come in cost order, random in their region, so each try starts with cache misses on a chain of
+  // loads (order_ entry, slot, the ends' offsets_, their face lists, those faces' corners). This loads each
+  // link of the chain for a candidate further on in the region's list (sorted_, before `end`), the link
+  // before it having been loaded some tries earlier: order_ kOrderAhead places on, the slot kSlotAhead, the
+  // ends' per-vertex data kEndAhead, their face lists kFacesAhead and those faces' indices kCornersAhead, so
+  // that the misses overlap the tries between instead of stalling each one in turn. Always inlined: called,
+  // it was removed as dead code by GCC 12 at -O2 (kept with -fno-tree-dce), so the collapse loop had no
+  // prefetch instruction at all.
+  [[gnu::always_inline]] void prefetch(uint32_t k, uint32_t end) const {
+    constexpr uint32_t kOrderAhead = 32, kSlotAhead = 16, kEndAhead = 8, kFacesAhead = 4, kCornersAhead = 2;
+    auto candidate = [&](uint32_t ahead) -> const Candidate& {
+      return slots_[order_[sorted_[k + ahead].slot].slot];
+    };
+    if (k + kOrderAhead < end) __builtin_prefetch(&order_[sorted_[k + kOrderAhead].slot]);
+    if (k + kSlotAhead < end) __builtin_prefetch(&candidate(kSlotAhead));
     if (k + kEndAhead < end) {
-      const Candidate& c = slots_[order_[sorted_[k + kEndAhead].slot].slot];
+      const Candidate& c = candidate(kEndAhead);
       for (uint32_t v : {c.a, c.b}) {
         __builtin_prefetch(&touched_[v]), __builtin_prefetch(&offsets_[v]), __builtin_prefetch(&pos_[v]);
         __builtin_prefetch(&quadric_[v]), __builtin_prefetch(&radius_[v]), __builtin_prefetch(&pid_[v]);
+        __builtin_prefetch(&wedge_[v]);
       }
+    }
+    if (k + kFacesAhead < end) {
+      const Candidate& c = candidate(kFacesAhead);
+      for (uint32_t v : {c.a, c.b})
+        if (offsets_[v + 1] > offsets_[v])
+          __builtin_prefetch(&faces_[offsets_[v]]), __builtin_prefetch(&faces_[offsets_[v + 1] - 1]);
+    }
+    if (k + kCornersAhead < end) {
+      const Candidate& c = candidate(kCornersAhead);
+      for (uint32_t v : {c.a, c.b})
+        for (uint32_t s = offsets_[v]; s < offsets_[v + 1]; ++s)
+          __builtin_prefetch(&indices_[3 * size_t(faces_[s])]);
     }
   }
 
