@@ -65,12 +65,19 @@ struct Segment {
 
 constexpr uint32_t kAnyRegion = UINT32_MAX;
 
+// A face around a collapsing edge a -> b: bit k of at_a (at_b) is set when its corner k is at a's (b's)
+// position. try_collapse's first walk sets them; the normal check and vertical_bound read them.
+struct StarFace {
+  uint32_t face;
+  uint8_t at_a, at_b;
+};
+
 // What one thread of the collapse loop needs of its own: the collapse's neighbourhood, vertical_bound's
 // faces and edges, and what its collapses changed (merged into the mesh's totals after the loop).
 struct Scratch {
   uint32_t region = kAnyRegion;  // collapses must keep every face they read inside this region
   std::vector<uint32_t> na, nb, apex, removed;
-  std::vector<uint32_t> star_a, star_b;  // the alive faces around a's and b's wedges (for_faces order)
+  std::vector<StarFace> star_a, star_b;  // the alive faces around a's and b's wedges (for_faces order)
   std::vector<Corners> old;
   std::vector<Segment> old_edges, spokes;  // spokes: direction from x, origin unused
   std::vector<double> spoke_x, spoke_y;    // the spokes' directions, for the crossing loop's first test
@@ -399,6 +406,16 @@ class Simplifier {
     }
   }
 
+  // Whether a face holds the directed edge j -> i, i.e. edge i -> j has a twin: one walk over i's faces
+  // (all alive after compact_faces), O(degree).
+  bool has_edge(uint32_t j, uint32_t i) const {
+    for (uint32_t s = offsets_[i]; s < offsets_[i + 1]; ++s) {
+      const uint32_t* t = &indices_[3 * size_t(faces_[s])];
+      if (t[0] == i ? t[2] == j : (t[1] == i ? t[0] == j : t[1] == j)) return true;
+    }
+    return false;
+  }
+
   // Vertex kinds (simplify.hpp): open edges, non-manifold edges (a directed edge twice) and fans (a vertex
   // whose faces do not form one disc or one open fan), then wedge rings.
   void classify() {
@@ -508,10 +525,14 @@ class Simplifier {
         face.add_plane(gradient[j].g, gradient[j].d, area);
       }
     }
-    for (uint32_t v : {v0, v1, v2}) {  // relative to each corner's own origin (origin_of)
+    for (int k = 0; k < 3; ++k) {  // relative to each corner's own origin (origin_of)
+      const uint32_t v = k == 0 ? v0 : (k == 1 ? v1 : v2);
       if (!mine(v)) continue;
-      const glm::vec3 d = pos_[v] - p0;
-      quadric_[v].add_shifted(face, glm::dvec3(d));
+      const glm::vec3 d = k == 0 ? glm::vec3(0.0f) : (k == 1 ? e1 : e2);  // pos_[v] - p0
+      if (k == 0)
+        quadric_[v].add(face);  // the shift by 0
+      else
+        quadric_[v].add_shifted(face, glm::dvec3(d));
       for (int j = 0; j < channels_; ++j) {
         attr_[v * size_t(channels_) + j].g += area * gradient[j].g;
         attr_[v * size_t(channels_) + j].d += area * (gradient[j].d + glm::dot(gradient[j].g, d));
@@ -756,24 +777,20 @@ class Simplifier {
   // quadrics, positions and faces keeps its cost and allowed direction (open edges and seam twins only
   // change at touched vertices). Every vertex is visited in parallel and reads its neighbours' touched_
   // (O(T / cores) per pass; listing the neighbours of touched vertices first was a serial O(V) scan per pass,
-  // 3 % of the wall time on elephant_1m); only vertices with such an edge walk their fan.
+  // 3 % of the wall time on elephant_1m). An edge with a twin is evaluated once, from its smaller end.
   size_t run_pass(size_t target) {
     const size_t m = source_.size();
     const bool all = slots_.size() != indices_.size();
     if (all) slots_.assign(indices_.size(), Candidate{std::numeric_limits<float>::infinity(), kNone, kNone});
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 1024), [&](const auto& r) {
-      thread_local std::vector<uint32_t> outs, ins;
       for (uint32_t i = r.begin(); i < r.end(); ++i) {
-        bool fanned = false;
         for (uint32_t s = offsets_[i]; s < offsets_[i + 1]; ++s) {  // faces are all alive (compact_faces)
           const uint32_t* t = &indices_[3 * size_t(faces_[s])];
           const uint32_t k = t[0] == i ? 0 : (t[1] == i ? 1 : 2), j = t[(k + 1) % 3];
           if (!all && !touched_[i] && !touched_[j]) continue;
-          if (!fanned) fan(i, outs, ins), fanned = true;
-          const bool twin = std::find(ins.begin(), ins.end(), j) != ins.end();
           slots_[3 * size_t(faces_[s]) + k] =
-              (twin && i > j) ? Candidate{std::numeric_limits<float>::infinity(), kNone, kNone}
-                              : evaluate(i, j);
+              i > j && has_edge(j, i) ? Candidate{std::numeric_limits<float>::infinity(), kNone, kNone}
+                                      : evaluate(i, j);
         }
       }
     });
@@ -918,19 +935,40 @@ class Simplifier {
     pending_.assign(order_.size(), 1);
   }
 
-  // Candidates come in cost order, random in their region, so each try starts with cache misses: this loads
-  // the slot of the candidate kSlotAhead places on in the region's list (sorted_, before `end`), and the
-  // per-vertex data of the ends of the one kEndAhead on (its slot loaded earlier), so that their misses
-  // overlap the tries between.
-  void prefetch(uint32_t k, uint32_t end) const {
-    constexpr uint32_t kSlotAhead = 16, kEndAhead = 8;
-    if (k + kSlotAhead < end) __builtin_prefetch(&slots_[order_[sorted_[k + kSlotAhead].slot].slot]);
+  // Candidates come in cost order, random in their region, so each try starts with cache misses on a chain of
+  // loads (order_ entry, slot, the ends' offsets_, their face lists, those faces' corners). This loads each
+  // link of the chain for a candidate further on in the region's list (sorted_, before `end`), the link
+  // before it having been loaded some tries earlier: order_ kOrderAhead places on, the slot kSlotAhead, the
+  // ends' per-vertex data kEndAhead, their face lists kFacesAhead and those faces' indices kCornersAhead, so
+  // that the misses overlap the tries between instead of stalling each one in turn. Always inlined: called,
+  // it was removed as dead code by GCC 12 at -O2 (kept with -fno-tree-dce), so the collapse loop had no
+  // prefetch instruction at all.
+  [[gnu::always_inline]] void prefetch(uint32_t k, uint32_t end) const {
+    constexpr uint32_t kOrderAhead = 32, kSlotAhead = 16, kEndAhead = 8, kFacesAhead = 4, kCornersAhead = 2;
+    auto candidate = [&](uint32_t ahead) -> const Candidate& {
+      return slots_[order_[sorted_[k + ahead].slot].slot];
+    };
+    if (k + kOrderAhead < end) __builtin_prefetch(&order_[sorted_[k + kOrderAhead].slot]);
+    if (k + kSlotAhead < end) __builtin_prefetch(&candidate(kSlotAhead));
     if (k + kEndAhead < end) {
-      const Candidate& c = slots_[order_[sorted_[k + kEndAhead].slot].slot];
+      const Candidate& c = candidate(kEndAhead);
       for (uint32_t v : {c.a, c.b}) {
         __builtin_prefetch(&touched_[v]), __builtin_prefetch(&offsets_[v]), __builtin_prefetch(&pos_[v]);
         __builtin_prefetch(&quadric_[v]), __builtin_prefetch(&radius_[v]), __builtin_prefetch(&pid_[v]);
+        __builtin_prefetch(&wedge_[v]);
       }
+    }
+    if (k + kFacesAhead < end) {
+      const Candidate& c = candidate(kFacesAhead);
+      for (uint32_t v : {c.a, c.b})
+        if (offsets_[v + 1] > offsets_[v])
+          __builtin_prefetch(&faces_[offsets_[v]]), __builtin_prefetch(&faces_[offsets_[v + 1] - 1]);
+    }
+    if (k + kCornersAhead < end) {
+      const Candidate& c = candidate(kCornersAhead);
+      for (uint32_t v : {c.a, c.b})
+        for (uint32_t s = offsets_[v]; s < offsets_[v + 1]; ++s)
+          __builtin_prefetch(&indices_[3 * size_t(faces_[s])]);
     }
   }
 
@@ -1035,12 +1073,15 @@ class Simplifier {
       return s.region == kAnyRegion ||
              (region_of(t[0]) == s.region && region_of(t[1]) == s.region && region_of(t[2]) == s.region);
     };
+    auto at = [](const uint32_t* q, uint32_t v) {
+      return uint8_t((q[0] == v) | (q[1] == v) << 1 | (q[2] == v) << 2);
+    };
     for_faces(p.a, [&](uint32_t f) {
-      s.star_a.push_back(f);
       const uint32_t* t = &indices_[3 * size_t(f)];
       inside = inside && in_region(t);
       uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
-      if (q[0] == pb || q[1] == pb || q[2] == pb) {
+      const StarFace& star = s.star_a.emplace_back(StarFace{f, at(q, pa), at(q, pb)});
+      if (star.at_b) {
         s.removed.push_back(f);
         for (uint32_t x : q)
           if (x != pa && x != pb) s.apex.push_back(x);
@@ -1051,11 +1092,11 @@ class Simplifier {
       }
     });
     for_faces(p.b, [&](uint32_t f) {
-      s.star_b.push_back(f);
       const uint32_t* t = &indices_[3 * size_t(f)];
       inside = inside && in_region(t);
       uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
-      if (q[0] == pa || q[1] == pa || q[2] == pa) return;
+      const StarFace& star = s.star_b.emplace_back(StarFace{f, at(q, pa), at(q, pb)});
+      if (star.at_a) return;
       ++kept_faces;
       for (uint32_t x : q)
         if (x != pb) s.nb.push_back(x);
@@ -1087,24 +1128,22 @@ class Simplifier {
     // Normal change of every face that stays and moves.
     const float cos_max = std::cos(glm::radians(opt_.max_normal_change_deg));
     bool ok = true;
-    auto check = [&](uint32_t f) {
-      if (!ok) return;
-      const uint32_t* t = &indices_[3 * size_t(f)];
-      uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
-      if ((q[0] == pa || q[1] == pa || q[2] == pa) && (q[0] == pb || q[1] == pb || q[2] == pb)) return;
+    auto check = [&](const StarFace& star) {
+      if (!ok || (star.at_a && star.at_b)) return;
+      const uint32_t* t = &indices_[3 * size_t(star.face)];
       glm::vec3 p0 = pos_[t[0]], p1 = pos_[t[1]], p2 = pos_[t[2]];
       glm::vec3 n0 = glm::cross(p1 - p0, p2 - p0);
       glm::vec3 c[3] = {p0, p1, p2};
       for (int k = 0; k < 3; ++k)
-        if (q[k] == pa || q[k] == pb) c[k] = x;
+        if ((star.at_a | star.at_b) >> k & 1) c[k] = x;
       glm::vec3 n1 = glm::cross(c[1] - c[0], c[2] - c[0]);
       float l0 = glm::length(n0), l1 = glm::length(n1);
       if (!(l0 > 1e-30f)) return;  // already degenerate in the input: nothing to flip
       if (!(l1 > 1e-6f * l0) || glm::dot(n0, n1) <= cos_max * l0 * l1) ok = false;
     };
-    for (uint32_t f : s.star_a) check(f);
+    for (const StarFace& star : s.star_a) check(star);
     if (p.move)
-      for (uint32_t f : s.star_b) check(f);
+      for (const StarFace& star : s.star_b) check(star);
     if (!ok) return rejected_slot(p, s);
     const double r_new = std::min(r_natural, vertical_bound(p, x, s, r_natural));
     if (r_new > max_error_) {
@@ -1114,8 +1153,8 @@ class Simplifier {
 
     // Apply.
     for (uint32_t f : s.removed) indices_[3 * size_t(f)] = kNone;
-    for (uint32_t f : s.star_a) {
-      uint32_t* t = &indices_[3 * size_t(f)];
+    for (const StarFace& star : s.star_a) {
+      uint32_t* t = &indices_[3 * size_t(star.face)];
       if (t[0] == kNone) continue;  // removed just now
       for (int k = 0; k < 3; ++k) {
         if (t[k] == p.a) t[k] = p.b;
@@ -1166,21 +1205,20 @@ class Simplifier {
     constexpr double kInf = std::numeric_limits<double>::infinity();
     auto closed = [&](uint32_t v) { return kind_[v] == kManifold || kind_[v] == kSeam; };
     if (!closed(p.a) || (p.move && !closed(p.b))) return kInf;
-    const uint32_t pa = pid_[p.a], pb = pid_[p.b];
     sc.old.clear();
     glm::dvec3 nsum(0.0);
     // a's faces, then (when x moves) b's that are not also a's: one loop, each record filled in place.
     const size_t na = sc.star_a.size(), nab = na + (p.move ? sc.star_b.size() : 0);
     for (size_t i = 0; i < nab; ++i) {
-      const uint32_t* t = &indices_[3 * size_t(i < na ? sc.star_a[i] : sc.star_b[i - na])];
-      if (i >= na && (pid_[t[0]] == pa || pid_[t[1]] == pa || pid_[t[2]] == pa)) continue;
+      const StarFace& star = i < na ? sc.star_a[i] : sc.star_b[i - na];
+      if (i >= na && star.at_a) continue;
+      const uint32_t* t = &indices_[3 * size_t(star.face)];
       Corners& c = sc.old.emplace_back();
       int moving = 0;
       for (int k = 0; k < 3; ++k) {
-        const uint32_t q = pid_[t[k]];
         c.p[k] = glm::dvec3(pos_[t[k]]);
         c.r[k] = radius_[t[k]];
-        c.moving[k] = q == pa || q == pb;
+        c.moving[k] = (star.at_a | star.at_b) >> k & 1;
         moving += c.moving[k];
         if (c.moving[k]) c.last_moving = k;
       }
