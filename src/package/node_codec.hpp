@@ -89,11 +89,18 @@ struct DecodedNode {
   std::vector<uint8_t> extra;
 };
 
-// Bytes of each part of one encoded node (before zstd), for size reports.
-// (Attributes share one vertex stream; measure one attribute's cost by encoding with and without it.)
+// Bytes of each part of one encoded node (before zstd), for size reports. Every codec lays the parts out in
+// this order, so they are also consecutive ranges of the node's bytes: header, vertices (positions, then
+// normals, then the other attributes), locked, indices.
+// Codec 1 interleaves all attributes in one vertex stream (normals = attributes = 0: measure one attribute's
+// cost by encoding with and without it); codecs 2 and 3 store normal residuals and the other attributes
+// (UVs, colours, vertex_data) apart and count them in `normals` and `attributes`, which are part of
+// `vertices`.
 struct NodeSizeBreakdown {
   size_t header = 0, vertices = 0, locked = 0, indices = 0;
+  size_t normals = 0, attributes = 0;  // of `vertices`
   size_t total() const { return header + vertices + locked + indices; }
+  size_t positions() const { return vertices - normals - attributes; }
 };
 
 class NodeCodec {

@@ -167,6 +167,7 @@ NodeSizeBreakdown PredictiveCodec::breakdown(std::span<const uint8_t> bytes, con
   NodeSizeBreakdown b;
   b.header = p.header_size;
   b.vertices = p.position_planes.size() + p.normal_planes.size() + p.attribute_stream.size();
+  b.normals = p.normal_planes.size(), b.attributes = p.attribute_stream.size();
   b.locked = p.locked_stream.size();
   b.indices = p.connectivity.size() + p.tail.size();  // tail: a progressive step's chains (connectivity)
   return b;

@@ -67,6 +67,7 @@ NodeSizeBreakdown TraversalCodec::breakdown(std::span<const uint8_t> bytes, cons
   NodeSizeBreakdown b;
   b.header = p.header_size;
   b.vertices = p.position_planes.size() + p.normal_planes.size() + p.attribute_stream.size();
+  b.normals = p.normal_planes.size(), b.attributes = p.attribute_stream.size();
   b.locked = p.locked_stream.size();
   b.indices = p.connectivity.size() + p.tail.size();
   return b;
