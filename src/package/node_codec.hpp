@@ -116,8 +116,16 @@ class NodeCodec {
   // bytes.size() + 65536 vertices. Thread-safe.
   virtual DecodedNode decode(std::span<const uint8_t> bytes, const PositionGrid& grid,
                              const std::string& where) const = 0;
-  // Where an encoded node's bytes go (parses only its header). Throws like decode.
-  virtual NodeSizeBreakdown breakdown(std::span<const uint8_t> bytes, const std::string& where) const = 0;
+  // Where the bytes of an encoded node of `node_size` bytes go, from its first bytes (`bytes` holds at least
+  // its header and may end before or run past the node's end: only the header is read). Lets a page stored
+  // by part (page_parts.hpp) find each node's parts from the headers alone. Throws like decode, also when the
+  // parts do not add up to node_size. Cost: O(1).
+  virtual NodeSizeBreakdown layout(std::span<const uint8_t> bytes, size_t node_size,
+                                   const std::string& where) const = 0;
+  // layout() of a whole node.
+  NodeSizeBreakdown breakdown(std::span<const uint8_t> bytes, const std::string& where) const {
+    return layout(bytes, bytes.size(), where);
+  }
 };
 
 // The codec that new packages are written with.

@@ -38,11 +38,14 @@ bool predict_positions(const int64_t* residual, uint32_t V, const uint32_t* o, u
 
 }  // namespace
 
-PredictiveNode PredictiveNode::parse(std::span<const uint8_t> bytes, uint8_t format, uint32_t known_flags,
-                                     const std::string& where) {
-  ByteReader r(bytes, where);
+namespace {
+
+// What parse and layout share: the header, widths and stream sizes of a node of node_size bytes, read from
+// r, checked to fit; `sizes` gets the attribute, locked and connectivity streams' sizes.
+PredictiveNode read_layout(ByteReader& r, size_t node_size, uint8_t format, uint32_t known_flags,
+                           uint64_t (&sizes)[3]) {
   PredictiveNode p;
-  static_cast<NodeHeader&>(p) = NodeHeader::read(r, format, known_flags, bytes.size());
+  static_cast<NodeHeader&>(p) = NodeHeader::read(r, format, known_flags, node_size);
   const uint8_t widths = r.u8();
   p.position_bytes = widths & 15, p.normal_bytes = widths >> 4;
   if (p.position_bytes < 1 || p.position_bytes > kMaxPositionBytes || p.normal_bytes > kMaxNormalBytes ||
@@ -51,17 +54,44 @@ PredictiveNode PredictiveNode::parse(std::span<const uint8_t> bytes, uint8_t for
   const uint64_t attribute_size = r.varint(), locked_size = r.varint(), connectivity_size = r.varint();
   p.header_size = r.position();
   const uint64_t planes = uint64_t(p.vertices) * (3 * p.position_bytes + 2 * p.normal_bytes);  // V ≤ 65536
-  if (planes > r.remaining() || attribute_size > r.remaining() - planes ||
-      locked_size > r.remaining() - planes - attribute_size ||
-      connectivity_size > r.remaining() - planes - attribute_size - locked_size)
+  const uint64_t remaining = node_size - std::min<uint64_t>(node_size, p.header_size);
+  if (p.header_size > node_size || planes > remaining || attribute_size > remaining - planes ||
+      locked_size > remaining - planes - attribute_size ||
+      connectivity_size > remaining - planes - attribute_size - locked_size)
     r.fail("stream sizes do not add up to the node size");
+  sizes[0] = attribute_size, sizes[1] = locked_size, sizes[2] = connectivity_size;
+  return p;
+}
+
+}  // namespace
+
+PredictiveNode PredictiveNode::parse(std::span<const uint8_t> bytes, uint8_t format, uint32_t known_flags,
+                                     const std::string& where) {
+  ByteReader r(bytes, where);
+  uint64_t sizes[3];
+  PredictiveNode p = read_layout(r, bytes.size(), format, known_flags, sizes);
   p.position_planes = r.bytes(size_t(3) * p.position_bytes * p.vertices, "position residuals");
   p.normal_planes = r.bytes(size_t(2) * p.normal_bytes * p.vertices, "normal residuals");
-  p.attribute_stream = r.bytes(attribute_size, "attribute stream");
-  p.locked_stream = r.bytes(locked_size, "locked stream");
-  p.connectivity = r.bytes(connectivity_size, "connectivity");
+  p.attribute_stream = r.bytes(sizes[0], "attribute stream");
+  p.locked_stream = r.bytes(sizes[1], "locked stream");
+  p.connectivity = r.bytes(sizes[2], "connectivity");
   p.tail = r.bytes(r.remaining(), "tail");
   return p;
+}
+
+NodeSizeBreakdown PredictiveNode::layout(std::span<const uint8_t> bytes, size_t node_size, uint8_t format,
+                                         uint32_t known_flags, const std::string& where, uint64_t* tail) {
+  ByteReader r(bytes, where);
+  uint64_t sizes[3];
+  const PredictiveNode p = read_layout(r, node_size, format, known_flags, sizes);
+  NodeSizeBreakdown b;
+  b.header = p.header_size;
+  b.normals = size_t(2) * p.normal_bytes * p.vertices, b.attributes = sizes[0];
+  b.vertices = size_t(3) * p.position_bytes * p.vertices + b.normals + b.attributes;
+  b.locked = sizes[1];
+  b.indices = node_size - b.header - b.vertices - b.locked;  // connectivity and tail
+  if (tail) *tail = b.indices - sizes[2];
+  return b;
 }
 
 PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedNode& n,

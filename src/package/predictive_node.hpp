@@ -35,6 +35,10 @@ struct PredictiveNode : NodeHeader {
   // that add up); throws lodstream::Error starting with `where`. Cost: O(1).
   static PredictiveNode parse(std::span<const uint8_t> bytes, uint8_t format, uint32_t known_flags,
                               const std::string& where);
+  // The parts of a node of `node_size` bytes from its first bytes (NodeCodec::layout; the tail counts as
+  // connectivity), checked as parse checks them; `tail` receives the tail's size. Cost: O(1).
+  static NodeSizeBreakdown layout(std::span<const uint8_t> bytes, size_t node_size, uint8_t format,
+                                  uint32_t known_flags, const std::string& where, uint64_t* tail = nullptr);
 };
 
 // The encoder's side. Residuals of the quantized node's coarse coordinates against `predictors` (3 per
