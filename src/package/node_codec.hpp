@@ -99,6 +99,9 @@ struct DecodedNode {
 struct NodeSizeBreakdown {
   size_t header = 0, vertices = 0, locked = 0, indices = 0;
   size_t normals = 0, attributes = 0;  // of `vertices`
+  // Of positions() and normals: their first bytes, the low byte planes where the codec stores byte planes
+  // (codecs 2 and 3: one byte per vertex and component), 0 otherwise.
+  size_t position_low = 0, normal_low = 0;
   size_t total() const { return header + vertices + locked + indices; }
   size_t positions() const { return vertices - normals - attributes; }
 };

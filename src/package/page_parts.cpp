@@ -11,10 +11,18 @@ namespace lodstream::package {
 
 namespace {
 
-constexpr size_t kParts = 6;  // NodeSizeBreakdown's parts, in its order
+// NodeSizeBreakdown's parts, in its order, the positions and normals cut into low and high byte planes.
+constexpr size_t kParts = 8;
 
 std::array<size_t, kParts> part_sizes(const NodeSizeBreakdown& b) {
-  return {b.header, b.positions(), b.normals, b.attributes, b.locked, b.indices};
+  return {b.header,
+          b.position_low,
+          b.positions() - b.position_low,
+          b.normal_low,
+          b.normals - b.normal_low,
+          b.attributes,
+          b.locked,
+          b.indices};
 }
 
 void put_varint(std::vector<uint8_t>& out, uint64_t v) {
@@ -23,8 +31,8 @@ void put_varint(std::vector<uint8_t>& out, uint64_t v) {
   out.insert(out.end(), w.bytes.begin(), w.bytes.end());
 }
 
-// The regrouped bytes (page_parts.hpp), as the size varints and the six streams; nullopt when a node's bytes
-// do not parse as the codec's.
+// The regrouped bytes (page_parts.hpp), as the size varints and the eight streams; nullopt when a node's
+// bytes do not parse as the codec's.
 std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<const uint8_t> page,
                                                                     std::span<const uint32_t> node_sizes,
                                                                     const NodeCodec& codec) {

@@ -105,6 +105,7 @@ NodeSizeBreakdown PredictiveNode::layout(std::span<const uint8_t> bytes, size_t 
   b.header = p.header_size;
   b.normals = size_t(2) * p.normal_bytes * p.vertices, b.attributes = sizes[0];
   b.vertices = size_t(3) * p.position_bytes * p.vertices + b.normals + b.attributes;
+  b.position_low = size_t(3) * p.vertices, b.normal_low = p.normal_bytes ? size_t(2) * p.vertices : 0;
   b.locked = sizes[1];
   b.indices = node_size - b.header - b.vertices - b.locked;  // connectivity and tail
   if (tail) *tail = b.indices - sizes[2];
