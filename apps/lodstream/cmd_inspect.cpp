@@ -1,14 +1,15 @@
-// `lodstream inspect SCENE.lods [--json] [--verify] [--cuts N]`: what a package holds (nodes, pages, levels,
-// bytes, per-level counts and errors) and, with --verify, whether every invariant of DESIGN.md's Data model
-// holds: the content hash, monotonic errors (a node's parents' pair is its parents' own pair and at least its
-// own), containing spheres, every page and node decodes and matches its record, and crack-free cuts: for N
-// random eyes and thresholds per representation, the cut chosen by the cut rule, welded by decoded position,
-// has exactly the boundary edges of the full-resolution (level-0) surface; and for an HLOD (check_hlod):
-// proxy object sets nest (an inner proxy's objects are the disjoint union of its children's, the root's cover
-// every object it lists once per leaf) and a leaf proxy bounds its objects' roots (error at least theirs in
-// world units, sphere containing theirs and the object's bounds); for a progressive mesh (check_progressive),
-// its steps form one chain and every prefix assembles into a valid mesh. Every embedded texture (blob) must
-// decode as an image. Exits 1 naming the first violation.
+// `lodstream inspect SCENE.lods [--json] [--verify] [--cuts N] [--parts]`: what a package holds (nodes,
+// pages, levels, bytes, per-level counts and errors; with --parts, each level's bytes per node part, raw and
+// after zstd, and vertices per triangle: package/size_account.hpp) and, with --verify, whether every
+// invariant of DESIGN.md's Data model holds: the content hash, monotonic errors (a node's parents' pair is
+// its parents' own pair and at least its own), containing spheres, every page and node decodes and matches
+// its record, and crack-free cuts: for N random eyes and thresholds per representation, the cut chosen by the
+// cut rule, welded by decoded position, has exactly the boundary edges of the full-resolution (level-0)
+// surface; and for an HLOD (check_hlod): proxy object sets nest (an inner proxy's objects are the disjoint
+// union of its children's, the root's cover every object it lists once per leaf) and a leaf proxy bounds its
+// objects' roots (error at least theirs in world units, sphere containing theirs and the object's bounds);
+// for a progressive mesh (check_progressive), its steps form one chain and every prefix assembles into a
+// valid mesh. Every embedded texture (blob) must decode as an image. Exits 1 naming the first violation.
 #include <tbb/parallel_for.h>
 
 #include <cmath>
@@ -24,6 +25,7 @@
 #include "hierarchy/cut.hpp"
 #include "package/progressive_prefix.hpp"
 #include "package/reader.hpp"
+#include "package/size_account.hpp"
 #include "schedule/cut.hpp"
 
 namespace lodstream::cli {
@@ -33,7 +35,7 @@ using namespace package;
 
 struct InspectArgs {
   std::string package;
-  bool json = false, verify = false;
+  bool json = false, verify = false, parts = false;
   int cuts = 32;
 };
 
@@ -189,6 +191,9 @@ int run_inspect(const InspectArgs& args) {
   uint64_t texture_bytes = 0;
   for (const Range& b : root.blobs) texture_bytes += b.size;
 
+  std::vector<LevelAccount> account;
+  if (args.parts) account = account_sizes(reader);
+
   std::string violation;
   if (args.verify) {
     reader.verify();  // header = trailer, content hash (throws on mismatch)
@@ -307,6 +312,24 @@ int run_inspect(const InspectArgs& args) {
                           {"textures", root.blobs.size()},
                           {"texture_bytes", texture_bytes},
                           {"per_level", level_json}};
+    if (args.parts) {
+      nlohmann::json parts = nlohmann::json::array();
+      for (const LevelAccount& a : account) {
+        nlohmann::json raw, compressed;
+        for (uint32_t p = 0; p < kNodeParts; ++p) {
+          raw[node_part_name(NodePart(p))] = a.parts[p].raw;
+          compressed[node_part_name(NodePart(p))] = a.parts[p].compressed;
+        }
+        parts.push_back({{"level", a.level},
+                         {"nodes", a.nodes},
+                         {"triangles", a.triangles},
+                         {"vertices", a.vertices},
+                         {"page_bytes", std::llround(a.page_bytes)},
+                         {"raw", raw},
+                         {"compressed", compressed}});
+      }
+      out["parts"] = parts;
+    }
     if (args.verify) {
       out["verified"] = violation.empty();
       out["violation"] = violation.empty() ? nlohmann::json(nullptr) : nlohmann::json(violation);
@@ -323,6 +346,18 @@ int run_inspect(const InspectArgs& args) {
     for (const auto& [l, s] : per_level)
       std::printf("  level %2u: %7zu nodes %10zu triangles  error %.4g .. %.4g\n", l, s.nodes, s.triangles,
                   s.min_error, s.max_error);
+    if (args.parts) {
+      std::printf(
+          "  bytes per stored triangle by part, raw / alone after zstd (inspect --help):\n  level  vert/tri");
+      for (uint32_t p = 0; p < kNodeParts; ++p) std::printf(" %15s", node_part_name(NodePart(p)));
+      std::printf("  pages after zstd\n");
+      for (const LevelAccount& a : account) {
+        const double t = double(std::max<uint64_t>(1, a.triangles));
+        std::printf("  %5u  %8.3f", a.level, double(a.vertices) / t);
+        for (const PartBytes& b : a.parts) std::printf("   %5.2f / %5.2f", b.raw / t, b.compressed / t);
+        std::printf("  %6.3f\n", a.page_bytes / t);
+      }
+    }
     if (args.verify && violation.empty())
       std::printf("verified: every invariant holds (%d cuts per DAG)\n", args.cuts);
   }
@@ -341,6 +376,11 @@ const bool registered = register_command(
        sub.add_flag("--verify", args->verify,
                     "check content hash, monotonic errors, containing spheres, decoding of every node and "
                     "crack-free cuts; exit 1 naming the first violation");
+       sub.add_flag(
+           "--parts", args->parts,
+           "also each level's vertices and bytes per node part (header, positions, normals, "
+           "attributes, locked, connectivity), raw and compressed alone by zstd in page-sized chunks, "
+           "and the stored page bytes per level (JSON key parts)");
        sub.add_option("--cuts", args->cuts, "random cuts checked per cluster DAG with --verify (default 32)");
        sub.add_flag(
            "--json", args->json,

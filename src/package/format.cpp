@@ -103,21 +103,73 @@ std::vector<uint8_t> zstd_compress(std::span<const uint8_t> raw, int level, int 
   return out;
 }
 
-std::vector<uint8_t> zstd_decompress(std::span<const uint8_t> frame, uint32_t raw_size,
-                                     const std::string& context) {
+std::vector<uint8_t> zstd_compress_parts(std::span<const std::span<const uint8_t>> parts, int level,
+                                         int min_match) {
+  std::unique_ptr<ZSTD_CCtx, size_t (*)(ZSTD_CCtx*)> cctx(ZSTD_createCCtx(), ZSTD_freeCCtx);
+  if (!cctx) throw Error("out of memory creating a zstd context");
+  size_t total = 0;
+  for (std::span<const uint8_t> p : parts) total += p.size();
+  // Each flush may add a block header (3 bytes) beyond the bound of the whole.
+  std::vector<uint8_t> out(ZSTD_compressBound(total) + 8 * parts.size() + 32);
+  size_t n = ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_compressionLevel, level);
+  if (!ZSTD_isError(n) && min_match != 0) n = ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_minMatch, min_match);
+  if (!ZSTD_isError(n)) n = ZSTD_CCtx_setPledgedSrcSize(cctx.get(), total);
+  ZSTD_outBuffer o{out.data(), out.size(), 0};
+  for (size_t i = 0; i < parts.size() && !ZSTD_isError(n); ++i) {
+    ZSTD_inBuffer in{parts[i].data(), parts[i].size(), 0};
+    const ZSTD_EndDirective end = i + 1 == parts.size() ? ZSTD_e_end : ZSTD_e_flush;
+    do n = ZSTD_compressStream2(cctx.get(), &o, &in, end);
+    while (!ZSTD_isError(n) && n != 0);  // the output buffer is large enough: one call normally suffices
+  }
+  if (parts.empty() && !ZSTD_isError(n)) {
+    ZSTD_inBuffer in{nullptr, 0, 0};
+    n = ZSTD_compressStream2(cctx.get(), &o, &in, ZSTD_e_end);
+  }
+  if (ZSTD_isError(n)) throw Error(std::string("zstd compression failed: ") + ZSTD_getErrorName(n));
+  out.resize(o.pos);
+  return out;
+}
+
+namespace {
+
+// The content size a zstd frame declares; throws unless it declares one.
+unsigned long long declared_size(std::span<const uint8_t> frame, const std::string& context) {
   unsigned long long declared = ZSTD_getFrameContentSize(frame.data(), frame.size());
   if (declared == ZSTD_CONTENTSIZE_ERROR || declared == ZSTD_CONTENTSIZE_UNKNOWN) {
     throw Error(context + ": not a valid zstd frame");
   }
+  return declared;
+}
+
+std::vector<uint8_t> decompress_declared(std::span<const uint8_t> frame, size_t declared,
+                                         const std::string& context) {
+  std::vector<uint8_t> out(declared);
+  size_t n = ZSTD_decompress(out.data(), out.size(), frame.data(), frame.size());
+  if (ZSTD_isError(n)) throw Error(context + ": zstd: " + ZSTD_getErrorName(n));
+  if (n != declared) throw Error(context + ": zstd frame decompressed to a different size");
+  return out;
+}
+
+}  // namespace
+
+std::vector<uint8_t> zstd_decompress(std::span<const uint8_t> frame, uint32_t raw_size,
+                                     const std::string& context) {
+  const unsigned long long declared = declared_size(frame, context);
   if (declared != raw_size) {
     throw Error(context + ": zstd frame holds " + std::to_string(declared) + " bytes, the index says " +
                 std::to_string(raw_size));
   }
-  std::vector<uint8_t> out(raw_size);
-  size_t n = ZSTD_decompress(out.data(), out.size(), frame.data(), frame.size());
-  if (ZSTD_isError(n)) throw Error(context + ": zstd: " + ZSTD_getErrorName(n));
-  if (n != raw_size) throw Error(context + ": zstd frame decompressed to a different size");
-  return out;
+  return decompress_declared(frame, raw_size, context);
+}
+
+std::vector<uint8_t> zstd_decompress_at_most(std::span<const uint8_t> frame, uint64_t max_size,
+                                             const std::string& context) {
+  const unsigned long long declared = declared_size(frame, context);
+  if (declared > max_size) {
+    throw Error(context + ": zstd frame holds " + std::to_string(declared) + " bytes, more than " +
+                std::to_string(max_size) + " possible");
+  }
+  return decompress_declared(frame, size_t(declared), context);
 }
 
 }  // namespace lodstream::package

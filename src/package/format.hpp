@@ -23,7 +23,8 @@
 namespace lodstream::package {
 
 inline constexpr std::array<uint8_t, 8> kMagic = {0x89, 'L', 'O', 'D', 'S', '\r', '\n', 0x1a};
-inline constexpr uint32_t kFormatVersion = 2;  // 2: node records coded against their run (index.hpp)
+// 2: node records coded against their run (index.hpp); 3: data pages stored by part (page_parts.hpp).
+inline constexpr uint32_t kFormatVersion = 3;
 inline constexpr size_t kHeaderSize = 64;
 
 // Hard limits a reader enforces before allocating: no valid writer output exceeds them.
@@ -74,9 +75,16 @@ class ContentHasher {
 // zstd frame of `raw` at `level` (1..22), with matches of at least `min_match` bytes (3..7; 0 = the level's
 // own). Throws lodstream::Error if zstd fails.
 std::vector<uint8_t> zstd_compress(std::span<const uint8_t> raw, int level, int min_match = 0);
+// One zstd frame of the concatenation of `parts`, as zstd_compress, but each part ends a zstd block, so that
+// each part's literals and sequences get entropy tables of their own (page_parts.hpp).
+std::vector<uint8_t> zstd_compress_parts(std::span<const std::span<const uint8_t>> parts, int level,
+                                         int min_match = 0);
 // Decompresses one zstd frame that must hold exactly `raw_size` bytes (checked against the frame header
 // before allocating, and after). `context` names the file and part for the error message.
 std::vector<uint8_t> zstd_decompress(std::span<const uint8_t> frame, uint32_t raw_size,
                                      const std::string& context);
+// Decompresses one zstd frame that declares at most `max_size` bytes (checked before allocating).
+std::vector<uint8_t> zstd_decompress_at_most(std::span<const uint8_t> frame, uint64_t max_size,
+                                             const std::string& context);
 
 }  // namespace lodstream::package

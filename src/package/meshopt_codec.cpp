@@ -46,18 +46,29 @@ struct Parsed : NodeHeader {
   std::span<const uint8_t> vertex_stream, locked_stream, index_stream, extra;
 };
 
-Parsed parse(std::span<const uint8_t> bytes, const std::string& where) {
-  ByteReader r(bytes, where);
+// The header of a node of node_size bytes and its stream sizes (vertex, locked, index), checked to add up.
+Parsed read_layout(ByteReader& r, size_t node_size, uint64_t (&sizes)[3]) {
   Parsed p;
-  static_cast<NodeHeader&>(p) = NodeHeader::read(r, kFormat, kAllFlags, bytes.size());
+  static_cast<NodeHeader&>(p) = NodeHeader::read(r, kFormat, kAllFlags, node_size);
   const uint64_t extra_size = p.extra_size;
   uint64_t vertex_size = r.varint(), locked_size = r.varint(), index_size = r.varint();
   p.header_size = r.position();
-  if (extra_size > r.remaining() || vertex_size > r.remaining() - extra_size ||
-      locked_size > r.remaining() - extra_size - vertex_size ||
-      index_size != r.remaining() - extra_size - vertex_size - locked_size) {
+  const uint64_t remaining = node_size - std::min<uint64_t>(node_size, p.header_size);
+  if (p.header_size > node_size || extra_size > remaining || vertex_size > remaining - extra_size ||
+      locked_size > remaining - extra_size - vertex_size ||
+      index_size != remaining - extra_size - vertex_size - locked_size) {
     r.fail("stream sizes do not add up to the node size");
   }
+  sizes[0] = vertex_size, sizes[1] = locked_size, sizes[2] = index_size;
+  return p;
+}
+
+Parsed parse(std::span<const uint8_t> bytes, const std::string& where) {
+  ByteReader r(bytes, where);
+  uint64_t sizes[3];
+  Parsed p = read_layout(r, bytes.size(), sizes);
+  const uint64_t vertex_size = sizes[0], locked_size = sizes[1], index_size = sizes[2];
+  const uint64_t extra_size = p.extra_size;
   p.vertex_stream = r.bytes(vertex_size, "vertex stream");
   p.locked_stream = r.bytes(locked_size, "locked stream");
   p.index_stream = r.bytes(index_size, "index stream");
@@ -183,13 +194,16 @@ DecodedNode MeshoptCodec::decode(std::span<const uint8_t> bytes, const PositionG
   return out;
 }
 
-NodeSizeBreakdown MeshoptCodec::breakdown(std::span<const uint8_t> bytes, const std::string& where) const {
-  const Parsed p = parse(bytes, where);
+NodeSizeBreakdown MeshoptCodec::layout(std::span<const uint8_t> bytes, size_t node_size,
+                                       const std::string& where) const {
+  ByteReader r(bytes, where);
+  uint64_t sizes[3];
+  const Parsed p = read_layout(r, node_size, sizes);
   NodeSizeBreakdown b;
   b.header = p.header_size;
-  b.vertices = p.vertex_stream.size();
-  b.locked = p.locked_stream.size();
-  b.indices = p.index_stream.size() + p.extra.size();  // extra: a progressive step's chains (connectivity)
+  b.vertices = sizes[0];
+  b.locked = sizes[1];
+  b.indices = sizes[2] + p.extra_size;  // extra: a progressive step's chains (connectivity)
   return b;
 }
 

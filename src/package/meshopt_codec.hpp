@@ -32,7 +32,8 @@ class MeshoptCodec final : public NodeCodec {
   std::vector<uint8_t> encode(const NodeGeometry& geometry, const PositionGrid& grid) const override;
   DecodedNode decode(std::span<const uint8_t> bytes, const PositionGrid& grid,
                      const std::string& where) const override;
-  NodeSizeBreakdown breakdown(std::span<const uint8_t> bytes, const std::string& where) const override;
+  NodeSizeBreakdown layout(std::span<const uint8_t> bytes, size_t node_size,
+                           const std::string& where) const override;
 };
 
 }  // namespace lodstream::package

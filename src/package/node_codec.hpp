@@ -89,11 +89,21 @@ struct DecodedNode {
   std::vector<uint8_t> extra;
 };
 
-// Bytes of each part of one encoded node (before zstd), for size reports.
-// (Attributes share one vertex stream; measure one attribute's cost by encoding with and without it.)
+// Bytes of each part of one encoded node (before zstd), for size reports. Every codec lays the parts out in
+// this order, so they are also consecutive ranges of the node's bytes: header, vertices (positions, then
+// normals, then the other attributes), locked, indices.
+// Codec 1 interleaves all attributes in one vertex stream (normals = attributes = 0: measure one attribute's
+// cost by encoding with and without it); codecs 2 and 3 store normal residuals and the other attributes
+// (UVs, colours, vertex_data) apart and count them in `normals` and `attributes`, which are part of
+// `vertices`.
 struct NodeSizeBreakdown {
   size_t header = 0, vertices = 0, locked = 0, indices = 0;
+  size_t normals = 0, attributes = 0;  // of `vertices`
+  // Of positions() and normals: their first bytes, the low byte planes where the codec stores byte planes
+  // (codecs 2 and 3: one byte per vertex and component), 0 otherwise.
+  size_t position_low = 0, normal_low = 0;
   size_t total() const { return header + vertices + locked + indices; }
+  size_t positions() const { return vertices - normals - attributes; }
 };
 
 class NodeCodec {
@@ -109,8 +119,16 @@ class NodeCodec {
   // bytes.size() + 65536 vertices. Thread-safe.
   virtual DecodedNode decode(std::span<const uint8_t> bytes, const PositionGrid& grid,
                              const std::string& where) const = 0;
-  // Where an encoded node's bytes go (parses only its header). Throws like decode.
-  virtual NodeSizeBreakdown breakdown(std::span<const uint8_t> bytes, const std::string& where) const = 0;
+  // Where the bytes of an encoded node of `node_size` bytes go, from its first bytes (`bytes` holds at least
+  // its header and may end before or run past the node's end: only the header is read). Lets a page stored
+  // by part (page_parts.hpp) find each node's parts from the headers alone. Throws like decode, also when the
+  // parts do not add up to node_size. Cost: O(1).
+  virtual NodeSizeBreakdown layout(std::span<const uint8_t> bytes, size_t node_size,
+                                   const std::string& where) const = 0;
+  // layout() of a whole node.
+  NodeSizeBreakdown breakdown(std::span<const uint8_t> bytes, const std::string& where) const {
+    return layout(bytes, bytes.size(), where);
+  }
 };
 
 // The codec that new packages are written with.

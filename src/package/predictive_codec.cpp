@@ -162,13 +162,13 @@ DecodedNode PredictiveCodec::decode(std::span<const uint8_t> bytes, const Positi
   return out;
 }
 
-NodeSizeBreakdown PredictiveCodec::breakdown(std::span<const uint8_t> bytes, const std::string& where) const {
-  const PredictiveNode p = parse(bytes, where);
-  NodeSizeBreakdown b;
-  b.header = p.header_size;
-  b.vertices = p.position_planes.size() + p.normal_planes.size() + p.attribute_stream.size();
-  b.locked = p.locked_stream.size();
-  b.indices = p.connectivity.size() + p.tail.size();  // tail: a progressive step's chains (connectivity)
+NodeSizeBreakdown PredictiveCodec::layout(std::span<const uint8_t> bytes, size_t node_size,
+                                          const std::string& where) const {
+  uint64_t tail = 0;  // a progressive step's chains (connectivity): the extra bytes
+  const NodeSizeBreakdown b = PredictiveNode::layout(bytes, node_size, kFormat, kAllFlags, where, &tail);
+  ByteReader r(bytes, where);
+  if (tail != NodeHeader::read(r, kFormat, kAllFlags, node_size).extra_size)
+    throw Error(where + ": stream sizes do not add up to the node size");
   return b;
 }
 

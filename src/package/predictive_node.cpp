@@ -18,22 +18,66 @@ constexpr uint32_t kMaxPositionBytes = 5, kMaxNormalBytes = 3;
 // hostile residuals (< 2^40) overflows int64.
 constexpr int64_t kMaxCoarse = int64_t(1) << 32;
 
-// c[v] = c[o1] + c[o2] - c[o] + residual[v] per axis for v < V (predictive_node.hpp), wrapping, the residuals
-// as read_planes leaves them (one array per axis). One pass; returns whether a result lies outside
-// [-kMaxCoarse, kMaxCoarse).
+// The damped parallelogram P of predictive_node.hpp, wrapping (uint64) until the final arithmetic shift, so
+// that hostile coordinates never overflow; j = 4 takes the plain form.
+template <uint32_t j>
+inline uint64_t damped_parallelogram(uint64_t a, uint64_t b, uint64_t c) {
+  if constexpr (j == 4) return a + b - c;
+  return uint64_t(int64_t((4 + j) * (a + b) - 2 * j * c + 4) >> 3);
+}
+inline int64_t damped_parallelogram(int64_t a, int64_t b, int64_t c, uint32_t j) {
+  return j == 4 ? a + b - c : (int64_t(4 + j) * (a + b) - int64_t(2 * j) * c + 4) >> 3;
+}
+
+// c[v] = P + residual[v] per axis for v < V (predictive_node.hpp), wrapping, the residuals as read_planes
+// leaves them (one array per axis). One pass; returns whether a result lies outside [-kMaxCoarse,
+// kMaxCoarse).
+template <uint32_t j>
 bool predict_positions(const int64_t* residual, uint32_t V, const uint32_t* o, uint64_t* c) {
   const int64_t *rx = residual, *ry = rx + V, *rz = ry + V;
   uint64_t shifted = 0;  // OR of c + kMaxCoarse: in range while below 2 kMaxCoarse
   for (uint32_t v = 0; v < V; ++v, o += 3) {
     const uint64_t *x = c + 3 * size_t(o[0]), *y = c + 3 * size_t(o[1]), *z = c + 3 * size_t(o[2]);
     uint64_t* to = c + 3 * size_t(v);
-    to[0] = x[0] + y[0] - z[0] + uint64_t(rx[v]);
-    to[1] = x[1] + y[1] - z[1] + uint64_t(ry[v]);
-    to[2] = x[2] + y[2] - z[2] + uint64_t(rz[v]);
+    to[0] = damped_parallelogram<j>(x[0], y[0], z[0]) + uint64_t(rx[v]);
+    to[1] = damped_parallelogram<j>(x[1], y[1], z[1]) + uint64_t(ry[v]);
+    to[2] = damped_parallelogram<j>(x[2], y[2], z[2]) + uint64_t(rz[v]);
     shifted |=
         (to[0] + uint64_t(kMaxCoarse)) | (to[1] + uint64_t(kMaxCoarse)) | (to[2] + uint64_t(kMaxCoarse));
   }
   return shifted >= 2 * uint64_t(kMaxCoarse);
+}
+
+// Bits of a zigzagged residual (0 for 0): the encoder's estimate of what a damping costs.
+inline uint32_t residual_bits(uint64_t z) {
+  return z ? 64 - uint32_t(__builtin_clzll(z)) : 0;
+}
+
+}  // namespace
+
+namespace {
+
+// What parse and layout share: the header, widths and stream sizes of a node of node_size bytes, read from
+// r, checked to fit; `sizes` gets the attribute, locked and connectivity streams' sizes.
+PredictiveNode read_layout(ByteReader& r, size_t node_size, uint8_t format, uint32_t known_flags,
+                           uint64_t (&sizes)[3]) {
+  PredictiveNode p;
+  static_cast<NodeHeader&>(p) = NodeHeader::read(r, format, known_flags, node_size);
+  const uint8_t widths = r.u8();
+  p.position_bytes = widths & 15, p.normal_bytes = (widths >> 4) & 3, p.damping = 4 - (widths >> 6);
+  if (p.position_bytes < 1 || p.position_bytes > kMaxPositionBytes || p.damping < 2 ||
+      (p.normal_bytes == 0) != !(p.flags & kHasNormals))
+    r.fail("invalid residual widths");
+  const uint64_t attribute_size = r.varint(), locked_size = r.varint(), connectivity_size = r.varint();
+  p.header_size = r.position();
+  const uint64_t planes = uint64_t(p.vertices) * (3 * p.position_bytes + 2 * p.normal_bytes);  // V ≤ 65536
+  const uint64_t remaining = node_size - std::min<uint64_t>(node_size, p.header_size);
+  if (p.header_size > node_size || planes > remaining || attribute_size > remaining - planes ||
+      locked_size > remaining - planes - attribute_size ||
+      connectivity_size > remaining - planes - attribute_size - locked_size)
+    r.fail("stream sizes do not add up to the node size");
+  sizes[0] = attribute_size, sizes[1] = locked_size, sizes[2] = connectivity_size;
+  return p;
 }
 
 }  // namespace
@@ -41,27 +85,31 @@ bool predict_positions(const int64_t* residual, uint32_t V, const uint32_t* o, u
 PredictiveNode PredictiveNode::parse(std::span<const uint8_t> bytes, uint8_t format, uint32_t known_flags,
                                      const std::string& where) {
   ByteReader r(bytes, where);
-  PredictiveNode p;
-  static_cast<NodeHeader&>(p) = NodeHeader::read(r, format, known_flags, bytes.size());
-  const uint8_t widths = r.u8();
-  p.position_bytes = widths & 15, p.normal_bytes = widths >> 4;
-  if (p.position_bytes < 1 || p.position_bytes > kMaxPositionBytes || p.normal_bytes > kMaxNormalBytes ||
-      (p.normal_bytes == 0) != !(p.flags & kHasNormals))
-    r.fail("invalid residual widths");
-  const uint64_t attribute_size = r.varint(), locked_size = r.varint(), connectivity_size = r.varint();
-  p.header_size = r.position();
-  const uint64_t planes = uint64_t(p.vertices) * (3 * p.position_bytes + 2 * p.normal_bytes);  // V ≤ 65536
-  if (planes > r.remaining() || attribute_size > r.remaining() - planes ||
-      locked_size > r.remaining() - planes - attribute_size ||
-      connectivity_size > r.remaining() - planes - attribute_size - locked_size)
-    r.fail("stream sizes do not add up to the node size");
+  uint64_t sizes[3];
+  PredictiveNode p = read_layout(r, bytes.size(), format, known_flags, sizes);
   p.position_planes = r.bytes(size_t(3) * p.position_bytes * p.vertices, "position residuals");
   p.normal_planes = r.bytes(size_t(2) * p.normal_bytes * p.vertices, "normal residuals");
-  p.attribute_stream = r.bytes(attribute_size, "attribute stream");
-  p.locked_stream = r.bytes(locked_size, "locked stream");
-  p.connectivity = r.bytes(connectivity_size, "connectivity");
+  p.attribute_stream = r.bytes(sizes[0], "attribute stream");
+  p.locked_stream = r.bytes(sizes[1], "locked stream");
+  p.connectivity = r.bytes(sizes[2], "connectivity");
   p.tail = r.bytes(r.remaining(), "tail");
   return p;
+}
+
+NodeSizeBreakdown PredictiveNode::layout(std::span<const uint8_t> bytes, size_t node_size, uint8_t format,
+                                         uint32_t known_flags, const std::string& where, uint64_t* tail) {
+  ByteReader r(bytes, where);
+  uint64_t sizes[3];
+  const PredictiveNode p = read_layout(r, node_size, format, known_flags, sizes);
+  NodeSizeBreakdown b;
+  b.header = p.header_size;
+  b.normals = size_t(2) * p.normal_bytes * p.vertices, b.attributes = sizes[0];
+  b.vertices = size_t(3) * p.position_bytes * p.vertices + b.normals + b.attributes;
+  b.position_low = size_t(3) * p.vertices, b.normal_low = p.normal_bytes ? size_t(2) * p.vertices : 0;
+  b.locked = sizes[1];
+  b.indices = node_size - b.header - b.vertices - b.locked;  // connectivity and tail
+  if (tail) *tail = b.indices - sizes[2];
+  return b;
 }
 
 PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedNode& n,
@@ -72,17 +120,23 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
   PredictiveResiduals r;
   std::vector<int64_t> c(n.c);
   c.insert(c.end(), std::begin(n.cmin), std::end(n.cmin));
-  r.positions.resize(3 * V);
-  uint64_t largest = 0;
-  for (size_t v = 0; v < V; ++v) {
-    const uint32_t* o = &predictors[3 * v];
-    for (int a = 0; a < 3; ++a) {
-      const int64_t predicted = c[3 * size_t(o[0]) + a] + c[3 * size_t(o[1]) + a] - c[3 * size_t(o[2]) + a];
-      r.positions[3 * v + a] = zigzag(c[3 * v + a] - predicted);
-      largest = std::max(largest, r.positions[3 * v + a]);
+  // The damping j whose residuals take the fewest bits (ties: the larger j).
+  uint64_t fewest = UINT64_MAX;
+  std::vector<uint64_t> residuals(3 * V);
+  for (uint32_t j = 4; j >= 2; --j) {
+    uint64_t bits = 0, largest = 0;
+    for (size_t v = 0; v < V; ++v) {
+      const uint32_t* o = &predictors[3 * v];
+      for (int a = 0; a < 3; ++a) {
+        const int64_t predicted = damped_parallelogram(c[3 * size_t(o[0]) + a], c[3 * size_t(o[1]) + a],
+                                                       c[3 * size_t(o[2]) + a], j);
+        residuals[3 * v + a] = zigzag(c[3 * v + a] - predicted);
+        bits += residual_bits(residuals[3 * v + a]), largest = std::max(largest, residuals[3 * v + a]);
+      }
     }
+    if (bits < fewest)
+      fewest = bits, r.damping = j, r.position_bytes = bytes_for(largest), r.positions = residuals;
   }
-  r.position_bytes = bytes_for(largest);
   if (g.mesh->has_normals()) {
     std::vector<glm::vec3> decoded(V + 1);  // predicted_normals reads one past the last
     std::vector<NormalSum> sum;
@@ -101,7 +155,7 @@ std::vector<uint8_t> write_predictive_node(const NodeHeader& header, const Predi
                                            std::span<const uint8_t> tail) {
   ByteWriter w;
   header.write(w);
-  w.u8(static_cast<uint8_t>(r.position_bytes | r.normal_bytes << 4));
+  w.u8(static_cast<uint8_t>(r.position_bytes | r.normal_bytes << 4 | (4 - r.damping) << 6));
   w.varint(attribute_stream.size());
   w.varint(locked_stream.size());
   w.varint(connectivity.size());
@@ -119,9 +173,9 @@ void decode_predicted_vertices(const PredictiveNode& p, std::span<const uint32_t
   const uint32_t V = p.vertices;
   Mesh& m = out.mesh;
   const LockedStream locked = LockedStream::parse(p.locked_stream, V, p.shift, where);
-  // c[v] = c[o1] + c[o2] - c[o] + residual, with entry V holding cmin, the residuals read from their planes
-  // first (one vectorized pass). The arithmetic wraps (unsigned), so hostile residuals cannot overflow; the
-  // results are range-checked in the same pass.
+  // c[v] = P + residual (the damped parallelogram), with entry V holding cmin, the residuals read from their
+  // planes first (one vectorized pass). The arithmetic wraps (unsigned), so hostile residuals cannot
+  // overflow; the results are range-checked in the same pass.
   thread_local std::vector<int64_t> c;
   c.resize(3 * (size_t(V) + 1));
   uint64_t* cu = reinterpret_cast<uint64_t*>(c.data());
@@ -129,7 +183,10 @@ void decode_predicted_vertices(const PredictiveNode& p, std::span<const uint32_t
   thread_local std::vector<int64_t> residual;
   residual.resize(3 * size_t(V));
   read_planes(p.position_planes.data(), V, 3, p.position_bytes, residual.data());
-  const bool out_of_range = predict_positions(residual.data(), V, predictors.data(), cu);
+  const bool out_of_range = p.damping == 4 ? predict_positions<4>(residual.data(), V, predictors.data(), cu)
+                            : p.damping == 3
+                                ? predict_positions<3>(residual.data(), V, predictors.data(), cu)
+                                : predict_positions<2>(residual.data(), V, predictors.data(), cu);
   if (out_of_range) throw Error(where + ": predicted position out of the grid's range");
   // Decoded into scratch and copied (no zero-fill of m.positions first); one spare entry for
   // predicted_normals.

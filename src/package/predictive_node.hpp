@@ -2,16 +2,20 @@
 // layout of a node's bytes, the parallelogram-predicted positions and the normals predicted from them.
 //
 // Bytes of a node:
-//   the common header (node_header.hpp); u8 widths (low nibble: bytes per position residual wp, 1..5; high
-//   nibble: bytes per normal residual wn, 0..3, 0 exactly without normals); varint sizes of the attribute,
-//   locked and connectivity streams; then the position planes (3 wp V bytes), the normal planes (2 wn V
-//   bytes), the attribute stream (vertex_attributes.hpp), the locked stream (coarse_positions.hpp), the
-//   connectivity stream and the tail (the rest: each codec says what).
-// Positions: vertex v's coarse coordinates (quantized_node.hpp) are c[v] = c[o1] + c[o2] - c[o] + residual[v]
-//   (the parallelogram across edge o1-o2 of the triangle o1 o2 o, Touma & Gotsman 1998, "Triangle Mesh
-//   Compression", GI'98) with predictors below v that the codec derives from the connectivity; a single
-//   predictor x is (x, x, x), and index V stands for cmin (no predictor). The residuals are zigzag-mapped,
-//   byte b of axis a at plane 3b + a (byte_planes.hpp).
+//   the common header (node_header.hpp); u8 widths (bits 0-3: bytes per position residual wp, 1..5; bits 4-5:
+//   bytes per normal residual wn, 0..3, 0 exactly without normals; bits 6-7: the damping j below, 4 - value);
+//   varint sizes of the attribute, locked and connectivity streams; then the position planes (3 wp V bytes),
+//   the normal planes (2 wn V bytes), the attribute stream (vertex_attributes.hpp), the locked stream
+//   (coarse_positions.hpp), the connectivity stream and the tail (the rest: each codec says what).
+// Positions: vertex v's coarse coordinates (quantized_node.hpp) are c[v] = P + residual[v] with P the
+//   parallelogram across edge o1-o2 of the triangle o1 o2 o (Touma & Gotsman 1998, "Triangle Mesh
+//   Compression", GI'98) damped toward the edge's midpoint m = (c[o1] + c[o2]) / 2: P = m + j/4 (m - c[o]),
+//   in integers P = floor(((4 + j)(c[o1] + c[o2]) - 2j c[o] + 4) / 8), j in {4, 3, 2} chosen per node by the
+//   encoder (j = 4 is the plain parallelogram c[o1] + c[o2] - c[o]; the simplified meshes of coarse levels
+//   are irregular and predict better with j = 3 or 2: measured on elephant_1m, levels 1-10 store 3-5 % fewer
+//   position bits). Predictors o1, o2, o lie below v; the codec derives them from the connectivity; a single
+//   predictor x is (x, x, x) (P = x for every j), and index V stands for cmin (no predictor). The residuals
+//   are zigzag-mapped, byte b of axis a at plane 3b + a (byte_planes.hpp).
 // Normals: predicted from the decoded positions (predicted_normals.hpp).
 #pragma once
 
@@ -27,6 +31,7 @@ namespace lodstream::package {
 
 struct PredictiveNode : NodeHeader {
   uint32_t position_bytes = 0, normal_bytes = 0;
+  uint32_t damping = 4;  // j of the position prediction
   size_t header_size = 0;
   std::span<const uint8_t> position_planes, normal_planes, attribute_stream, locked_stream, connectivity,
       tail;
@@ -35,6 +40,10 @@ struct PredictiveNode : NodeHeader {
   // that add up); throws lodstream::Error starting with `where`. Cost: O(1).
   static PredictiveNode parse(std::span<const uint8_t> bytes, uint8_t format, uint32_t known_flags,
                               const std::string& where);
+  // The parts of a node of `node_size` bytes from its first bytes (NodeCodec::layout; the tail counts as
+  // connectivity), checked as parse checks them; `tail` receives the tail's size. Cost: O(1).
+  static NodeSizeBreakdown layout(std::span<const uint8_t> bytes, size_t node_size, uint8_t format,
+                                  uint32_t known_flags, const std::string& where, uint64_t* tail = nullptr);
 };
 
 // The encoder's side. Residuals of the quantized node's coarse coordinates against `predictors` (3 per
@@ -44,6 +53,7 @@ struct PredictiveNode : NodeHeader {
 struct PredictiveResiduals {
   std::vector<uint64_t> positions, normals;
   uint32_t position_bytes = 0, normal_bytes = 0;
+  uint32_t damping = 4;  // j
 };
 PredictiveResiduals predictive_residuals(const NodeGeometry& geometry, const QuantizedNode& node,
                                          std::span<const uint32_t> predictors,

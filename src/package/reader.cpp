@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "core/error.hpp"
+#include "package/page_parts.hpp"
 
 namespace lodstream::package {
 
@@ -85,8 +86,8 @@ std::vector<uint8_t> PackageReader::read_range(const Range& range, const std::st
   return stored;
 }
 
-std::vector<uint8_t> PackageReader::unpack(const Range& range, std::span<const uint8_t> stored,
-                                           const std::string& what) const {
+void PackageReader::check_stored(const Range& range, std::span<const uint8_t> stored,
+                                 const std::string& what) const {
   if (stored.size() != range.size) {
     throw Error(where(what + ": " + std::to_string(stored.size()) + " bytes given, " +
                       std::to_string(range.size) + " expected"));
@@ -95,6 +96,11 @@ std::vector<uint8_t> PackageReader::unpack(const Range& range, std::span<const u
     throw Error(
         where(what + " at offset " + std::to_string(range.offset) + ": checksum mismatch (corrupted)"));
   }
+}
+
+std::vector<uint8_t> PackageReader::unpack(const Range& range, std::span<const uint8_t> stored,
+                                           const std::string& what) const {
+  check_stored(range, stored, what);
   return zstd_decompress(stored, range.raw_size, where(what));
 }
 
@@ -134,7 +140,10 @@ const NodeRecord& PackageReader::node(uint32_t id) {
 
 std::vector<uint8_t> PackageReader::unpack_page(uint32_t page, std::span<const uint8_t> stored) const {
   if (page >= root_.pages.size()) throw Error(where("page " + std::to_string(page) + " does not exist"));
-  return unpack(root_.pages[page], stored, "page " + std::to_string(page));
+  const Range& range = root_.pages[page];
+  const std::string what = "page " + std::to_string(page);
+  check_stored(range, stored, what);
+  return decompress_page(stored, range.raw_size, *codec_, where(what));
 }
 
 std::vector<uint8_t> PackageReader::read_page(uint32_t page) const {

@@ -64,6 +64,8 @@ class PackageReader {
 
  private:
   std::vector<uint8_t> read_range(const Range& range, const std::string& what) const;
+  // Throws unless `stored` has the range's size and checksum.
+  void check_stored(const Range& range, std::span<const uint8_t> stored, const std::string& what) const;
   std::vector<uint8_t> unpack(const Range& range, std::span<const uint8_t> stored,
                               const std::string& what) const;
   void check_layout() const;

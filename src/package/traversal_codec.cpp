@@ -61,15 +61,10 @@ DecodedNode TraversalCodec::decode(std::span<const uint8_t> bytes, const Positio
   return out;
 }
 
-NodeSizeBreakdown TraversalCodec::breakdown(std::span<const uint8_t> bytes, const std::string& where) const {
-  if (!bytes.empty() && bytes[0] == kOrderedFormat) return ordered_codec().breakdown(bytes, where);
-  const PredictiveNode p = PredictiveNode::parse(bytes, kFormat, kAllFlags, where);
-  NodeSizeBreakdown b;
-  b.header = p.header_size;
-  b.vertices = p.position_planes.size() + p.normal_planes.size() + p.attribute_stream.size();
-  b.locked = p.locked_stream.size();
-  b.indices = p.connectivity.size() + p.tail.size();
-  return b;
+NodeSizeBreakdown TraversalCodec::layout(std::span<const uint8_t> bytes, size_t node_size,
+                                         const std::string& where) const {
+  if (!bytes.empty() && bytes[0] == kOrderedFormat) return ordered_codec().layout(bytes, node_size, where);
+  return PredictiveNode::layout(bytes, node_size, kFormat, kAllFlags, where);
 }
 
 }  // namespace lodstream::package

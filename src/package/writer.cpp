@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "package/meshopt_codec.hpp"
+#include "package/page_parts.hpp"
 
 namespace lodstream::package {
 
@@ -74,6 +75,7 @@ void PackageWriter::place(size_t first, size_t end) {
     locations_[e.id] = {uint32_t(pages_.size() + pending_.size()), uint32_t(page_.size()), uint32_t(e.size),
                         true};
     page_.insert(page_.end(), group_bytes_.begin() + e.offset, group_bytes_.begin() + e.offset + e.size);
+    page_nodes_.push_back(uint32_t(e.size));
   }
 }
 
@@ -91,20 +93,22 @@ void PackageWriter::end_group() {
 void PackageWriter::flush_page() {
   if (page_.empty()) return;
   pending_.push_back(std::move(page_));
-  page_ = {};
+  pending_nodes_.push_back(std::move(page_nodes_));
+  page_ = {}, page_nodes_ = {};
   if (pending_.size() >= kPendingPages) write_pending();
 }
 
 void PackageWriter::write_pending() {
   std::vector<std::vector<uint8_t>> stored(pending_.size());
   tbb::parallel_for(size_t(0), pending_.size(), [&](size_t i) {
-    stored[i] = zstd_compress(pending_[i], options_.zstd_level, page_min_match(options_.codec));
+    stored[i] = compress_page(pending_[i], pending_nodes_[i], node_codec(options_.codec), options_.zstd_level,
+                              page_min_match(options_.codec));
   });
   for (size_t i = 0; i < pending_.size(); ++i) {
     pages_.push_back(write_stored(stored[i], uint32_t(pending_[i].size())));
     page_bytes_ += stored[i].size();
   }
-  pending_.clear();
+  pending_.clear(), pending_nodes_.clear();
 }
 
 uint32_t PackageWriter::add_blob(std::span<const uint8_t> bytes) {

@@ -97,10 +97,12 @@ class PackageWriter {
   std::vector<uint8_t> group_bytes_;
   std::vector<Entry> group_;
   std::vector<uint8_t> page_;
+  std::vector<uint32_t> page_nodes_;  // the sizes of page_'s nodes, in order (page_parts.hpp)
   // Closed pages not yet compressed: kPendingPages at a time are compressed on every core (zstd was a serial
   // 3 % of an elephant_1m bake), then written in page order, so the bytes do not depend on thread timing.
   static constexpr size_t kPendingPages = 16;
   std::vector<std::vector<uint8_t>> pending_;
+  std::vector<std::vector<uint32_t>> pending_nodes_;
   std::vector<Location> locations_;  // by node id
   std::vector<Range> pages_, blobs_;
   uint64_t page_bytes_ = 0;

@@ -1,0 +1,43 @@
+// Data pages stored by part (format version 3). zstd entropy-codes a block's literals with one Huffman table,
+// so a page of whole nodes codes position residuals, normal residuals, connectivity symbols and headers with
+// one table for all. Stored by part, a page is the same bytes regrouped: the parts of NodeSizeBreakdown
+// (header, positions' low byte planes, their other planes, normals' low and other planes, attributes,
+// locked, connectivity: eight) of every node, part by part, each part ending a zstd block, so that each gets
+// its own tables (matches may still reach back across parts). Measured (bake, codec 3, zstd 9, min match 6,
+// whole package), six parts (positions and normals whole), then eight: elephant_1m 7,279,505 -> 6,850,221 B
+// (-5.9 %) -> 6,749,830 (also with the damped parallelogram: -0.4 % of this), refined_elephant 569,408 ->
+// 539,775 (-5.2 %) -> 530,950 (-0.9 %), motorBike (10-bit normals) 2,607,957 -> 2,528,943 (-3.0 %), then -1.4
+// %; decode (bench_package, codec 3, checksum + zstd + codec) 33.4 -> 31.4 M triangles/s per core (load 5.5).
+//
+// The regrouped bytes (the zstd frame's content): eight varints, the sizes of the eight part streams; then
+// the streams. The header stream holds, per node in page order, varint node size then the node's header; the
+// other streams the node's part, in the same order. A reader walks the header stream: the codec's layout()
+// of each header gives the sizes of that node's parts (NodeCodec::layout), and copying them back in order
+// gives the page of whole nodes that the node records point into. A page whose frame holds exactly the
+// page's raw size is stored whole (the writer keeps whichever is smaller, and stores whole a page whose
+// bytes are not all codec nodes).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "package/node_codec.hpp"
+
+namespace lodstream::package {
+
+// The stored bytes of a page of whole nodes (`node_sizes`, in page order, add up to page.size()): one zstd
+// frame at `level` / `min_match` (format.hpp's zstd_compress), by part when `codec` parses every node and
+// that is smaller, else whole. Cost: two zstd compressions of the page.
+std::vector<uint8_t> compress_page(std::span<const uint8_t> page, std::span<const uint32_t> node_sizes,
+                                   const NodeCodec& codec, int level, int min_match);
+
+// The page of whole nodes (raw_size bytes) from its stored frame, either form. Every size is checked: a
+// corrupted or hostile page gives a lodstream::Error starting with `where`, never a crash or an allocation
+// above 2 raw_size + 64 bytes. Cost: a zstd decompression, plus a copy of the page when stored by part.
+std::vector<uint8_t> decompress_page(std::span<const uint8_t> stored, uint32_t raw_size,
+                                     const NodeCodec& codec, const std::string& where);
+
+}  // namespace lodstream::package

@@ -1,0 +1,119 @@
+// Data pages stored by part (package/page_parts.hpp): they round-trip, are smaller than whole pages for the
+// byte-plane codecs, pages of non-codec bytes stay whole, and hostile regrouped bytes are errors.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/error.hpp"
+#include "package/format.hpp"
+#include "package/meshopt_codec.hpp"
+#include "package/page_parts.hpp"
+#include "package/predictive_codec.hpp"
+#include "package/traversal_codec.hpp"
+#include "package_fixture.hpp"
+#include "support/shapes.hpp"
+
+namespace lodstream::test {
+namespace {
+
+using namespace package;
+
+struct Page {
+  std::vector<uint8_t> bytes;
+  std::vector<uint32_t> node_sizes;
+};
+
+// A sphere with normals cut into chunks of 64 triangles, each encoded by `codec`, one after the other.
+Page sphere_page(const NodeCodec& codec) {
+  const Mesh sphere = uv_sphere(1.0f, 24, 32);
+  const PositionGrid grid = PositionGrid::for_bounds(sphere.bounds());
+  std::vector<std::vector<uint8_t>> locked;
+  Page page;
+  for (const Mesh& chunk : split_into_chunks(sphere, 64, locked)) {
+    NodeGeometry g;
+    g.mesh = &chunk;
+    const std::vector<uint8_t> node = codec.encode(g, grid);
+    page.bytes.insert(page.bytes.end(), node.begin(), node.end());
+    page.node_sizes.push_back(uint32_t(node.size()));
+  }
+  return page;
+}
+
+// The regrouped bytes a page stored by part decompresses to.
+std::vector<uint8_t> content(std::span<const uint8_t> stored) {
+  return zstd_decompress_at_most(stored, UINT32_MAX, "test");
+}
+
+class PageParts : public ::testing::TestWithParam<uint32_t> {};
+
+INSTANTIATE_TEST_SUITE_P(Codecs, PageParts,
+                         ::testing::Values(MeshoptCodec::kId, PredictiveCodec::kId, TraversalCodec::kId),
+                         [](const auto& info) { return "codec" + std::to_string(info.param); });
+
+TEST_P(PageParts, RoundTripAndNeverLargerThanWhole) {
+  const NodeCodec& codec = node_codec(GetParam());
+  const Page page = sphere_page(codec);
+  ASSERT_GT(page.node_sizes.size(), 10u);
+  const std::vector<uint8_t> stored = compress_page(page.bytes, page.node_sizes, codec, 9, 6);
+  EXPECT_EQ(decompress_page(stored, uint32_t(page.bytes.size()), codec, "page"), page.bytes);
+  const size_t whole = zstd_compress(page.bytes, 9, 6).size();
+  EXPECT_LE(stored.size(), whole);
+  if (GetParam() != MeshoptCodec::kId) {
+    // Residual planes, connectivity and headers with tables of their own: stored by part, and smaller.
+    EXPECT_GT(content(stored).size(), page.bytes.size());
+    EXPECT_LT(stored.size(), whole);
+  }
+}
+
+TEST(PageParts, PagesOfNonCodecBytesAreStoredWhole) {
+  std::vector<uint8_t> bytes(3000);
+  for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = uint8_t(i * 7 % 251);
+  const std::vector<uint32_t> sizes = {1000, 1500, 500};
+  const NodeCodec& codec = node_codec(TraversalCodec::kId);
+  const std::vector<uint8_t> stored = compress_page(bytes, sizes, codec, 9, 6);
+  EXPECT_EQ(content(stored).size(), bytes.size());
+  EXPECT_EQ(decompress_page(stored, uint32_t(bytes.size()), codec, "page"), bytes);
+}
+
+TEST(PageParts, HostileRegroupedBytesAreErrorsOrPagesOfTheRightSize) {
+  const NodeCodec& codec = node_codec(TraversalCodec::kId);
+  const Page page = sphere_page(codec);
+  const uint32_t raw_size = uint32_t(page.bytes.size());
+  const std::vector<uint8_t> good = content(compress_page(page.bytes, page.node_sizes, codec, 9, 6));
+  ASSERT_GT(good.size(), raw_size);
+  auto unpack = [&](const std::vector<uint8_t>& regrouped) {
+    return decompress_page(zstd_compress(regrouped, 1), raw_size, codec, "page 7");
+  };
+  EXPECT_EQ(unpack(good), page.bytes);
+  auto expect_error = [&](std::vector<uint8_t> regrouped, const char* what) {
+    try {
+      unpack(regrouped);
+      ADD_FAILURE() << what << ": no error";
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("page 7", 0), 0u) << e.what();
+    }
+  };
+  std::vector<uint8_t> bad = good;
+  bad.push_back(0);
+  expect_error(bad, "a byte of no node");
+  bad = good;
+  bad.pop_back();
+  expect_error(bad, "a missing byte");
+  bad = good;
+  bad[0] ^= 1;  // the header stream's size
+  expect_error(bad, "stream sizes");
+  expect_error(std::vector<uint8_t>(2 * size_t(raw_size) + 65, 0), "larger than any regrouping");
+
+  std::mt19937 rng(7);
+  for (int i = 0; i < 400; ++i) {
+    bad = good;
+    for (int k = 0; k < 1 + i % 4; ++k) bad[rng() % bad.size()] = uint8_t(rng());
+    try {
+      EXPECT_EQ(unpack(bad).size(), raw_size);  // bytes the codec itself checks when it decodes the nodes
+    } catch (const Error&) {
+    }
+  }
+}
+
+}  // namespace
+}  // namespace lodstream::test
