@@ -6,6 +6,7 @@
 #include "core/error.hpp"
 #include "package/bytes.hpp"
 #include "package/format.hpp"
+#include "package/meshopt_codec.hpp"
 
 namespace lodstream::package {
 
@@ -63,9 +64,8 @@ std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<co
 
 std::vector<uint8_t> compress_page(std::span<const uint8_t> page, std::span<const uint32_t> node_sizes,
                                    const NodeCodec& codec, int level, int min_match) {
-  std::vector<uint8_t> whole = zstd_compress(page, level, min_match);
   const auto streams = regroup(page, node_sizes, codec);
-  if (!streams) return whole;
+  if (!streams) return zstd_compress(page, level, min_match);
   std::array<std::span<const uint8_t>, kParts + 1> parts;
   for (size_t i = 0; i <= kParts; ++i) parts[i] = (*streams)[i];
   // The sizes and the header stream share the first block.
@@ -73,6 +73,8 @@ std::vector<uint8_t> compress_page(std::span<const uint8_t> page, std::span<cons
   head.insert(head.end(), (*streams)[1].begin(), (*streams)[1].end());
   parts[1] = head;
   std::vector<uint8_t> by_part = zstd_compress_parts(std::span(parts).subspan(1), level, min_match);
+  if (codec.id() != MeshoptCodec::kId) return by_part;
+  std::vector<uint8_t> whole = zstd_compress(page, level, min_match);
   return by_part.size() < whole.size() ? by_part : whole;
 }
 

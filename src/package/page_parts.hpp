@@ -14,8 +14,12 @@
 // other streams the node's part, in the same order. A reader walks the header stream: the codec's layout()
 // of each header gives the sizes of that node's parts (NodeCodec::layout), and copying them back in order
 // gives the page of whole nodes that the node records point into. A page whose frame holds exactly the
-// page's raw size is stored whole (the writer keeps whichever is smaller, and stores whole a page whose
-// bytes are not all codec nodes).
+// page's raw size is stored whole: a page whose bytes are not all codec nodes, or a codec-1 page that is
+// smaller whole. Pages of the byte-plane codecs (2, 3) are not also compressed whole: by part was smaller on
+// every page of elephant_1m, motorBike and refined_elephant with codecs 2 and 3 and of the city with codec 3
+// (2,378 pages; elephant_1m codec 3 6,320,159 vs 6,764,425 B), and the second compression cost about a tenth
+// of a bake's CPU. Codec 1's pages were smaller by part too on those meshes (400 pages), but not always: a
+// small page of a test sphere is 1 % larger by part, so codec 1 keeps whichever is smaller.
 #pragma once
 
 #include <cstdint>
@@ -29,8 +33,8 @@
 namespace lodstream::package {
 
 // The stored bytes of a page of whole nodes (`node_sizes`, in page order, add up to page.size()): one zstd
-// frame at `level` / `min_match` (format.hpp's zstd_compress), by part when `codec` parses every node and
-// that is smaller, else whole. Cost: two zstd compressions of the page.
+// frame at `level` / `min_match` (format.hpp's zstd_compress), by part when `codec` parses every node (for
+// codec 1: and that is smaller), else whole. Cost: one zstd compression of the page (two for codec 1).
 std::vector<uint8_t> compress_page(std::span<const uint8_t> page, std::span<const uint32_t> node_sizes,
                                    const NodeCodec& codec, int level, int min_match);
 

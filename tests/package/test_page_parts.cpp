@@ -50,7 +50,7 @@ INSTANTIATE_TEST_SUITE_P(Codecs, PageParts,
                          ::testing::Values(MeshoptCodec::kId, PredictiveCodec::kId, TraversalCodec::kId),
                          [](const auto& info) { return "codec" + std::to_string(info.param); });
 
-TEST_P(PageParts, RoundTripAndNeverLargerThanWhole) {
+TEST_P(PageParts, RoundTripByPartAndNoLargerThanWhole) {
   const NodeCodec& codec = node_codec(GetParam());
   const Page page = sphere_page(codec);
   ASSERT_GT(page.node_sizes.size(), 10u);
