@@ -92,15 +92,8 @@ ContentHash ContentHasher::digest() const {
 }
 
 std::vector<uint8_t> zstd_compress(std::span<const uint8_t> raw, int level, int min_match) {
-  std::unique_ptr<ZSTD_CCtx, size_t (*)(ZSTD_CCtx*)> cctx(ZSTD_createCCtx(), ZSTD_freeCCtx);
-  if (!cctx) throw Error("out of memory creating a zstd context");
-  std::vector<uint8_t> out(ZSTD_compressBound(raw.size()));
-  size_t n = ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_compressionLevel, level);
-  if (!ZSTD_isError(n) && min_match != 0) n = ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_minMatch, min_match);
-  if (!ZSTD_isError(n)) n = ZSTD_compress2(cctx.get(), out.data(), out.size(), raw.data(), raw.size());
-  if (ZSTD_isError(n)) throw Error(std::string("zstd compression failed: ") + ZSTD_getErrorName(n));
-  out.resize(n);
-  return out;
+  const std::span<const uint8_t> whole[1] = {raw};
+  return zstd_compress_parts(whole, level, min_match);  // one part: the frame ZSTD_compress2 writes
 }
 
 std::vector<uint8_t> zstd_compress_parts(std::span<const std::span<const uint8_t>> parts, int level,

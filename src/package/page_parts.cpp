@@ -48,11 +48,11 @@ std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<co
       return std::nullopt;  // not a codec node (NodeEncoding::raw)
     }
     put_varint(out[1], size);
+    const std::array<size_t, kParts> n = part_sizes(b);
     size_t from = 0;
     for (size_t p = 0; p < kParts; ++p) {
-      const size_t n = part_sizes(b)[p];
-      out[1 + p].insert(out[1 + p].end(), node.begin() + from, node.begin() + from + n);
-      from += n;
+      out[1 + p].insert(out[1 + p].end(), node.begin() + from, node.begin() + from + n[p]);
+      from += n[p];
     }
     at += size;
   }

@@ -19,14 +19,11 @@ constexpr uint32_t kMaxPositionBytes = 5, kMaxNormalBytes = 3;
 constexpr int64_t kMaxCoarse = int64_t(1) << 32;
 
 // The damped parallelogram P of predictive_node.hpp, wrapping (uint64) until the final arithmetic shift, so
-// that hostile coordinates never overflow; j = 4 takes the plain form.
-template <uint32_t j>
-inline uint64_t damped_parallelogram(uint64_t a, uint64_t b, uint64_t c) {
-  if constexpr (j == 4) return a + b - c;
+// that hostile coordinates never overflow; j = 4 takes the plain form. The decoder calls it with j a
+// template constant (predict_positions), the encoder with each j it tries.
+inline uint64_t damped_parallelogram(uint64_t a, uint64_t b, uint64_t c, uint32_t j) {
+  if (j == 4) return a + b - c;
   return uint64_t(int64_t((4 + j) * (a + b) - 2 * j * c + 4) >> 3);
-}
-inline int64_t damped_parallelogram(int64_t a, int64_t b, int64_t c, uint32_t j) {
-  return j == 4 ? a + b - c : (int64_t(4 + j) * (a + b) - int64_t(2 * j) * c + 4) >> 3;
 }
 
 // c[v] = P + residual[v] per axis for v < V (predictive_node.hpp), wrapping, the residuals as read_planes
@@ -39,9 +36,9 @@ bool predict_positions(const int64_t* residual, uint32_t V, const uint32_t* o, u
   for (uint32_t v = 0; v < V; ++v, o += 3) {
     const uint64_t *x = c + 3 * size_t(o[0]), *y = c + 3 * size_t(o[1]), *z = c + 3 * size_t(o[2]);
     uint64_t* to = c + 3 * size_t(v);
-    to[0] = damped_parallelogram<j>(x[0], y[0], z[0]) + uint64_t(rx[v]);
-    to[1] = damped_parallelogram<j>(x[1], y[1], z[1]) + uint64_t(ry[v]);
-    to[2] = damped_parallelogram<j>(x[2], y[2], z[2]) + uint64_t(rz[v]);
+    to[0] = damped_parallelogram(x[0], y[0], z[0], j) + uint64_t(rx[v]);
+    to[1] = damped_parallelogram(x[1], y[1], z[1], j) + uint64_t(ry[v]);
+    to[2] = damped_parallelogram(x[2], y[2], z[2], j) + uint64_t(rz[v]);
     shifted |=
         (to[0] + uint64_t(kMaxCoarse)) | (to[1] + uint64_t(kMaxCoarse)) | (to[2] + uint64_t(kMaxCoarse));
   }
@@ -128,8 +125,9 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
     for (size_t v = 0; v < V; ++v) {
       const uint32_t* o = &predictors[3 * v];
       for (int a = 0; a < 3; ++a) {
-        const int64_t predicted = damped_parallelogram(c[3 * size_t(o[0]) + a], c[3 * size_t(o[1]) + a],
-                                                       c[3 * size_t(o[2]) + a], j);
+        const int64_t predicted =
+            int64_t(damped_parallelogram(uint64_t(c[3 * size_t(o[0]) + a]), uint64_t(c[3 * size_t(o[1]) + a]),
+                                         uint64_t(c[3 * size_t(o[2]) + a]), j));
         residuals[3 * v + a] = zigzag(c[3 * v + a] - predicted);
         bits += residual_bits(residuals[3 * v + a]), largest = std::max(largest, residuals[3 * v + a]);
       }
