@@ -39,10 +39,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <memory>
 #include <mutex>
+#include <numeric>
 #include <span>
+#include <unordered_map>
 
 #include "bake_textures.hpp"
 #include "command.hpp"
@@ -135,16 +138,74 @@ uint32_t cluster_normal_bits(float error, const BakeArgs& args) {
   return error > 0.0f ? std::min(args.normal_bits, args.coarse_normal_bits) : args.normal_bits;
 }
 
-// A DAG cluster's node: on its mesh's grid, free vertices with the shift for its error, locked ones exact. A
-// level-0 cluster (error 0, shift 0) is stored exactly without its locked flags, which are not yet set when
-// the DAG hands it over (DagOptions::finished).
-std::vector<uint8_t> encode_cluster(const NodeCodec& codec, const hierarchy::DagCluster& c,
-                                    const PositionGrid& grid, const BakeArgs& args) {
+// A record (package/node_codec.hpp): DAG clusters [first, first + count) of one page group welded into one
+// mesh on their identical vertices (same position and attributes: seams stay split), each cluster's triangles
+// a consecutive range, stored as one node with one vertex pool. Precision: free vertices are shared only by
+// clusters of one producing group and one consuming group (the header comment), so only inside one record,
+// and all clusters that hold a free vertex use one shift; the record stores free vertices with its clusters'
+// smallest shift (a cluster of a larger one decodes more precisely than its stored error assumes, which stays
+// a bound) and every vertex locked in any of its clusters exactly, so no other record's decoding changes and
+// cuts stay crack-free. Normals: the clusters' largest normal bits. `vertices[c]` receives cluster c's
+// distinct vertices (what a reader's cluster holds: welding also merges identical vertices within a cluster).
+std::vector<uint8_t> encode_record(const NodeCodec& codec, const hierarchy::ClusterDag& dag,
+                                   std::span<const uint32_t> clusters, const PositionGrid& grid,
+                                   const BakeArgs& args, std::span<uint32_t> vertices) {
+  Mesh mesh;
+  std::vector<uint8_t> locked;
+  std::vector<uint32_t> cluster_triangles;
   NodeGeometry geometry;
-  geometry.normal_bits = cluster_normal_bits(c.error, args);
-  geometry.mesh = &c.mesh;
-  geometry.position_shift = position_shift(c.error, grid);
-  if (geometry.position_shift > 0) geometry.locked = c.locked;
+  geometry.position_shift = UINT32_MAX;
+  geometry.normal_bits = 0;
+  for (uint32_t c : clusters) {
+    const hierarchy::DagCluster& cluster = dag.clusters[c];
+    geometry.position_shift = std::min(geometry.position_shift, position_shift(cluster.error, grid));
+    geometry.normal_bits = std::max(geometry.normal_bits, cluster_normal_bits(cluster.error, args));
+  }
+  // Weld key: the bits of position, normal, UV and colour.
+  using Key = std::array<uint32_t, 12>;
+  struct KeyHash {
+    size_t operator()(const Key& k) const {
+      uint64_t h = 0x9e3779b97f4a7c15ull;
+      for (uint32_t x : k) h = (h ^ x) * 0xff51afd7ed558ccdull;
+      return size_t(h ^ (h >> 32));
+    }
+  };
+  std::unordered_map<Key, uint32_t, KeyHash> welded;
+  std::vector<uint32_t> remap, seen;
+  for (size_t k = 0; k < clusters.size(); ++k) {
+    const Mesh& m = dag.clusters[clusters[k]].mesh;
+    const std::vector<uint8_t>& cluster_locked = dag.clusters[clusters[k]].locked;
+    remap.resize(m.vertex_count());
+    for (uint32_t v = 0; v < m.vertex_count(); ++v) {
+      Key key{};
+      std::memcpy(&key[0], &m.positions[v], 12);
+      if (m.has_normals()) std::memcpy(&key[3], &m.normals[v], 12);
+      if (m.has_uvs()) std::memcpy(&key[6], &m.uvs[v], 8);
+      if (m.has_colors()) std::memcpy(&key[8], &m.colors[v], 16);
+      const auto [it, added] = welded.emplace(key, uint32_t(mesh.positions.size()));
+      remap[v] = it->second;
+      if (added) {
+        mesh.positions.push_back(m.positions[v]);
+        if (m.has_normals()) mesh.normals.push_back(m.normals[v]);
+        if (m.has_uvs()) mesh.uvs.push_back(m.uvs[v]);
+        if (m.has_colors()) mesh.colors.push_back(m.colors[v]);
+        locked.push_back(0);
+      }
+      if (!cluster_locked.empty() && cluster_locked[v]) locked[remap[v]] = 1;
+    }
+    // The cluster's distinct vertices as its triangles use them.
+    seen.assign(mesh.positions.size(), 0);
+    uint32_t distinct = 0;
+    for (uint32_t i : m.indices) {
+      mesh.indices.push_back(remap[i]);
+      distinct += seen[remap[i]] == 0, seen[remap[i]] = 1;
+    }
+    vertices[k] = distinct;
+    cluster_triangles.push_back(uint32_t(m.triangle_count()));
+  }
+  geometry.mesh = &mesh;
+  if (geometry.position_shift > 0) geometry.locked = locked;
+  if (clusters.size() > 1) geometry.cluster_triangles = cluster_triangles;
   return codec.encode(geometry, grid);
 }
 
@@ -257,10 +318,7 @@ int run_bake(const BakeArgs& args) {
   std::vector<hierarchy::ProgressiveSteps> pms(scene.meshes.size());  // steps empty: a DAG
   std::vector<Bounds> bounds(scene.meshes.size());
   std::vector<PositionGrid> grids(scene.meshes.size());
-  // Encoded DAG clusters by mesh and cluster, encoded as the DAG finishes them (DagOptions::finished): the
-  // encoding fills the core that the DAG's grouping (METIS) leaves idle.
   const NodeCodec& codec = node_codec(args.codec);
-  std::vector<std::vector<std::vector<uint8_t>>> encoded_clusters(scene.meshes.size());
   std::atomic<size_t> done_triangles{0};
   std::mutex progress_mutex;
   int shown_percent = -1;  // the bar is redrawn when the percentage changes (not per cluster batch)
@@ -294,21 +352,13 @@ int run_bake(const BakeArgs& args) {
       const size_t done_here = triangles - std::min(triangles, active);
       if (done_here > reported) report(done_here - reported), reported = done_here;
     };
-    options.finished = [&, m](const hierarchy::ClusterDag& dag, std::span<const uint32_t> clusters) {
-      std::vector<std::vector<uint8_t>>& out = encoded_clusters[m];
-      out.resize(dag.clusters.size());
-      tbb::parallel_for(size_t(0), clusters.size(), [&](size_t i) {
-        out[clusters[i]] = encode_cluster(codec, dag.clusters[clusters[i]], grids[m], args);
-        out[clusters[i]].shrink_to_fit();  // kept until the pages are written: no growth slack
-      });
-    };
     dags[m] = hierarchy::build_cluster_dag(std::move(scene.meshes[m]), options);  // the DAG holds it now
     report(triangles - reported);
     scene.meshes[m] = Mesh{};
   });
   std::fprintf(stderr, "\n");
 
-  end_phase("hierarchy");  // DAG clusters included: they are encoded as the DAG finishes them
+  end_phase("hierarchy");
 
   // HLOD over the objects (none for a single object).
   const double hlod_start = elapsed();
@@ -520,26 +570,44 @@ int run_bake(const BakeArgs& args) {
       for (uint32_t k : dag.groups[c.parent_group].clusters) n.parents.push_back(ids[k]);
   });
 
-  // Encode what is left (HLOD proxies, progressive steps; DAG clusters are encoded already), in parallel a
-  // batch of page groups at a time, and write (serial).
+  // Encode, in parallel a batch of page groups at a time, and write (serial). Records: within a page group,
+  // consecutive DAG clusters (a group's input clusters, or a DAG's roots) are one record of at most
+  // codec.max_record_clusters() clusters (encode_record); every other node is stored alone.
   WriterOptions writer_options;
   writer_options.codec = args.codec;
   PackageWriter writer(args.output, writer_options);
   NodeSizeBreakdown breakdown;
-  size_t first = 0;
+  auto is_cluster = [&](size_t id) { return order[id].mesh != kNone && pms[order[id].mesh].steps.empty(); };
+  struct Record {
+    size_t first, count;  // node ids [first, first + count)
+  };
+  std::vector<Record> batch;
   std::vector<std::vector<uint8_t>> encoded;
+  size_t first = 0;
   for (size_t g = 0; g < page_group_ends.size();) {
-    size_t g_end = g, end = first;
-    while (g_end < page_group_ends.size() && page_group_ends[g_end] - first < 4096)
-      end = page_group_ends[g_end++];
-    if (g_end == g) end = page_group_ends[g_end++];
-    encoded.assign(end - first, {});
-    tbb::parallel_for(first, end, [&](size_t id) {
+    batch.clear();
+    for (size_t nodes = 0; g < page_group_ends.size() && (batch.empty() || nodes < 4096); ++g) {
+      for (size_t id = first; id < page_group_ends[g];) {
+        size_t count = 1;
+        while (is_cluster(id) && id + count < page_group_ends[g] && is_cluster(id + count) &&
+               order[id + count].mesh == order[id].mesh && count < codec.max_record_clusters())
+          ++count;
+        batch.push_back({id, count});
+        id += count;
+      }
+      nodes += page_group_ends[g] - first;
+      first = page_group_ends[g];
+      batch.push_back({first, 0});  // the page group's end
+    }
+    encoded.assign(batch.size(), {});
+    tbb::parallel_for(size_t(0), batch.size(), [&](size_t r) {
+      const size_t id = batch[r].first;
+      if (batch[r].count == 0) return;
       NodeGeometry geometry;
       geometry.normal_bits = args.normal_bits;
       if (order[id].mesh == kNone) {  // an HLOD proxy: finest grid of the HLOD representation
         geometry.mesh = &hlod.nodes[order[id].cluster].mesh;
-        encoded[id - first] = codec.encode(geometry, ps.representations[hlod_representation].grid);
+        encoded[r] = codec.encode(geometry, ps.representations[hlod_representation].grid);
         return;
       }
       if (!pms[order[id].mesh].steps.empty()) {  // a progressive step: finest grid, order kept
@@ -551,22 +619,29 @@ int run_bake(const BakeArgs& args) {
         geometry.preserve_order = true;
         geometry.index_end = pm.vertices;
         geometry.extra = chains;
-        encoded[id - first] = codec.encode(geometry, ps.representations[order[id].mesh].grid);
+        encoded[r] = codec.encode(geometry, ps.representations[order[id].mesh].grid);
         return;
       }
-      encoded[id - first] = std::move(encoded_clusters[order[id].mesh][order[id].cluster]);
+      std::vector<uint32_t> clusters, vertices(batch[r].count);
+      for (size_t k = 0; k < batch[r].count; ++k) clusters.push_back(order[id + k].cluster);
+      encoded[r] = encode_record(codec, dags[order[id].mesh], clusters,
+                                 ps.representations[order[id].mesh].grid, args, vertices);
+      for (size_t k = 0; k < batch[r].count; ++k) records[id + k].vertices = vertices[k];
     });
-    for (size_t id = first; id < end; ++id) {
-      NodeSizeBreakdown b = codec.breakdown(encoded[id - first], args.output);
+    for (size_t r = 0; r < batch.size(); ++r) {
+      if (batch[r].count == 0) {
+        writer.end_group();
+        continue;
+      }
+      const NodeSizeBreakdown b = codec.breakdown(encoded[r], args.output);
       breakdown.header += b.header, breakdown.vertices += b.vertices, breakdown.locked += b.locked;
       breakdown.indices += b.indices;
-      writer.add_node(uint32_t(id), encoded[id - first]);
-      if (id + 1 == page_group_ends[g]) writer.end_group(), ++g;
+      std::vector<uint32_t> ids(batch[r].count);
+      std::iota(ids.begin(), ids.end(), uint32_t(batch[r].first));
+      writer.add_record(ids, encoded[r]);
     }
-    first = end;
   }
   encoded = {};
-  encoded_clusters = {};
   size_t stored_triangles = 0;
   for (const NodeRecord& n : records) stored_triangles += n.triangles;
   int grid_bits = 14;

@@ -1,5 +1,8 @@
 #include "package/traversal_connectivity.hpp"
 
+#include <algorithm>
+#include <utility>
+
 #include "core/error.hpp"
 #include "package/bytes.hpp"
 
@@ -12,7 +15,9 @@ constexpr uint32_t kNone = UINT32_MAX;
 // The front of traversal_connectivity.hpp, shared by encoder and decoder so that both apply the same rules.
 class Front {
  public:
-  enum State : uint32_t { kPending, kDone, kGone };  // to process; in its loop, processed; out of the loops
+  // To process; in its loop, processed; out of the loops; in its loop, to process again once the next
+  // cluster of a record starts (kDefer).
+  enum State : uint32_t { kPending, kDone, kGone, kDeferred };
   struct Edge {
     uint32_t a, b, o, prev, next, state;
   };
@@ -82,6 +87,36 @@ class Front {
   }
   // kBoundary.
   void done(uint32_t e) { edges_[e].state = kDone; }
+  // kDefer + d: the gate waits for cluster `cluster` (the current one + 1 + d); `deferred` lists (cluster,
+  // gate) in the order they were deferred.
+  void defer(uint32_t e, uint32_t cluster, std::vector<std::pair<uint32_t, uint32_t>>& deferred) {
+    edges_[e].state = kDeferred;
+    deferred.push_back({cluster, e});
+  }
+  // Cluster `cluster` starts: the gates deferred to it become gates again, processed before the rest
+  // (`reopened`, in deferral order), so that it grows from the decoded part's border.
+  static void reopen(Front& front, uint32_t cluster, std::vector<std::pair<uint32_t, uint32_t>>& deferred,
+                     std::vector<uint32_t>& reopened, size_t& next_reopened) {
+    reopened.clear(), next_reopened = 0;
+    size_t kept = 0;
+    for (const auto& [c, e] : deferred) {
+      if (c != cluster) {
+        deferred[kept++] = {c, e};
+      } else if (front.edges_[e].state == kDeferred) {
+        front.edges_[e].state = kPending, reopened.push_back(e);
+      }
+    }
+    deferred.resize(kept);
+  }
+  // The next gate: the first pending reopened edge, else the first pending edge at or after `e` (advancing
+  // e); size() when there is none.
+  uint32_t next_gate(const std::vector<uint32_t>& reopened, size_t& next_reopened, uint32_t& e) const {
+    while (next_reopened < reopened.size()) {
+      const uint32_t r = reopened[next_reopened++];
+      if (edges_[r].state == kPending) return r;
+    }
+    return e = gate(e);
+  }
 
  private:
   void push(uint32_t a, uint32_t b, uint32_t o, uint32_t prev, uint32_t next) {
@@ -107,8 +142,15 @@ void put_varint(std::vector<uint8_t>& out, uint32_t v) {
 
 }  // namespace
 
-TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V) {
+TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
+                               std::span<const uint32_t> cluster_triangles) {
   const uint32_t T = uint32_t(indices.size() / 3);
+  // cluster_of[t]: the cluster of triangle t (all 0 without clusters).
+  std::vector<uint32_t> cluster_of(T, 0);
+  for (uint32_t c = 0, t = 0; c < cluster_triangles.size(); ++c)
+    for (uint32_t k = 0; k < cluster_triangles[c] && t < T; ++k) cluster_of[t++] = c;
+  uint32_t cluster = 0;  // the cluster being encoded: triangles [.., cluster_end) of the output
+  uint32_t cluster_end = cluster_triangles.empty() ? T : cluster_triangles[0];
   TraversalCode code;
   code.indices.reserve(indices.size());
   code.predictors.reserve(3 * size_t(V));
@@ -135,11 +177,18 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V) {
   Front front(edges, T);
   uint32_t scan = 0;  // triangles below it are encoded
   uint32_t done = 0;  // triangles emitted
-  uint32_t e = 0;     // the gate
+  uint32_t e = 0;     // the scan for gates
+  std::vector<std::pair<uint32_t, uint32_t>> deferred;
+  std::vector<uint32_t> reopened;
+  size_t next_reopened = 0;
   while (done < T) {
-    e = front.gate(e);
-    if (e == front.size()) {
-      while (encoded[scan]) ++scan;
+    if (done == cluster_end) {
+      cluster_end += cluster_triangles[++cluster];
+      Front::reopen(front, cluster, deferred, reopened, next_reopened);
+    }
+    const uint32_t gate = front.next_gate(reopened, next_reopened, e);
+    if (gate == front.size()) {
+      while (encoded[scan]) ++scan;  // the first triangle left, of the current cluster
       encoded[scan] = 1;
       uint32_t corner[3];
       for (int k = 0; k < 3; ++k) {
@@ -159,17 +208,24 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V) {
       ++done;
       continue;
     }
-    const Front::Edge g = front.edge(e);
-    // The triangle across a -> b holds half-edge b -> a.
+    const Front::Edge g = front.edge(gate);
+    // The triangle across a -> b holds half-edge b -> a; one of a later cluster defers the gate.
     const uint32_t a_in = code.order[g.a], b_in = code.order[g.b];
-    uint32_t across = kNone;
+    uint32_t across = kNone, later = kNone;  // later: the first later cluster across
     for (uint32_t i = first[b_in]; i < first[b_in + 1] && across == kNone; ++i) {
       const uint32_t c = corners[i];
-      if (!encoded[c / 3] && indices[next_corner(c)] == a_in) across = c;
+      if (encoded[c / 3] || indices[next_corner(c)] != a_in) continue;
+      if (cluster_of[c / 3] == cluster) across = c;
+      later = std::min(later, cluster_of[c / 3]);
+    }
+    if (across == kNone && later != kNone && later - cluster - 1 < kDeferClusters) {
+      code.symbols.push_back(uint8_t(kDefer + (later - cluster - 1)));
+      front.defer(gate, later, deferred);
+      continue;
     }
     if (across == kNone) {
       code.symbols.push_back(kBoundary);
-      front.done(e);
+      front.done(gate);
       continue;
     }
     encoded[across / 3] = 1;
@@ -178,20 +234,20 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V) {
     if (c == kNone) {
       code.symbols.push_back(kVertex);
       c = add_vertex(c_in, g.a, g.b, g.o);
-      front.attach(e, c);
-    } else if (front.closes(e) && c == front.left(e)) {
+      front.attach(gate, c);
+    } else if (front.closes(gate) && c == front.left(gate)) {
       code.symbols.push_back(kEnd);
-      front.close_loop(e);
-    } else if (c == front.left(e)) {
+      front.close_loop(gate);
+    } else if (c == front.left(gate)) {
       code.symbols.push_back(kLeft);
-      front.close_left(e);
-    } else if (c == front.right(e)) {
+      front.close_left(gate);
+    } else if (c == front.right(gate)) {
       code.symbols.push_back(kRight);
-      front.close_right(e);
+      front.close_right(gate);
     } else {
       code.symbols.push_back(kSplit);
       put_varint(code.references, uint32_t(code.order.size()) - 1 - c);
-      front.attach(e, c);
+      front.attach(gate, c);
     }
     emit(g.b, g.a, c);
     ++done;
@@ -205,7 +261,8 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V) {
 }
 
 void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t> references, uint32_t T,
-                      uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where) {
+                      uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where,
+                      std::span<const uint32_t> cluster_triangles) {
   ByteReader refs(references, where);
   auto fail = [&](const char* what) { throw Error(where + ": corrupted connectivity (" + what + ")"); };
   thread_local std::vector<Front::Edge> edges;
@@ -215,10 +272,20 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
   const uint8_t* const symbols_end = symbol + symbols.size();
   uint32_t* out = indices;
   const uint32_t* const end = indices + 3 * size_t(T);
-  uint32_t e = 0;  // the gate
+  uint32_t e = 0;  // the scan for gates
+  thread_local std::vector<std::pair<uint32_t, uint32_t>> deferred;
+  thread_local std::vector<uint32_t> reopened;
+  deferred.clear(), reopened.clear();
+  size_t next_reopened = 0;
+  uint32_t cluster = 0;
+  const uint32_t* cluster_end = cluster_triangles.empty() ? end : indices + 3 * size_t(cluster_triangles[0]);
   while (out != end) {
-    e = front.gate(e);
-    if (e == front.size()) {
+    if (out == cluster_end) {  // the counts add up to T (the caller checked): a next cluster exists
+      cluster_end += 3 * size_t(cluster_triangles[++cluster]);
+      Front::reopen(front, cluster, deferred, reopened, next_reopened);
+    }
+    const uint32_t gate = front.next_gate(reopened, next_reopened, e);
+    if (gate == front.size()) {
       uint32_t corner[3];
       for (int k = 0; k < 3; ++k) {
         const uint64_t r = refs.varint();
@@ -238,7 +305,7 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
       continue;
     }
     if (symbol == symbols_end) fail("symbols end early");
-    const Front::Edge& g = front.edge(e);
+    const Front::Edge& g = front.edge(gate);
     const uint32_t a = g.a, b = g.b;
     uint32_t c;
     switch (*symbol++) {
@@ -246,39 +313,40 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
         if (next == V) fail("more vertices than the node holds");
         c = next++;
         predictors[3 * c] = a, predictors[3 * c + 1] = b, predictors[3 * c + 2] = g.o;
-        front.attach(e, c);
+        front.attach(gate, c);
         break;
       case kLeft:
-        c = front.left(e);
+        c = front.left(gate);
         if (c == kNone) fail("left turn in a loop of 2");
-        front.close_left(e);
+        front.close_left(gate);
         break;
       case kRight:
-        c = front.right(e);
+        c = front.right(gate);
         if (c == kNone) fail("right turn in a loop of 2");
-        front.close_right(e);
+        front.close_right(gate);
         break;
       case kEnd:
-        if (!front.closes(e)) fail("end of a loop that is not 3 edges");
-        c = front.left(e);
-        front.close_loop(e);
+        if (!front.closes(gate)) fail("end of a loop that is not 3 edges");
+        c = front.left(gate);
+        front.close_loop(gate);
         break;
       case kSplit: {
         const uint64_t r = refs.varint();
         if (r >= next) fail("reference to a vertex not decoded yet");
         c = next - 1 - uint32_t(r);
-        front.attach(e, c);
+        front.attach(gate, c);
         break;
       }
       case kBoundary:
-        front.done(e++);  // the gate is done: the next one lies past it
+        front.done(gate);
         continue;
       default:
-        fail("unknown symbol");
+        if (symbol[-1] < kDefer || symbol[-1] >= kDefer + kDeferClusters) fail("unknown symbol");
+        front.defer(gate, cluster + 1 + (symbol[-1] - kDefer), deferred);
+        continue;
     }
     out[0] = b, out[1] = a, out[2] = c;
     out += 3;
-    ++e;
   }
   if (symbol != symbols_end) fail("symbols left over");
   if (!refs.at_end()) fail("references left over");
