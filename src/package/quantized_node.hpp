@@ -20,8 +20,9 @@ constexpr size_t kMaxNodeVertices = 65536;
 constexpr uint32_t kMaxPositionShift = 24;
 constexpr int64_t kMaxGridCoordinate = int64_t(1) << 30;
 // The most clusters one record holds (NodeGeometry::cluster_triangles; a DAG group's input clusters are about
-// 8, the bake splits larger page groups).
-constexpr uint32_t kMaxRecordClusters = 64;
+// 8, the bake splits larger page groups; 31: a cluster tag fits a traversal symbol's 5 high bits,
+// traversal_connectivity.hpp).
+constexpr uint32_t kMaxRecordClusters = 31;
 
 struct QuantizedNode {
   std::vector<uint32_t> order;    // order[new] = the caller's vertex

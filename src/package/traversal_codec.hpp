@@ -16,9 +16,9 @@
 //   traversal's predictors.
 // Records: a page group's clusters encoded as one node (NodeGeometry::cluster_triangles) share one vertex
 //   pool, so a vertex that several of its clusters hold is stored and predicted once (a cluster alone
-//   stores its border vertices again and predicts them from half their fan); the traversal keeps each
-//   cluster's triangles a consecutive range (traversal_connectivity.hpp). A record of progressive steps
-//   (order significant) is refused.
+//   stores its border vertices again and predicts them from half their fan); the traversal tags each
+//   triangle's cluster and the decoder returns each cluster's triangles as a consecutive range
+//   (traversal_connectivity.hpp). A record of progressive steps (order significant) is refused.
 #pragma once
 
 #include "package/node_codec.hpp"

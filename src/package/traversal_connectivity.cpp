@@ -1,8 +1,5 @@
 #include "package/traversal_connectivity.hpp"
 
-#include <algorithm>
-#include <utility>
-
 #include "core/error.hpp"
 #include "package/bytes.hpp"
 
@@ -15,11 +12,10 @@ constexpr uint32_t kNone = UINT32_MAX;
 // The front of traversal_connectivity.hpp, shared by encoder and decoder so that both apply the same rules.
 class Front {
  public:
-  // To process; in its loop, processed; out of the loops; in its loop, to process again once the next
-  // cluster of a record starts (kDefer).
-  enum State : uint32_t { kPending, kDone, kGone, kDeferred };
+  enum State : uint32_t { kPending, kDone, kGone };  // to process; in its loop, processed; out of the loops
   struct Edge {
     uint32_t a, b, o, prev, next, state;
+    uint32_t cluster;  // of its triangle (records of several clusters; 0 otherwise)
   };
 
   // A front for T triangles in `storage` (reused between calls): its edges pointer and size live in the
@@ -52,32 +48,33 @@ class Front {
     return g.prev != g.next && edges_[g.next].next == g.prev;
   }
 
-  void start(uint32_t v0, uint32_t v1, uint32_t v2) {
+  // The new triangle's edges get its cluster k.
+  void start(uint32_t v0, uint32_t v1, uint32_t v2, uint32_t k) {
     const uint32_t at = size_;
-    push(v0, v1, v2, at + 2, at + 1);
-    push(v1, v2, v0, at, at + 2);
-    push(v2, v0, v1, at + 1, at);
+    push(v0, v1, v2, at + 2, at + 1, k);
+    push(v1, v2, v0, at, at + 2, k);
+    push(v2, v0, v1, at + 1, at, k);
   }
   // kVertex and kSplit: the gate a -> b becomes a -> c, c -> b.
-  void attach(uint32_t e, uint32_t c) {
+  void attach(uint32_t e, uint32_t c, uint32_t k) {
     const uint32_t a = edges_[e].a, b = edges_[e].b, prev = edges_[e].prev, next = edges_[e].next;
     const uint32_t x = size_, y = x + 1;
-    push(a, c, b, prev, y);
-    push(c, b, a, x, next);
+    push(a, c, b, prev, y, k);
+    push(c, b, a, x, next, k);
     edges_[prev].next = x;  // a loop has 2 edges or more: prev and next are not the gate
     edges_[next].prev = y;
     edges_[e].state = kGone;
   }
   // kLeft: P = p -> a and the gate become p -> b.
-  void close_left(uint32_t e) {
+  void close_left(uint32_t e, uint32_t k) {
     Edge &g = edges_[e], &p = edges_[g.prev];
-    link(p.prev, g.next, p.a, g.b, g.a);
+    link(p.prev, g.next, p.a, g.b, g.a, k);
     p.state = g.state = kGone;
   }
   // kRight: the gate and N = b -> n become a -> n.
-  void close_right(uint32_t e) {
+  void close_right(uint32_t e, uint32_t k) {
     Edge &g = edges_[e], &n = edges_[g.next];
-    link(g.prev, n.next, g.a, n.b, g.b);
+    link(g.prev, n.next, g.a, n.b, g.b, k);
     n.state = g.state = kGone;
   }
   // kEnd: the loop of 3 is gone.
@@ -87,46 +84,16 @@ class Front {
   }
   // kBoundary.
   void done(uint32_t e) { edges_[e].state = kDone; }
-  // kDefer + d: the gate waits for cluster `cluster` (the current one + 1 + d); `deferred` lists (cluster,
-  // gate) in the order they were deferred.
-  void defer(uint32_t e, uint32_t cluster, std::vector<std::pair<uint32_t, uint32_t>>& deferred) {
-    edges_[e].state = kDeferred;
-    deferred.push_back({cluster, e});
-  }
-  // Cluster `cluster` starts: the gates deferred to it become gates again, processed before the rest
-  // (`reopened`, in deferral order), so that it grows from the decoded part's border.
-  static void reopen(Front& front, uint32_t cluster, std::vector<std::pair<uint32_t, uint32_t>>& deferred,
-                     std::vector<uint32_t>& reopened, size_t& next_reopened) {
-    reopened.clear(), next_reopened = 0;
-    size_t kept = 0;
-    for (const auto& [c, e] : deferred) {
-      if (c != cluster) {
-        deferred[kept++] = {c, e};
-      } else if (front.edges_[e].state == kDeferred) {
-        front.edges_[e].state = kPending, reopened.push_back(e);
-      }
-    }
-    deferred.resize(kept);
-  }
-  // The next gate: the first pending reopened edge, else the first pending edge at or after `e` (advancing
-  // e); size() when there is none.
-  uint32_t next_gate(const std::vector<uint32_t>& reopened, size_t& next_reopened, uint32_t& e) const {
-    while (next_reopened < reopened.size()) {
-      const uint32_t r = reopened[next_reopened++];
-      if (edges_[r].state == kPending) return r;
-    }
-    return e = gate(e);
-  }
 
  private:
-  void push(uint32_t a, uint32_t b, uint32_t o, uint32_t prev, uint32_t next) {
+  void push(uint32_t a, uint32_t b, uint32_t o, uint32_t prev, uint32_t next, uint32_t k) {
     Edge& x = edges_[size_++];
-    x.a = a, x.b = b, x.o = o, x.prev = prev, x.next = next, x.state = kPending;
+    x.a = a, x.b = b, x.o = o, x.prev = prev, x.next = next, x.state = kPending, x.cluster = k;
   }
   // A new edge a -> b (third corner o) between `before` and `after`.
-  void link(uint32_t before, uint32_t after, uint32_t a, uint32_t b, uint32_t o) {
+  void link(uint32_t before, uint32_t after, uint32_t a, uint32_t b, uint32_t o, uint32_t k) {
     const uint32_t x = size_;
-    push(a, b, o, before, after);
+    push(a, b, o, before, after, k);
     edges_[before].next = x;
     edges_[after].prev = x;
   }
@@ -140,17 +107,39 @@ void put_varint(std::vector<uint8_t>& out, uint32_t v) {
   out.push_back(uint8_t(v));
 }
 
+// The symbol byte of a triangle of cluster k across a gate of cluster `gate` (traversal_connectivity.hpp).
+uint8_t tagged(TraversalSymbol symbol, uint32_t k, uint32_t gate) {
+  return uint8_t(symbol | (k == gate ? 0 : (k + 1) << 3));
+}
+
+// Moves the triangles (3 indices each) into the clusters' ranges, in their order within each cluster; false
+// when the clusters' triangle counts differ from `cluster_triangles`. Cost: O(T).
+bool sort_by_cluster(uint32_t* indices, std::span<const uint8_t> cluster_of,
+                     std::span<const uint32_t> cluster_triangles) {
+  thread_local std::vector<uint32_t> at, copy;
+  at.assign(cluster_triangles.size() + 1, 0);
+  for (uint8_t k : cluster_of) ++at[k + 1];  // k < cluster_triangles.size(), checked by the callers
+  for (size_t k = 0; k < cluster_triangles.size(); ++k) {
+    if (at[k + 1] != cluster_triangles[k]) return false;
+    at[k + 1] += at[k];
+  }
+  copy.assign(indices, indices + 3 * cluster_of.size());
+  for (size_t t = 0; t < cluster_of.size(); ++t) {
+    uint32_t* to = indices + 3 * size_t(at[cluster_of[t]]++);
+    to[0] = copy[3 * t], to[1] = copy[3 * t + 1], to[2] = copy[3 * t + 2];
+  }
+  return true;
+}
+
 }  // namespace
 
 TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
                                std::span<const uint32_t> cluster_triangles) {
   const uint32_t T = uint32_t(indices.size() / 3);
-  // cluster_of[t]: the cluster of triangle t (all 0 without clusters).
-  std::vector<uint32_t> cluster_of(T, 0);
+  const bool clustered = cluster_triangles.size() > 1;
+  std::vector<uint8_t> cluster_of(T, 0), emitted_cluster;  // by input triangle; by emitted triangle
   for (uint32_t c = 0, t = 0; c < cluster_triangles.size(); ++c)
-    for (uint32_t k = 0; k < cluster_triangles[c] && t < T; ++k) cluster_of[t++] = c;
-  uint32_t cluster = 0;  // the cluster being encoded: triangles [.., cluster_end) of the output
-  uint32_t cluster_end = cluster_triangles.empty() ? T : cluster_triangles[0];
+    for (uint32_t k = 0; k < cluster_triangles[c] && t < T; ++k) cluster_of[t++] = uint8_t(c);
   TraversalCode code;
   code.indices.reserve(indices.size());
   code.predictors.reserve(3 * size_t(V));
@@ -171,25 +160,23 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
     code.predictors.insert(code.predictors.end(), {o1, o2, o});
     return decoded[input];
   };
-  auto emit = [&](uint32_t a, uint32_t b, uint32_t c) { code.indices.insert(code.indices.end(), {a, b, c}); };
+  auto emit = [&](uint32_t a, uint32_t b, uint32_t c, uint8_t k) {
+    code.indices.insert(code.indices.end(), {a, b, c});
+    emitted_cluster.push_back(k);
+  };
 
   std::vector<Front::Edge> edges;
   Front front(edges, T);
   uint32_t scan = 0;  // triangles below it are encoded
   uint32_t done = 0;  // triangles emitted
-  uint32_t e = 0;     // the scan for gates
-  std::vector<std::pair<uint32_t, uint32_t>> deferred;
-  std::vector<uint32_t> reopened;
-  size_t next_reopened = 0;
+  uint32_t e = 0;     // the gate
   while (done < T) {
-    if (done == cluster_end) {
-      cluster_end += cluster_triangles[++cluster];
-      Front::reopen(front, cluster, deferred, reopened, next_reopened);
-    }
-    const uint32_t gate = front.next_gate(reopened, next_reopened, e);
-    if (gate == front.size()) {
-      while (encoded[scan]) ++scan;  // the first triangle left, of the current cluster
+    e = front.gate(e);
+    if (e == front.size()) {
+      while (encoded[scan]) ++scan;
       encoded[scan] = 1;
+      const uint8_t k = cluster_of[scan];
+      if (clustered) put_varint(code.references, k);
       uint32_t corner[3];
       for (int k = 0; k < 3; ++k) {
         const uint32_t input = indices[3 * scan + k];
@@ -203,53 +190,47 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
           corner[k] = add_vertex(input, from, from, from);
         }
       }
-      front.start(corner[0], corner[1], corner[2]);
-      emit(corner[0], corner[1], corner[2]);
+      front.start(corner[0], corner[1], corner[2], k);
+      emit(corner[0], corner[1], corner[2], k);
       ++done;
       continue;
     }
-    const Front::Edge g = front.edge(gate);
-    // The triangle across a -> b holds half-edge b -> a; one of a later cluster defers the gate.
+    const Front::Edge g = front.edge(e);
+    // The triangle across a -> b holds half-edge b -> a.
     const uint32_t a_in = code.order[g.a], b_in = code.order[g.b];
-    uint32_t across = kNone, later = kNone;  // later: the first later cluster across
+    uint32_t across = kNone;
     for (uint32_t i = first[b_in]; i < first[b_in + 1] && across == kNone; ++i) {
       const uint32_t c = corners[i];
-      if (encoded[c / 3] || indices[next_corner(c)] != a_in) continue;
-      if (cluster_of[c / 3] == cluster) across = c;
-      later = std::min(later, cluster_of[c / 3]);
-    }
-    if (across == kNone && later != kNone && later - cluster - 1 < kDeferClusters) {
-      code.symbols.push_back(uint8_t(kDefer + (later - cluster - 1)));
-      front.defer(gate, later, deferred);
-      continue;
+      if (!encoded[c / 3] && indices[next_corner(c)] == a_in) across = c;
     }
     if (across == kNone) {
       code.symbols.push_back(kBoundary);
-      front.done(gate);
+      front.done(e);
       continue;
     }
     encoded[across / 3] = 1;
+    const uint8_t k = cluster_of[across / 3];
     const uint32_t c_in = indices[next_corner(next_corner(across))];
     uint32_t c = decoded[c_in];
     if (c == kNone) {
-      code.symbols.push_back(kVertex);
+      code.symbols.push_back(tagged(kVertex, k, g.cluster));
       c = add_vertex(c_in, g.a, g.b, g.o);
-      front.attach(gate, c);
-    } else if (front.closes(gate) && c == front.left(gate)) {
-      code.symbols.push_back(kEnd);
-      front.close_loop(gate);
-    } else if (c == front.left(gate)) {
-      code.symbols.push_back(kLeft);
-      front.close_left(gate);
-    } else if (c == front.right(gate)) {
-      code.symbols.push_back(kRight);
-      front.close_right(gate);
+      front.attach(e, c, k);
+    } else if (front.closes(e) && c == front.left(e)) {
+      code.symbols.push_back(tagged(kEnd, k, g.cluster));
+      front.close_loop(e);
+    } else if (c == front.left(e)) {
+      code.symbols.push_back(tagged(kLeft, k, g.cluster));
+      front.close_left(e, k);
+    } else if (c == front.right(e)) {
+      code.symbols.push_back(tagged(kRight, k, g.cluster));
+      front.close_right(e, k);
     } else {
-      code.symbols.push_back(kSplit);
+      code.symbols.push_back(tagged(kSplit, k, g.cluster));
       put_varint(code.references, uint32_t(code.order.size()) - 1 - c);
-      front.attach(gate, c);
+      front.attach(e, c, k);
     }
-    emit(g.b, g.a, c);
+    emit(g.b, g.a, c, k);
     ++done;
   }
   for (uint32_t v = 0; v < V; ++v) {
@@ -257,6 +238,7 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
     const uint32_t from = code.order.empty() ? V : uint32_t(code.order.size()) - 1;
     add_vertex(v, from, from, from);
   }
+  if (clustered) sort_by_cluster(code.indices.data(), emitted_cluster, cluster_triangles);
   return code;
 }
 
@@ -272,20 +254,23 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
   const uint8_t* const symbols_end = symbol + symbols.size();
   uint32_t* out = indices;
   const uint32_t* const end = indices + 3 * size_t(T);
-  uint32_t e = 0;  // the scan for gates
-  thread_local std::vector<std::pair<uint32_t, uint32_t>> deferred;
-  thread_local std::vector<uint32_t> reopened;
-  deferred.clear(), reopened.clear();
-  size_t next_reopened = 0;
-  uint32_t cluster = 0;
-  const uint32_t* cluster_end = cluster_triangles.empty() ? end : indices + 3 * size_t(cluster_triangles[0]);
+  // Clusters of a record: each triangle's (then sorted into the clusters' ranges); C = 1 otherwise (every
+  // symbol's cluster code must then be 0).
+  const uint32_t C = cluster_triangles.size() > 1 ? uint32_t(cluster_triangles.size()) : 1;
+  thread_local std::vector<uint8_t> cluster_of;
+  if (C > 1) cluster_of.resize(T);
+  uint8_t* cluster = cluster_of.data();
+  uint32_t e = 0;  // the gate
   while (out != end) {
-    if (out == cluster_end) {  // the counts add up to T (the caller checked): a next cluster exists
-      cluster_end += 3 * size_t(cluster_triangles[++cluster]);
-      Front::reopen(front, cluster, deferred, reopened, next_reopened);
-    }
-    const uint32_t gate = front.next_gate(reopened, next_reopened, e);
-    if (gate == front.size()) {
+    e = front.gate(e);
+    if (e == front.size()) {
+      uint32_t k = 0;
+      if (C > 1) {
+        const uint64_t read = refs.varint();
+        if (read >= C) fail("cluster out of range");
+        k = uint32_t(read);
+        *cluster++ = uint8_t(k);
+      }
       uint32_t corner[3];
       for (int k = 0; k < 3; ++k) {
         const uint64_t r = refs.varint();
@@ -299,57 +284,62 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
           corner[k] = next - uint32_t(r);
         }
       }
-      front.start(corner[0], corner[1], corner[2]);
+      front.start(corner[0], corner[1], corner[2], k);
       out[0] = corner[0], out[1] = corner[1], out[2] = corner[2];
       out += 3;
       continue;
     }
     if (symbol == symbols_end) fail("symbols end early");
-    const Front::Edge& g = front.edge(gate);
+    const Front::Edge& g = front.edge(e);
     const uint32_t a = g.a, b = g.b;
+    const uint32_t code = *symbol >> 3;  // 0: the gate's cluster, else cluster code - 1
+    const uint32_t k = code == 0 ? g.cluster : code - 1;
+    if (k >= C) fail("cluster out of range");
     uint32_t c;
-    switch (*symbol++) {
+    switch (*symbol++ & 7) {
       case kVertex:
         if (next == V) fail("more vertices than the node holds");
         c = next++;
         predictors[3 * c] = a, predictors[3 * c + 1] = b, predictors[3 * c + 2] = g.o;
-        front.attach(gate, c);
+        front.attach(e, c, k);
         break;
       case kLeft:
-        c = front.left(gate);
+        c = front.left(e);
         if (c == kNone) fail("left turn in a loop of 2");
-        front.close_left(gate);
+        front.close_left(e, k);
         break;
       case kRight:
-        c = front.right(gate);
+        c = front.right(e);
         if (c == kNone) fail("right turn in a loop of 2");
-        front.close_right(gate);
+        front.close_right(e, k);
         break;
       case kEnd:
-        if (!front.closes(gate)) fail("end of a loop that is not 3 edges");
-        c = front.left(gate);
-        front.close_loop(gate);
+        if (!front.closes(e)) fail("end of a loop that is not 3 edges");
+        c = front.left(e);
+        front.close_loop(e);
         break;
       case kSplit: {
         const uint64_t r = refs.varint();
         if (r >= next) fail("reference to a vertex not decoded yet");
         c = next - 1 - uint32_t(r);
-        front.attach(gate, c);
+        front.attach(e, c, k);
         break;
       }
       case kBoundary:
-        front.done(gate);
+        front.done(e++);  // the gate is done: the next one lies past it
         continue;
       default:
-        if (symbol[-1] < kDefer || symbol[-1] >= kDefer + kDeferClusters) fail("unknown symbol");
-        front.defer(gate, cluster + 1 + (symbol[-1] - kDefer), deferred);
-        continue;
+        fail("unknown symbol");
     }
     out[0] = b, out[1] = a, out[2] = c;
     out += 3;
+    if (C > 1) *cluster++ = uint8_t(k);
+    ++e;
   }
   if (symbol != symbols_end) fail("symbols left over");
   if (!refs.at_end()) fail("references left over");
+  if (C > 1 && !sort_by_cluster(indices, std::span(cluster_of).first(T), cluster_triangles))
+    fail("triangles per cluster differ from the header's");
   for (; next < V; ++next) {
     const uint32_t from = next > 0 ? next - 1 : V;
     predictors[3 * next] = predictors[3 * next + 1] = predictors[3 * next + 2] = from;
