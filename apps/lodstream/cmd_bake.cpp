@@ -13,7 +13,9 @@
 // then the other HLOD nodes, each parent's children as one page group, then each progressive mesh's steps 1..
 // in order (a page group each), then, from the coarsest level down, the input clusters of each group
 // simplification as one page group: refining a group needs exactly its input clusters, so they travel
-// together.
+// together. With a codec that stores records (codec 3), each page group of DAG clusters (a group's input
+// clusters, a DAG's roots) is one record (package/records.hpp): one vertex pool for all its clusters, encoded
+// after the DAG is built (encode_record).
 //
 // Precision (how the codec's position_shift is spent): level-0 clusters are stored on the finest grid of
 // their mesh: 2^-b of its diagonal with b the fewest bits in [14, --max-grid-bits = 20] that keep its
@@ -39,7 +41,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <fstream>
 #include <memory>
 #include <mutex>
@@ -57,6 +58,7 @@
 #include "io/import.hpp"
 #include "package/node_codec.hpp"
 #include "package/progressive_prefix.hpp"
+#include "package/records.hpp"
 #include "package/writer.hpp"
 #include "schedule/screen_error.hpp"
 #include "timing.hpp"
@@ -150,62 +152,23 @@ uint32_t cluster_normal_bits(float error, const BakeArgs& args) {
 std::vector<uint8_t> encode_record(const NodeCodec& codec, const hierarchy::ClusterDag& dag,
                                    std::span<const uint32_t> clusters, const PositionGrid& grid,
                                    const BakeArgs& args, std::span<uint32_t> vertices) {
-  Mesh mesh;
-  std::vector<uint8_t> locked;
-  std::vector<uint32_t> cluster_triangles;
+  std::vector<const Mesh*> meshes;
+  std::vector<std::span<const uint8_t>> locked;
   NodeGeometry geometry;
   geometry.position_shift = UINT32_MAX;
   geometry.normal_bits = 0;
   for (uint32_t c : clusters) {
     const hierarchy::DagCluster& cluster = dag.clusters[c];
+    meshes.push_back(&cluster.mesh);
+    locked.push_back(cluster.locked);
     geometry.position_shift = std::min(geometry.position_shift, position_shift(cluster.error, grid));
     geometry.normal_bits = std::max(geometry.normal_bits, cluster_normal_bits(cluster.error, args));
   }
-  // Weld key: the bits of position, normal, UV and colour.
-  using Key = std::array<uint32_t, 12>;
-  struct KeyHash {
-    size_t operator()(const Key& k) const {
-      uint64_t h = 0x9e3779b97f4a7c15ull;
-      for (uint32_t x : k) h = (h ^ x) * 0xff51afd7ed558ccdull;
-      return size_t(h ^ (h >> 32));
-    }
-  };
-  std::unordered_map<Key, uint32_t, KeyHash> welded;
-  std::vector<uint32_t> remap, seen;
-  for (size_t k = 0; k < clusters.size(); ++k) {
-    const Mesh& m = dag.clusters[clusters[k]].mesh;
-    const std::vector<uint8_t>& cluster_locked = dag.clusters[clusters[k]].locked;
-    remap.resize(m.vertex_count());
-    for (uint32_t v = 0; v < m.vertex_count(); ++v) {
-      Key key{};
-      std::memcpy(&key[0], &m.positions[v], 12);
-      if (m.has_normals()) std::memcpy(&key[3], &m.normals[v], 12);
-      if (m.has_uvs()) std::memcpy(&key[6], &m.uvs[v], 8);
-      if (m.has_colors()) std::memcpy(&key[8], &m.colors[v], 16);
-      const auto [it, added] = welded.emplace(key, uint32_t(mesh.positions.size()));
-      remap[v] = it->second;
-      if (added) {
-        mesh.positions.push_back(m.positions[v]);
-        if (m.has_normals()) mesh.normals.push_back(m.normals[v]);
-        if (m.has_uvs()) mesh.uvs.push_back(m.uvs[v]);
-        if (m.has_colors()) mesh.colors.push_back(m.colors[v]);
-        locked.push_back(0);
-      }
-      if (!cluster_locked.empty() && cluster_locked[v]) locked[remap[v]] = 1;
-    }
-    // The cluster's distinct vertices as its triangles use them.
-    seen.assign(mesh.positions.size(), 0);
-    uint32_t distinct = 0;
-    for (uint32_t i : m.indices) {
-      mesh.indices.push_back(remap[i]);
-      distinct += seen[remap[i]] == 0, seen[remap[i]] = 1;
-    }
-    vertices[k] = distinct;
-    cluster_triangles.push_back(uint32_t(m.triangle_count()));
-  }
-  geometry.mesh = &mesh;
-  if (geometry.position_shift > 0) geometry.locked = locked;
-  if (clusters.size() > 1) geometry.cluster_triangles = cluster_triangles;
+  const RecordMesh record = weld_record(meshes, locked);
+  std::copy(record.cluster_vertices.begin(), record.cluster_vertices.end(), vertices.begin());
+  geometry.mesh = &record.mesh;
+  if (geometry.position_shift > 0) geometry.locked = record.locked;
+  if (clusters.size() > 1) geometry.cluster_triangles = record.cluster_triangles;
   return codec.encode(geometry, grid);
 }
 

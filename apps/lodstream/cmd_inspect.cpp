@@ -25,7 +25,7 @@
 #include "hierarchy/cut.hpp"
 #include "package/progressive_prefix.hpp"
 #include "package/reader.hpp"
-#include "package/record_cluster.hpp"
+#include "package/records.hpp"
 #include "package/size_account.hpp"
 #include "schedule/cut.hpp"
 

@@ -13,9 +13,10 @@ namespace lodstream::package {
 
 namespace {
 
-// Smallest serialized node record (index.hpp, "Node records"): head, 3 field deltas, page, offset, size,
-// triangles, vertices, the object count and the two pair codes, with both link lists implied.
-constexpr size_t kMinNodeRecordBytes = 12;
+// Smallest serialized node record (index.hpp, "Node records"): head, 3 field deltas, triangles, vertices, the
+// object count and the two pair codes, with both link lists implied and page, offset, size and cluster
+// those of the previous record's bytes (bit 5).
+constexpr size_t kMinNodeRecordBytes = 9;
 
 void write_sphere(ByteWriter& w, const Sphere& s) {
   w.f32(s.center.x), w.f32(s.center.y), w.f32(s.center.z), w.f32(s.radius);

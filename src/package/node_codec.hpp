@@ -79,7 +79,7 @@ struct NodeGeometry {
   // A record of several clusters (a page group's clusters welded on their shared vertices, one vertex pool):
   // the triangle count of each cluster, adding up to the mesh's; the mesh's triangles are the clusters'
   // consecutive ranges in this order. Empty = one cluster. At most NodeCodec::max_record_clusters() entries;
-  // the codec keeps each cluster's triangles a consecutive range (record_cluster.hpp extracts one).
+  // the codec keeps each cluster's triangles a consecutive range (records.hpp extracts one).
   std::span<const uint32_t> cluster_triangles;
 };
 

@@ -4,7 +4,7 @@
 
 #include "core/error.hpp"
 #include "package/page_parts.hpp"
-#include "package/record_cluster.hpp"
+#include "package/records.hpp"
 
 namespace lodstream::package {
 

@@ -50,7 +50,7 @@ class PackageReader {
   std::span<const uint8_t> node_bytes(uint32_t id, std::span<const uint8_t> page);
   // Decodes codec node `id` from its decompressed page and checks the result against the node's record
   // (counts, and every index within the representation's vertices). A node that is one cluster of a record
-  // (NodeRecord::cluster) gets that cluster alone (record_cluster.hpp); the last record of several clusters
+  // (NodeRecord::cluster) gets that cluster alone (records.hpp); the last record of several clusters
   // decoded is kept, so decoding its clusters one after another (consecutive ids) decodes it once.
   DecodedNode decode_node(uint32_t id, std::span<const uint8_t> page);
   // read_page + decode_node.

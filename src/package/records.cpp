@@ -1,0 +1,98 @@
+#include "package/records.hpp"
+
+#include <array>
+#include <cstring>
+#include <unordered_map>
+
+#include "core/error.hpp"
+
+namespace lodstream::package {
+
+RecordMesh weld_record(std::span<const Mesh* const> clusters,
+                       std::span<const std::span<const uint8_t>> locked) {
+  using Key = std::array<uint32_t, 12>;  // the bits of position, normal, UV and colour
+  struct KeyHash {
+    size_t operator()(const Key& k) const {
+      uint64_t h = 0x9e3779b97f4a7c15ull;
+      for (uint32_t x : k) h = (h ^ x) * 0xff51afd7ed558ccdull;
+      return size_t(h ^ (h >> 32));
+    }
+  };
+  RecordMesh r;
+  Mesh& out = r.mesh;
+  std::unordered_map<Key, uint32_t, KeyHash> welded;
+  std::vector<uint32_t> remap;
+  std::vector<uint8_t> seen;
+  for (size_t k = 0; k < clusters.size(); ++k) {
+    const Mesh& m = *clusters[k];
+    out.material = m.material;
+    remap.resize(m.vertex_count());
+    for (uint32_t v = 0; v < m.vertex_count(); ++v) {
+      Key key{};
+      std::memcpy(&key[0], &m.positions[v], 12);
+      if (m.has_normals()) std::memcpy(&key[3], &m.normals[v], 12);
+      if (m.has_uvs()) std::memcpy(&key[6], &m.uvs[v], 8);
+      if (m.has_colors()) std::memcpy(&key[8], &m.colors[v], 16);
+      const auto [it, added] = welded.emplace(key, uint32_t(out.positions.size()));
+      remap[v] = it->second;
+      if (added) {
+        out.positions.push_back(m.positions[v]);
+        if (m.has_normals()) out.normals.push_back(m.normals[v]);
+        if (m.has_uvs()) out.uvs.push_back(m.uvs[v]);
+        if (m.has_colors()) out.colors.push_back(m.colors[v]);
+        r.locked.push_back(0);
+      }
+      if (k < locked.size() && !locked[k].empty() && locked[k][v]) r.locked[remap[v]] = 1;
+    }
+    seen.assign(out.positions.size(), 0);
+    uint32_t distinct = 0;
+    for (uint32_t i : m.indices) {
+      out.indices.push_back(remap[i]);
+      distinct += seen[remap[i]] == 0, seen[remap[i]] = 1;
+    }
+    r.cluster_vertices.push_back(distinct);
+    r.cluster_triangles.push_back(uint32_t(m.triangle_count()));
+  }
+  return r;
+}
+
+DecodedNode extract_cluster(const DecodedNode& record, uint32_t cluster, const std::string& where) {
+  const uint32_t clusters = record_clusters(record);
+  if (cluster >= clusters) {
+    throw Error(where + ": cluster " + std::to_string(cluster) + " out of range (its record holds " +
+                std::to_string(clusters) + ")");
+  }
+  if (clusters == 1) return record;
+  size_t first = 0;  // the cluster's first triangle
+  for (uint32_t c = 0; c < cluster; ++c) first += record.cluster_triangles[c];
+  const size_t count = record.cluster_triangles[cluster];
+  const Mesh& in = record.mesh;
+  const size_t V = in.positions.size();
+  thread_local std::vector<uint32_t> compact;  // record vertex -> cluster vertex, UINT32_MAX = not yet used
+  compact.assign(V, UINT32_MAX);
+  DecodedNode out;
+  Mesh& m = out.mesh;
+  m.material = in.material;
+  m.indices.resize(3 * count);
+  std::vector<uint32_t> used;  // used[cluster vertex] = record vertex
+  used.reserve(count + 2);
+  for (size_t i = 0; i < 3 * count; ++i) {
+    const uint32_t v = in.indices[3 * first + i];  // < V: the codec checked every index
+    if (compact[v] == UINT32_MAX) compact[v] = uint32_t(used.size()), used.push_back(v);
+    m.indices[i] = compact[v];
+  }
+  m.positions.reserve(used.size());
+  for (uint32_t v : used) m.positions.push_back(in.positions[v]);
+  if (in.has_normals())
+    for (uint32_t v : used) m.normals.push_back(in.normals[v]);
+  if (in.has_uvs())
+    for (uint32_t v : used) m.uvs.push_back(in.uvs[v]);
+  if (in.has_colors())
+    for (uint32_t v : used) m.colors.push_back(in.colors[v]);
+  if (!record.vertex_data.empty())
+    for (uint32_t v : used) out.vertex_data.push_back(record.vertex_data[v]);
+  out.index_end = uint32_t(used.size());
+  return out;
+}
+
+}  // namespace lodstream::package
