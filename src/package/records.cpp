@@ -67,30 +67,41 @@ DecodedNode extract_cluster(const DecodedNode& record, uint32_t cluster, const s
   for (uint32_t c = 0; c < cluster; ++c) first += record.cluster_triangles[c];
   const size_t count = record.cluster_triangles[cluster];
   const Mesh& in = record.mesh;
-  const size_t V = in.positions.size();
-  thread_local std::vector<uint32_t> compact;  // record vertex -> cluster vertex, UINT32_MAX = not yet used
-  compact.assign(V, UINT32_MAX);
+  // record vertex -> cluster vertex (UINT32_MAX = not used yet); reset after use, so that each call costs
+  // O(the cluster), not O(the record).
+  thread_local std::vector<uint32_t> compact, used;  // used[cluster vertex] = record vertex
+  if (compact.size() < in.positions.size()) compact.resize(in.positions.size(), UINT32_MAX);
+  used.clear();
   DecodedNode out;
   Mesh& m = out.mesh;
   m.material = in.material;
   m.indices.resize(3 * count);
-  std::vector<uint32_t> used;  // used[cluster vertex] = record vertex
-  used.reserve(count + 2);
+  const uint32_t* from = in.indices.data() + 3 * first;  // < V: the codec checked every index
   for (size_t i = 0; i < 3 * count; ++i) {
-    const uint32_t v = in.indices[3 * first + i];  // < V: the codec checked every index
+    const uint32_t v = from[i];
     if (compact[v] == UINT32_MAX) compact[v] = uint32_t(used.size()), used.push_back(v);
     m.indices[i] = compact[v];
   }
-  m.positions.reserve(used.size());
-  for (uint32_t v : used) m.positions.push_back(in.positions[v]);
-  if (in.has_normals())
-    for (uint32_t v : used) m.normals.push_back(in.normals[v]);
-  if (in.has_uvs())
-    for (uint32_t v : used) m.uvs.push_back(in.uvs[v]);
-  if (in.has_colors())
-    for (uint32_t v : used) m.colors.push_back(in.colors[v]);
-  if (!record.vertex_data.empty())
-    for (uint32_t v : used) out.vertex_data.push_back(record.vertex_data[v]);
+  const size_t n = used.size();
+  m.positions.resize(n);
+  for (size_t k = 0; k < n; ++k) m.positions[k] = in.positions[used[k]];
+  if (in.has_normals()) {
+    m.normals.resize(n);
+    for (size_t k = 0; k < n; ++k) m.normals[k] = in.normals[used[k]];
+  }
+  if (in.has_uvs()) {
+    m.uvs.resize(n);
+    for (size_t k = 0; k < n; ++k) m.uvs[k] = in.uvs[used[k]];
+  }
+  if (in.has_colors()) {
+    m.colors.resize(n);
+    for (size_t k = 0; k < n; ++k) m.colors[k] = in.colors[used[k]];
+  }
+  if (!record.vertex_data.empty()) {
+    out.vertex_data.resize(n);
+    for (size_t k = 0; k < n; ++k) out.vertex_data[k] = record.vertex_data[used[k]];
+  }
+  for (uint32_t v : used) compact[v] = UINT32_MAX;
   out.index_end = uint32_t(used.size());
   return out;
 }
