@@ -46,7 +46,9 @@
 #include <mutex>
 #include <numeric>
 #include <span>
+#include <tuple>
 #include <unordered_map>
+#include <utility>
 
 #include "bake_textures.hpp"
 #include "command.hpp"
@@ -140,29 +142,32 @@ uint32_t cluster_normal_bits(float error, const BakeArgs& args) {
   return error > 0.0f ? std::min(args.normal_bits, args.coarse_normal_bits) : args.normal_bits;
 }
 
-// A record (package/node_codec.hpp): DAG clusters [first, first + count) of one page group welded into one
-// mesh on their identical vertices (same position and attributes: seams stay split), each cluster's triangles
-// a consecutive range, stored as one node with one vertex pool. Precision: free vertices are shared only by
-// clusters of one producing group and one consuming group (the header comment), so only inside one record,
-// and all clusters that hold a free vertex use one shift; the record stores free vertices with its clusters'
-// smallest shift (a cluster of a larger one decodes more precisely than its stored error assumes, which stays
-// a bound) and every vertex locked in any of its clusters exactly, so no other record's decoding changes and
-// cuts stay crack-free. Normals: the clusters' largest normal bits. `vertices[c]` receives cluster c's
-// distinct vertices (what a reader's cluster holds: welding also merges identical vertices within a cluster).
+// How a DAG cluster is stored: (position shift, normal bits).
+std::pair<uint32_t, uint32_t> precision(const hierarchy::DagCluster& c, const PositionGrid& grid,
+                                        const BakeArgs& args) {
+  return {position_shift(c.error, grid), cluster_normal_bits(c.error, args)};
+}
+
+// A record (package/records.hpp): DAG clusters of one page group and one precision welded into one mesh on
+// their identical vertices (same position and attributes: seams stay split), each cluster's triangles a
+// consecutive range, stored as one node with one vertex pool, free vertices at the clusters' shift, every
+// vertex locked in any of them exactly. Each vertex decodes to what it decodes to in a node of its cluster
+// alone (the same grid value, the same octahedral normal), so cuts stay crack-free and renders unchanged:
+// a free vertex is shared only by clusters of one producing group and one consuming group (the header
+// comment), that is only inside one page group and at one precision. (Records of mixed precision, free
+// vertices at the clusters' smallest shift and normals at their largest bits, were 1.5 % smaller on
+// elephant_1m and motorBike, but changed coarse positions.) `vertices[c]` receives cluster c's distinct
+// vertices (what a reader's cluster holds: welding also merges identical vertices within a cluster).
 std::vector<uint8_t> encode_record(const NodeCodec& codec, const hierarchy::ClusterDag& dag,
                                    std::span<const uint32_t> clusters, const PositionGrid& grid,
                                    const BakeArgs& args, std::span<uint32_t> vertices) {
   std::vector<const Mesh*> meshes;
   std::vector<std::span<const uint8_t>> locked;
   NodeGeometry geometry;
-  geometry.position_shift = UINT32_MAX;
-  geometry.normal_bits = 0;
+  std::tie(geometry.position_shift, geometry.normal_bits) = precision(dag.clusters[clusters[0]], grid, args);
   for (uint32_t c : clusters) {
-    const hierarchy::DagCluster& cluster = dag.clusters[c];
-    meshes.push_back(&cluster.mesh);
-    locked.push_back(cluster.locked);
-    geometry.position_shift = std::min(geometry.position_shift, position_shift(cluster.error, grid));
-    geometry.normal_bits = std::max(geometry.normal_bits, cluster_normal_bits(cluster.error, args));
+    meshes.push_back(&dag.clusters[c].mesh);
+    locked.push_back(dag.clusters[c].locked);
   }
   const RecordMesh record = weld_record(meshes, locked);
   std::copy(record.cluster_vertices.begin(), record.cluster_vertices.end(), vertices.begin());
@@ -465,7 +470,15 @@ int run_bake(const BakeArgs& args) {
   std::stable_sort(groups.begin(), groups.end(),
                    [](const GroupRef& a, const GroupRef& b) { return a.level > b.level; });
   for (const GroupRef& gr : groups) {
-    for (uint32_t c : dags[gr.mesh].groups[gr.group].children) {
+    // By precision (stable), so that the clusters stored alike are consecutive: a record holds clusters of
+    // one precision (encode_record).
+    std::vector<uint32_t> children = dags[gr.mesh].groups[gr.group].children;
+    const hierarchy::ClusterDag& dag = dags[gr.mesh];
+    std::stable_sort(children.begin(), children.end(), [&](uint32_t a, uint32_t b) {
+      return precision(dag.clusters[a], grids[gr.mesh], args) <
+             precision(dag.clusters[b], grids[gr.mesh], args);
+    });
+    for (uint32_t c : children) {
       node_id[gr.mesh][c] = uint32_t(order.size());
       order.push_back({gr.mesh, c});
     }
@@ -541,6 +554,9 @@ int run_bake(const BakeArgs& args) {
   PackageWriter writer(args.output, writer_options);
   NodeSizeBreakdown breakdown;
   auto is_cluster = [&](size_t id) { return order[id].mesh != kNone && pms[order[id].mesh].steps.empty(); };
+  auto precision_of = [&](size_t id) {
+    return precision(dags[order[id].mesh].clusters[order[id].cluster], grids[order[id].mesh], args);
+  };
   struct Record {
     size_t first, count;  // node ids [first, first + count)
   };
@@ -553,7 +569,8 @@ int run_bake(const BakeArgs& args) {
       for (size_t id = first; id < page_group_ends[g];) {
         size_t count = 1;
         while (is_cluster(id) && id + count < page_group_ends[g] && is_cluster(id + count) &&
-               order[id + count].mesh == order[id].mesh && count < codec.max_record_clusters())
+               order[id + count].mesh == order[id].mesh && count < codec.max_record_clusters() &&
+               precision_of(id + count) == precision_of(id))
           ++count;
         batch.push_back({id, count});
         id += count;
