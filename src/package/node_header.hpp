@@ -3,8 +3,8 @@
 //   u8 normal_bits (0 without normals), varint vertex count V (≤ 65536), varint triangle count T, varint
 //   first_vertex, [progressive (flag 32): varint index_end, varint size of the extra bytes], svarint cmin[3]
 //   (the node's smallest coarse coordinates), [with UVs: f32 uv_min[2], f32 uv_extent[2]], [a record of
-//   several clusters (flag 64): varint cluster count C (2..kMaxRecordClusters = 31), then the triangle counts of
-//   clusters 0..C-2 (varints; the last cluster has the rest, at least one triangle each)].
+//   several clusters (flag 64): varint cluster count C (2..kMaxRecordClusters = 31), then the triangle counts
+//   of clusters 0..C-2 (varints; the last cluster has the rest, at least one triangle each)].
 // Each codec stores the extra bytes (NodeGeometry::extra) last, after its streams.
 #pragma once
 

@@ -29,10 +29,11 @@
 // when it is the cluster of the gate's triangle, else 1 + its cluster; a piece start's references begin with
 // a varint cluster. After the traversal both sides move the triangles into the clusters' ranges, in
 // traversal order within each (a counting sort), so a decoded record's cluster c is a consecutive range.
-// Measured on elephant_1m (bake, codec 3): 5,382,094 B, level-0 connectivity 0.25 B/tri after zstd; the
-// tags cost 4.7 % (5,142,369 B untagged, which cannot be split back into clusters); a first version that
-// kept each cluster's triangles together in the traversal (deferring gates into later clusters, no tags)
-// gave 5,689,401 B, its connectivity 0.38 B/tri: it breaks the regular symbol runs zstd finds.
+// Measured on elephant_1m (bake, codec 3, records of mixed precision): 5,382,094 B, level-0 connectivity
+// 0.25 B/tri after zstd; the tags cost 4.7 % (5,142,369 B untagged, which cannot be split back into
+// clusters); a first version that kept each cluster's triangles together in the traversal (deferring gates
+// into later clusters, no tags) gave 5,689,401 B, its connectivity 0.38 B/tri: it breaks the regular symbol
+// runs zstd finds.
 //
 // On a manifold patch about half the symbols are kVertex and most others kLeft / kRight / kBoundary (border
 // edges), so zstd's entropy stage takes them to about 2 bits per triangle. Decode: O(T), no search, no hash.
