@@ -71,18 +71,23 @@ DecodedNode extract_cluster(const DecodedNode& record, uint32_t cluster, const s
   // O(the cluster), not O(the record).
   thread_local std::vector<uint32_t> compact, used;  // used[cluster vertex] = record vertex
   if (compact.size() < in.positions.size()) compact.resize(in.positions.size(), UINT32_MAX);
-  used.clear();
+  if (used.size() < in.positions.size()) used.resize(in.positions.size());
   DecodedNode out;
   Mesh& m = out.mesh;
   m.material = in.material;
   m.indices.resize(3 * count);
   const uint32_t* from = in.indices.data() + 3 * first;  // < V: the codec checked every index
+  uint32_t* to = m.indices.data();
+  uint32_t* const map = compact.data();
+  uint32_t* const first_use = used.data();
+  uint32_t n = 0;
   for (size_t i = 0; i < 3 * count; ++i) {
     const uint32_t v = from[i];
-    if (compact[v] == UINT32_MAX) compact[v] = uint32_t(used.size()), used.push_back(v);
-    m.indices[i] = compact[v];
+    uint32_t c = map[v];
+    if (c == UINT32_MAX) c = map[v] = n, first_use[n++] = v;
+    to[i] = c;
   }
-  const size_t n = used.size();
+  for (uint32_t k = 0; k < n; ++k) map[first_use[k]] = UINT32_MAX;  // before anything may throw
   m.positions.resize(n);
   for (size_t k = 0; k < n; ++k) m.positions[k] = in.positions[used[k]];
   if (in.has_normals()) {
@@ -101,8 +106,7 @@ DecodedNode extract_cluster(const DecodedNode& record, uint32_t cluster, const s
     out.vertex_data.resize(n);
     for (size_t k = 0; k < n; ++k) out.vertex_data[k] = record.vertex_data[used[k]];
   }
-  for (uint32_t v : used) compact[v] = UINT32_MAX;
-  out.index_end = uint32_t(used.size());
+  out.index_end = n;
   return out;
 }
 

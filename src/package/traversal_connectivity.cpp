@@ -112,21 +112,20 @@ uint8_t tagged(TraversalSymbol symbol, uint32_t k, uint32_t gate) {
   return uint8_t(symbol | (k == gate ? 0 : (k + 1) << 3));
 }
 
-// Moves the triangles (3 indices each) into the clusters' ranges, in their order within each cluster; false
-// when the clusters' triangle counts differ from `cluster_triangles`. Cost: O(T).
-bool sort_by_cluster(uint32_t* indices, std::span<const uint8_t> cluster_of,
+// Writes the triangles `from` (3 indices each) into `to` in the clusters' ranges, in their order within each
+// cluster; false when the clusters' triangle counts differ from `cluster_triangles`. Cost: O(T).
+bool sort_by_cluster(const uint32_t* from, uint32_t* to, std::span<const uint8_t> cluster_of,
                      std::span<const uint32_t> cluster_triangles) {
-  thread_local std::vector<uint32_t> at, copy;
+  thread_local std::vector<uint32_t> at;
   at.assign(cluster_triangles.size() + 1, 0);
   for (uint8_t k : cluster_of) ++at[k + 1];  // k < cluster_triangles.size(), checked by the callers
   for (size_t k = 0; k < cluster_triangles.size(); ++k) {
     if (at[k + 1] != cluster_triangles[k]) return false;
     at[k + 1] += at[k];
   }
-  copy.assign(indices, indices + 3 * cluster_of.size());
   for (size_t t = 0; t < cluster_of.size(); ++t) {
-    uint32_t* to = indices + 3 * size_t(at[cluster_of[t]]++);
-    to[0] = copy[3 * t], to[1] = copy[3 * t + 1], to[2] = copy[3 * t + 2];
+    uint32_t* x = to + 3 * size_t(at[cluster_of[t]]++);
+    x[0] = from[3 * t], x[1] = from[3 * t + 1], x[2] = from[3 * t + 2];
   }
   return true;
 }
@@ -238,7 +237,10 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
     const uint32_t from = code.order.empty() ? V : uint32_t(code.order.size()) - 1;
     add_vertex(v, from, from, from);
   }
-  if (clustered) sort_by_cluster(code.indices.data(), emitted_cluster, cluster_triangles);
+  if (clustered) {
+    const std::vector<uint32_t> traversal_order = code.indices;
+    sort_by_cluster(traversal_order.data(), code.indices.data(), emitted_cluster, cluster_triangles);
+  }
   return code;
 }
 
@@ -252,13 +254,14 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
   uint32_t next = 0;  // the next new vertex
   const uint8_t* symbol = symbols.data();
   const uint8_t* const symbols_end = symbol + symbols.size();
-  uint32_t* out = indices;
-  const uint32_t* const end = indices + 3 * size_t(T);
-  // Clusters of a record: each triangle's (then sorted into the clusters' ranges); C = 1 otherwise (every
-  // symbol's cluster code must then be 0).
+  // Clusters of a record: each triangle's, the triangles decoded into `traversal_order` and then sorted into
+  // the clusters' ranges of `indices`; C = 1 otherwise (every symbol's cluster code must then be 0).
   const uint32_t C = cluster_triangles.size() > 1 ? uint32_t(cluster_triangles.size()) : 1;
   thread_local std::vector<uint8_t> cluster_of;
-  if (C > 1) cluster_of.resize(T);
+  thread_local std::vector<uint32_t> traversal_order;
+  if (C > 1) cluster_of.resize(T), traversal_order.resize(3 * size_t(T));
+  uint32_t* out = C > 1 ? traversal_order.data() : indices;
+  const uint32_t* const end = out + 3 * size_t(T);
   uint8_t* cluster = cluster_of.data();
   uint32_t e = 0;  // the gate
   while (out != end) {
@@ -338,7 +341,8 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
   }
   if (symbol != symbols_end) fail("symbols left over");
   if (!refs.at_end()) fail("references left over");
-  if (C > 1 && !sort_by_cluster(indices, std::span(cluster_of).first(T), cluster_triangles))
+  if (C > 1 &&
+      !sort_by_cluster(traversal_order.data(), indices, std::span(cluster_of).first(T), cluster_triangles))
     fail("triangles per cluster differ from the header's");
   for (; next < V; ++next) {
     const uint32_t from = next > 0 ? next - 1 : V;
