@@ -13,6 +13,7 @@
 #include <benchmark/benchmark.h>
 #include <meshoptimizer.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
@@ -23,6 +24,7 @@
 #include "core/error.hpp"
 #include "io/import.hpp"
 #include "package/reader.hpp"
+#include "package/records.hpp"
 #include "package/writer.hpp"
 
 namespace {
@@ -118,8 +120,32 @@ std::vector<std::vector<uint8_t>> encode_all(const Meshlets& m, int attributes, 
   return out;
 }
 
+// Records (codec 3): each group of 8 consecutive meshlets (a page group) as one record, welded on their
+// shared vertices (package/records.hpp).
+constexpr size_t kRecordClusters = 8;
+// Benchmark argument of codec 3 with such records (decoded one cluster after another in id order, as a
+// client does: each record is decoded once, PackageReader keeping the last).
+constexpr uint32_t kRecordsArg = 4;
+std::vector<std::vector<uint8_t>> encode_records(const Meshlets& m, const NodeCodec& codec) {
+  std::vector<std::vector<uint8_t>> out;
+  for (size_t first = 0; first < m.chunks.size(); first += kRecordClusters) {
+    const size_t end = std::min(m.chunks.size(), first + kRecordClusters);
+    std::vector<const Mesh*> meshes;
+    std::vector<std::span<const uint8_t>> locked;
+    for (size_t i = first; i < end; ++i) meshes.push_back(&m.chunks[i]), locked.push_back(m.locked[i]);
+    const RecordMesh record = weld_record(meshes, locked);
+    NodeGeometry g;
+    g.mesh = &record.mesh;
+    g.normal_bits = g_normal_bits;
+    g.cluster_triangles = record.cluster_triangles;
+    out.push_back(codec.encode(g, m.grid));
+  }
+  return out;
+}
+
 WrittenPackage write_package(const Meshlets& m, const std::vector<std::vector<uint8_t>>& nodes,
-                             const std::filesystem::path& file, int zstd_level, const NodeCodec& codec) {
+                             const std::filesystem::path& file, int zstd_level, const NodeCodec& codec,
+                             bool records_form = false) {
   WriterOptions options;
   options.zstd_level = zstd_level;
   options.codec = codec.id();
@@ -132,12 +158,25 @@ WrittenPackage write_package(const Meshlets& m, const std::vector<std::vector<ui
   rep.grid = m.grid;
   scene.representations.push_back(rep);
   scene.objects.push_back({"mesh", glm::mat4(1.0f), 0});
-  std::vector<NodeRecord> records(nodes.size());
-  for (uint32_t id = 0; id < nodes.size(); ++id) {
-    writer.add_node(id, nodes[id]);
-    if (id % 8 == 7) writer.end_group();  // groups of 8 clusters, as a DAG group
+  std::vector<NodeRecord> records(m.chunks.size());
+  for (uint32_t id = 0; id < m.chunks.size(); ++id) {
     records[id].triangles = uint32_t(m.chunks[id].triangle_count());
     records[id].vertices = uint32_t(m.chunks[id].vertex_count());
+  }
+  if (records_form) {
+    for (uint32_t r = 0; r < nodes.size(); ++r) {
+      std::vector<uint32_t> ids;
+      for (uint32_t id = r * kRecordClusters;
+           id < std::min<size_t>(m.chunks.size(), (r + 1) * kRecordClusters); ++id)
+        ids.push_back(id);
+      writer.add_record(ids, nodes[r]);
+      writer.end_group();
+    }
+  } else {
+    for (uint32_t id = 0; id < nodes.size(); ++id) {
+      writer.add_node(id, nodes[id]);
+      if (id % 8 == 7) writer.end_group();  // groups of 8 clusters, as a DAG group
+    }
   }
   return writer.finish(scene, records, 0);
 }
@@ -205,6 +244,12 @@ void print_sizes(const NodeCodec& codec) {
       "  connectivity %.3f B/tri | positions (+node headers) %.3f | normals %.3f | uvs %.3f | index %.3f\n",
       conn / T, (double(pos.page_bytes) - conn) / T, (double(pos_n.page_bytes) - pos.page_bytes) / T,
       (double(full.page_bytes) - pos_n.page_bytes) / T, (full.bytes - full.page_bytes) / T);
+  if (codec.max_record_clusters() >= kRecordClusters) {
+    const WrittenPackage r =
+        write_package(m, encode_records(m, codec), temp_file("bench_level.lods"), g_zstd_level, codec, true);
+    std::printf("records of %zu meshlets (benchmark argument %u): %.3f B/tri = %llu bytes\n", kRecordClusters,
+                kRecordsArg, r.bytes / T, (unsigned long long)r.bytes);
+  }
   for (int level : {3, 9, 15, 19}) {
     const double t0 = thread_cpu_seconds();
     WrittenPackage w = write_package(m, all, temp_file("bench_level.lods"), level, codec);
@@ -245,10 +290,12 @@ const Loaded& loaded(uint32_t id) {
   static std::map<uint32_t, Loaded> all;
   if (auto it = all.find(id); it != all.end()) return it->second;
   return all[id] = [id] {
-    const NodeCodec& codec = node_codec(id);
+    const bool records = id == kRecordsArg;
+    const NodeCodec& codec = node_codec(records ? 3 : id);
     Loaded r;
-    write_package(meshlets(), encode_all(meshlets(), kAll, codec), temp_file("bench_read.lods"), g_zstd_level,
-                  codec);
+    write_package(meshlets(),
+                  records ? encode_records(meshlets(), codec) : encode_all(meshlets(), kAll, codec),
+                  temp_file("bench_read.lods"), g_zstd_level, codec, records);
     r.reader = std::make_unique<PackageReader>(PackageReader::open(temp_file("bench_read.lods")));
     for (uint32_t p = 0; p < r.reader->root().pages.size(); ++p) {
       const Range& range = r.reader->root().pages[p];
@@ -288,8 +335,8 @@ void BM_DecodeCodecOnly(benchmark::State& state) {
 
 BENCHMARK(BM_Encode)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_EncodeAndWrite)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Decode)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_DecodeCodecOnly)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Decode)->Arg(1)->Arg(2)->Arg(3)->Arg(kRecordsArg)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DecodeCodecOnly)->Arg(1)->Arg(2)->Arg(3)->Arg(kRecordsArg)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -25,6 +25,7 @@
 #include "hierarchy/cut.hpp"
 #include "package/progressive_prefix.hpp"
 #include "package/reader.hpp"
+#include "package/records.hpp"
 #include "package/size_account.hpp"
 #include "schedule/cut.hpp"
 
@@ -182,9 +183,12 @@ int run_inspect(const InspectArgs& args) {
   };
   std::map<uint32_t, Level> per_level;
   size_t stored_triangles = 0;
-  for (const NodeRecord& n : nodes) {
+  for (uint32_t id = 0; id < nodes.size(); ++id) {
+    const NodeRecord& n = nodes[id];
     Level& l = per_level[n.level];
-    ++l.nodes, l.triangles += n.triangles, l.raw_bytes += n.size, stored_triangles += n.triangles;
+    ++l.nodes, l.triangles += n.triangles, stored_triangles += n.triangles;
+    // A record's bytes once (its clusters are consecutive ids sharing them).
+    if (id == 0 || n.page != nodes[id - 1].page || n.offset != nodes[id - 1].offset) l.raw_bytes += n.size;
     l.min_error = std::min(l.min_error, n.error), l.max_error = std::max(l.max_error, n.error);
   }
   const uint64_t bytes = reader.header().file_size;
@@ -211,12 +215,22 @@ int run_inspect(const InspectArgs& args) {
       std::vector<std::vector<DecodedNode>> decoded(end - first);
       tbb::parallel_for(first, end, [&](size_t p) {
         const std::vector<uint8_t> page = reader.read_page(uint32_t(p));
+        DecodedNode record;  // the record of the previous node (its clusters are consecutive ids)
+        uint32_t record_offset = UINT32_MAX;
         for (uint32_t id : on_page[p]) {
           const NodeRecord& n = nodes[id];
-          decoded[p - first].push_back(
-              reader.codec().decode(std::span<const uint8_t>(page).subspan(n.offset, n.size),
-                                    root.scene.representations[n.representation].grid,
-                                    args.package + ": node " + std::to_string(id)));
+          const std::string where = args.package + ": node " + std::to_string(id);
+          if (n.offset != record_offset) {
+            record = reader.codec().decode(std::span<const uint8_t>(page).subspan(n.offset, n.size),
+                                           root.scene.representations[n.representation].grid, where);
+            record_offset = n.offset;
+          }
+          if (record_clusters(record) == 1 && n.cluster == 0) {  // a node alone (progressive steps too)
+            decoded[p - first].push_back(std::move(record));
+            record_offset = UINT32_MAX;
+          } else {
+            decoded[p - first].push_back(extract_cluster(record, n.cluster, where));
+          }
         }
       });
       for (size_t p = first; p < end && violation.empty(); ++p)

@@ -7,14 +7,16 @@
 #include "core/error.hpp"
 #include "package/bytes.hpp"
 #include "package/format.hpp"
+#include "package/quantized_node.hpp"
 
 namespace lodstream::package {
 
 namespace {
 
-// Smallest serialized node record (index.hpp, "Node records"): head, 3 field deltas, page, offset, size,
-// triangles, vertices, the object count and the two pair codes, with both link lists implied.
-constexpr size_t kMinNodeRecordBytes = 12;
+// Smallest serialized node record (index.hpp, "Node records"): head, 3 field deltas, triangles, vertices, the
+// object count and the two pair codes, with both link lists implied and page, offset, size and cluster
+// those of the previous record's bytes (bit 5).
+constexpr size_t kMinNodeRecordBytes = 9;
 
 void write_sphere(ByteWriter& w, const Sphere& s) {
   w.f32(s.center.x), w.f32(s.center.y), w.f32(s.center.z), w.f32(s.radius);
@@ -134,20 +136,25 @@ struct RecordRun {
   }
 };
 
-enum : uint8_t { kSameChildren = 8, kSameParents = 16 };
+enum : uint8_t { kSameChildren = 8, kSameParents = 16, kSameRecord = 32 };
 
 void write_node(ByteWriter& w, const NodeRecord& n, uint32_t id, RecordRun& run) {
   const NodeRecord& prev = run.previous();
   const bool same_children = !run.done.empty() && n.children == prev.children;
   const bool same_parents = !run.done.empty() && n.parents == prev.parents;
+  const bool same_record = !run.done.empty() && n.page == prev.page && n.offset == prev.offset &&
+                           n.size == prev.size && n.cluster == prev.cluster + 1;
   w.u8(static_cast<uint8_t>(uint8_t(n.kind) | uint8_t(n.encoding) << 2 | (same_children ? kSameChildren : 0) |
-                            (same_parents ? kSameParents : 0)));
+                            (same_parents ? kSameParents : 0) | (same_record ? kSameRecord : 0)));
   w.svarint(int64_t(n.representation) - prev.representation);
   w.svarint(int64_t(n.material) - prev.material);
   w.svarint(int64_t(n.level) - prev.level);
-  w.svarint(int64_t(n.page) - prev.page);
-  w.svarint(int64_t(n.offset) - (n.page == prev.page ? int64_t(prev.offset) + prev.size : 0));
-  w.varint(n.size);
+  if (!same_record) {
+    w.svarint(int64_t(n.page) - prev.page);
+    w.svarint(int64_t(n.offset) - (n.page == prev.page ? int64_t(prev.offset) + prev.size : 0));
+    w.varint(n.size);
+    w.varint(n.cluster);
+  }
   w.varint(n.triangles), w.varint(n.vertices);
   if (!same_children) write_ids(w, n.children, id);
   if (!same_parents) write_ids(w, n.parents, id);
@@ -165,25 +172,33 @@ NodeRecord read_node(ByteReader& r, const RootIndex& root, uint32_t id, RecordRu
   const NodeRecord& prev = run.previous();
   NodeRecord n;
   const uint8_t head = r.u8();
-  if (head & ~uint8_t(3 | 4 | kSameChildren | kSameParents))
+  if (head & ~uint8_t(3 | 4 | kSameChildren | kSameParents | kSameRecord))
     r.fail("node " + std::to_string(id) + ": unknown record flags");
   n.kind = NodeKind(head & 3), n.encoding = NodeEncoding((head >> 2) & 1);
-  if ((head & (kSameChildren | kSameParents)) && run.done.empty())
+  if ((head & (kSameChildren | kSameParents | kSameRecord)) && run.done.empty())
     r.fail("node " + std::to_string(id) + ": refers to a previous record that this run does not have");
   n.representation = read_delta(r, prev.representation, root.scene.representations.size(), "representation");
   n.material = read_delta(r, prev.material, root.scene.materials.size(), "material");
   n.level = read_delta(r, prev.level, 1u << 16, "level");
-  n.page = read_delta(r, prev.page, root.pages.size(), "page");
-  const int64_t base = n.page == prev.page ? int64_t(prev.offset) + prev.size : 0;
-  const int64_t delta = r.svarint();  // checked before adding so that nothing overflows
-  const int64_t offset = delta < -base || delta > int64_t(UINT32_MAX) ? -1 : base + delta;
-  const uint64_t size = r.varint();
-  if (offset < 0 || uint64_t(offset) > root.pages[n.page].raw_size ||
-      size > root.pages[n.page].raw_size - uint64_t(offset)) {
-    r.fail("node " + std::to_string(id) + ": bytes [" + std::to_string(offset) + ", +" +
-           std::to_string(size) + ") outside page " + std::to_string(n.page));
+  if (head & kSameRecord) {
+    n.page = prev.page, n.offset = prev.offset, n.size = prev.size, n.cluster = prev.cluster + 1;
+  } else {
+    n.page = read_delta(r, prev.page, root.pages.size(), "page");
+    const int64_t base = n.page == prev.page ? int64_t(prev.offset) + prev.size : 0;
+    const int64_t delta = r.svarint();  // checked before adding so that nothing overflows
+    const int64_t offset = delta < -base || delta > int64_t(UINT32_MAX) ? -1 : base + delta;
+    const uint64_t size = r.varint();
+    if (offset < 0 || uint64_t(offset) > root.pages[n.page].raw_size ||
+        size > root.pages[n.page].raw_size - uint64_t(offset)) {
+      r.fail("node " + std::to_string(id) + ": bytes [" + std::to_string(offset) + ", +" +
+             std::to_string(size) + ") outside page " + std::to_string(n.page));
+    }
+    n.offset = uint32_t(offset), n.size = uint32_t(size);
+    const uint64_t cluster = r.varint();
+    n.cluster = uint32_t(std::min<uint64_t>(cluster, kMaxRecordClusters));
   }
-  n.offset = uint32_t(offset), n.size = uint32_t(size);
+  if (n.cluster >= kMaxRecordClusters)
+    r.fail("node " + std::to_string(id) + ": cluster index of its record out of range");
   n.triangles = r.index(uint64_t(UINT32_MAX) + 1, "triangle count");
   n.vertices = r.index(uint64_t(UINT32_MAX) + 1, "vertex count");
   n.children = head & kSameChildren ? prev.children : read_ids(r, id, root.node_count, "child");

@@ -49,8 +49,11 @@ struct NodeRecord {
   uint32_t representation = 0;
   uint32_t material = 0;
   uint32_t level = 0;  // 0 = finest
-  // Where its bytes are: [offset, offset + size) of the decompressed page `page`. Filled in by the writer.
-  uint32_t page = 0, offset = 0, size = 0;
+  // Where its bytes are: [offset, offset + size) of the decompressed page `page`, the bytes of its record
+  // (node_codec.hpp, NodeGeometry::cluster_triangles: a page group's clusters stored as one node), of which
+  // it is cluster `cluster` (< kMaxRecordClusters; 0 for a node stored alone). The clusters of one record
+  // share page, offset and size. Filled in by the writer.
+  uint32_t page = 0, offset = 0, size = 0, cluster = 0;
   uint32_t triangles = 0, vertices = 0;
   float error = 0.0f;
   Sphere sphere;

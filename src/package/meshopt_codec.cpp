@@ -83,6 +83,7 @@ MeshoptCodec::MeshoptCodec() {
 }
 
 std::vector<uint8_t> MeshoptCodec::encode(const NodeGeometry& g, const PositionGrid& grid) const {
+  if (g.cluster_triangles.size() > 1) throw Error("node codec 1: one cluster per node");
   const QuantizedNode n = quantize_node(g, grid);
   const Mesh& m = *g.mesh;
   const size_t V = m.positions.size();
@@ -204,6 +205,7 @@ NodeSizeBreakdown MeshoptCodec::layout(std::span<const uint8_t> bytes, size_t no
   b.vertices = sizes[0];
   b.locked = sizes[1];
   b.indices = sizes[2] + p.extra_size;  // extra: a progressive step's chains (connectivity)
+  b.stored_vertices = p.vertices;
   return b;
 }
 

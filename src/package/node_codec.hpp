@@ -76,6 +76,11 @@ struct NodeGeometry {
   // Optional bytes stored losslessly after the geometry, opaque to the codec (e.g. a progressive step's
   // vertex-substitution chains, package/progressive_prefix.hpp).
   std::span<const uint8_t> extra;
+  // A record of several clusters (a page group's clusters welded on their shared vertices, one vertex pool):
+  // the triangle count of each cluster, adding up to the mesh's; the mesh's triangles are the clusters'
+  // consecutive ranges in this order. Empty = one cluster. At most NodeCodec::max_record_clusters() entries;
+  // the codec keeps each cluster's triangles a consecutive range (records.hpp extracts one).
+  std::span<const uint32_t> cluster_triangles;
 };
 
 // A decoded node: `mesh.indices` number vertices as the representation does (chunk vertex i is first_vertex +
@@ -87,6 +92,9 @@ struct DecodedNode {
   uint32_t index_end = 0;  // every index is below it (first_vertex + vertex count unless encoded larger)
   std::vector<uint32_t> vertex_data;
   std::vector<uint8_t> extra;
+  // A record's clusters: triangle count of each (consecutive ranges of mesh.indices, in order), as encoded;
+  // empty for a node of one cluster.
+  std::vector<uint32_t> cluster_triangles;
 };
 
 // Bytes of each part of one encoded node (before zstd), for size reports. Every codec lays the parts out in
@@ -102,6 +110,8 @@ struct NodeSizeBreakdown {
   // Of positions() and normals: their first bytes, the low byte planes where the codec stores byte planes
   // (codecs 2 and 3: one byte per vertex and component), 0 otherwise.
   size_t position_low = 0, normal_low = 0;
+  // The vertices the node stores (its header's count: a record's shared vertex pool).
+  uint32_t stored_vertices = 0;
   size_t total() const { return header + vertices + locked + indices; }
   size_t positions() const { return vertices - normals - attributes; }
 };
@@ -111,6 +121,9 @@ class NodeCodec {
   virtual ~NodeCodec() = default;
   // The id recorded in the package; unique per codec and per incompatible revision of its byte format.
   virtual uint32_t id() const = 0;
+  // The most clusters one encoded record may hold (NodeGeometry::cluster_triangles): 1 for a codec that
+  // stores one cluster per node (codecs 1 and 2, which reorder triangles freely).
+  virtual uint32_t max_record_clusters() const { return 1; }
   // Encodes; throws lodstream::Error on invalid input (sizes, > 65536 vertices, indices out of range,
   // positions off the grid's range). Thread-safe: callers may encode many nodes in parallel.
   virtual std::vector<uint8_t> encode(const NodeGeometry& geometry, const PositionGrid& grid) const = 0;

@@ -15,6 +15,10 @@ NodeHeader NodeHeader::of(uint8_t format, uint32_t flags, const NodeGeometry& g,
   h.first_vertex = g.first_vertex;
   h.index_end = n.index_end, h.extra_size = g.extra.size();
   if (h.index_end != h.first_vertex + h.vertices || h.extra_size != 0) h.flags |= kProgressive;
+  if (g.cluster_triangles.size() > 1) {
+    h.flags |= kClusters;
+    h.cluster_triangles.assign(g.cluster_triangles.begin(), g.cluster_triangles.end());
+  }
   std::copy(std::begin(n.cmin), std::end(n.cmin), h.cmin);
   h.uv_min = n.uv_min, h.uv_extent = n.uv_extent;
   return h;
@@ -31,6 +35,10 @@ void NodeHeader::write(ByteWriter& w) const {
   if (flags & kProgressive) w.varint(index_end), w.varint(extra_size);
   for (int64_t c : cmin) w.svarint(c);
   if (flags & kHasUvs) w.f32(uv_min.x), w.f32(uv_min.y), w.f32(uv_extent.x), w.f32(uv_extent.y);
+  if (flags & kClusters) {
+    w.varint(cluster_triangles.size());
+    for (size_t c = 0; c + 1 < cluster_triangles.size(); ++c) w.varint(cluster_triangles[c]);
+  }
 }
 
 NodeHeader NodeHeader::read(ByteReader& r, uint8_t format, uint32_t known_flags, size_t node_size) {
@@ -66,6 +74,20 @@ NodeHeader NodeHeader::read(ByteReader& r, uint8_t format, uint32_t known_flags,
   if (h.flags & kHasUvs) {
     h.uv_min = {r.finite_f32("uv"), r.finite_f32("uv")};
     h.uv_extent = {r.finite_f32("uv"), r.finite_f32("uv")};
+  }
+  if (h.flags & kClusters) {
+    const uint64_t count = r.varint();
+    if (count < 2 || count > kMaxRecordClusters)
+      r.fail("cluster count " + std::to_string(count) + " invalid");
+    h.cluster_triangles.resize(count);
+    uint64_t sum = 0;
+    for (uint64_t c = 0; c + 1 < count; ++c) {
+      const uint64_t t = r.varint();
+      if (t == 0 || t >= h.triangles - std::min<uint64_t>(h.triangles, sum))
+        r.fail("cluster triangle counts invalid");
+      h.cluster_triangles[c] = uint32_t(t), sum += t;
+    }
+    h.cluster_triangles.back() = h.triangles - uint32_t(sum);
   }
   return h;
 }

@@ -117,6 +117,7 @@ PredictiveCodec::PredictiveCodec() {
 }
 
 std::vector<uint8_t> PredictiveCodec::encode(const NodeGeometry& g, const PositionGrid& grid) const {
+  if (g.cluster_triangles.size() > 1) throw Error("node codec 2: one cluster per node");
   const QuantizedNode n = quantize_node(g, grid);
   const Mesh& m = *g.mesh;
   const uint32_t V = uint32_t(m.positions.size());

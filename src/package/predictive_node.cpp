@@ -106,6 +106,7 @@ NodeSizeBreakdown PredictiveNode::layout(std::span<const uint8_t> bytes, size_t 
   b.locked = sizes[1];
   b.indices = node_size - b.header - b.vertices - b.locked;  // connectivity and tail
   if (tail) *tail = b.indices - sizes[2];
+  b.stored_vertices = p.vertices;
   return b;
 }
 

@@ -32,6 +32,14 @@ QuantizedNode quantize_node(const NodeGeometry& g, const PositionGrid& grid) {
   for (uint32_t i : m.indices) {
     if (i >= index_end) invalid("index " + std::to_string(i) + " out of range");
   }
+  if (g.cluster_triangles.size() > kMaxRecordClusters) invalid("more clusters than a record may hold");
+  uint64_t cluster_sum = 0;
+  for (uint32_t t : g.cluster_triangles) {
+    if (t == 0) invalid("a cluster of no triangles");
+    cluster_sum += t;
+  }
+  if (!g.cluster_triangles.empty() && cluster_sum != m.indices.size() / 3)
+    invalid("cluster triangle counts do not add up to the triangles");
 
   // Vertex order: meshopt's vertex-cache then vertex-fetch order (what its codecs compress best), unless the
   // caller's order is significant. order[new] = old.

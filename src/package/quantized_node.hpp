@@ -19,6 +19,10 @@ namespace lodstream::package {
 constexpr size_t kMaxNodeVertices = 65536;
 constexpr uint32_t kMaxPositionShift = 24;
 constexpr int64_t kMaxGridCoordinate = int64_t(1) << 30;
+// The most clusters one record holds (NodeGeometry::cluster_triangles; a DAG group's input clusters are about
+// 8, the bake splits larger page groups; 31: a cluster tag fits a traversal symbol's 5 high bits,
+// traversal_connectivity.hpp).
+constexpr uint32_t kMaxRecordClusters = 31;
 
 struct QuantizedNode {
   std::vector<uint32_t> order;    // order[new] = the caller's vertex
@@ -30,9 +34,10 @@ struct QuantizedNode {
   glm::vec2 uv_min{0.0f}, uv_extent{0.0f};  // the node's UV box (zero without UVs)
 };
 
-// Validates (throws lodstream::Error "node codec: ..." on the errors NodeCodec::encode lists), reorders for
-// meshopt's codecs (vertex-cache, then vertex-fetch order: vertices in first-use order) unless first_vertex >
-// 0 or preserve_order, and quantizes. Cost: O(V + T) plus meshopt's reordering.
+// Validates (throws lodstream::Error "node codec: ..." on the errors NodeCodec::encode lists, and cluster
+// triangle counts that are more than kMaxRecordClusters, zero or do not add up to the triangles), reorders
+// for meshopt's codecs (vertex-cache, then vertex-fetch order: vertices in first-use order) unless
+// first_vertex > 0 or preserve_order, and quantizes. Cost: O(V + T) plus meshopt's reordering.
 QuantizedNode quantize_node(const NodeGeometry& geometry, const PositionGrid& grid);
 
 // Renumbers the node's vertices: new vertex i is current vertex order[i] (order, q, c and locked follow;

@@ -4,6 +4,7 @@
 
 #include "core/error.hpp"
 #include "package/page_parts.hpp"
+#include "package/records.hpp"
 
 namespace lodstream::package {
 
@@ -164,7 +165,24 @@ DecodedNode PackageReader::decode_node(uint32_t id, std::span<const uint8_t> pag
   const std::string what = where("node " + std::to_string(id) + " (page " + std::to_string(n.page) + ")");
   if (n.encoding != NodeEncoding::codec) throw Error(what + ": holds raw bytes, not codec geometry");
   std::span<const uint8_t> bytes = node_bytes(id, page);
-  DecodedNode decoded = codec_->decode(bytes, root_.scene.representations[n.representation].grid, what);
+  const Representation& rep = root_.scene.representations[n.representation];
+  DecodedNode decoded;
+  const bool cached = last_record_.valid && last_record_.page == n.page && last_record_.offset == n.offset &&
+                      last_record_.size == n.size;
+  if (cached) {
+    decoded = extract_cluster(last_record_.decoded, n.cluster, what);
+  } else {
+    DecodedNode record = codec_->decode(bytes, rep.grid, what);
+    if (record_clusters(record) == 1) {
+      if (n.cluster != 0) extract_cluster(record, n.cluster, what);  // throws: out of range
+      decoded = std::move(record);
+    } else {
+      // A record of several clusters: its clusters are usually decoded one after another (consecutive ids of
+      // one page group), so it is kept until another record is decoded.
+      decoded = extract_cluster(record, n.cluster, what);
+      last_record_ = {true, n.page, n.offset, n.size, std::move(record)};
+    }
+  }
   if (decoded.mesh.triangle_count() != n.triangles || decoded.mesh.vertex_count() != n.vertices) {
     throw Error(what + ": record says " + std::to_string(n.triangles) + " triangles / " +
                 std::to_string(n.vertices) + " vertices, its bytes hold " +

@@ -49,7 +49,9 @@ class PackageReader {
   // Node `id`'s bytes inside its decompressed page.
   std::span<const uint8_t> node_bytes(uint32_t id, std::span<const uint8_t> page);
   // Decodes codec node `id` from its decompressed page and checks the result against the node's record
-  // (counts, and every index within the representation's vertices).
+  // (counts, and every index within the representation's vertices). A node that is one cluster of a record
+  // (NodeRecord::cluster) gets that cluster alone (records.hpp); the last record of several clusters
+  // decoded is kept, so decoding its clusters one after another (consecutive ids) decodes it once.
   DecodedNode decode_node(uint32_t id, std::span<const uint8_t> page);
   // read_page + decode_node.
   DecodedNode load_node(uint32_t id);
@@ -77,6 +79,12 @@ class PackageReader {
   RootIndex root_;
   const NodeCodec* codec_ = nullptr;
   std::vector<std::vector<NodeRecord>> index_pages_;  // loaded records, by index page (empty until loaded)
+  struct LastRecord {
+    bool valid = false;
+    uint32_t page = 0, offset = 0, size = 0;
+    DecodedNode decoded;
+  };
+  LastRecord last_record_;  // decode_node's last record of several clusters
 };
 
 }  // namespace lodstream::package

@@ -28,17 +28,25 @@ std::vector<LevelAccount> account_sizes(PackageReader& reader, const SizeAccount
   for (uint32_t page = 0; page < ranges.size(); ++page) {
     if (on_page[page].empty()) continue;
     const std::vector<uint8_t> raw = reader.read_page(page);
-    uint64_t page_raw = 0;
-    for (uint32_t id : on_page[page]) page_raw += reader.node(id).size;
-    for (uint32_t id : on_page[page]) {
+    uint64_t page_raw = 0;  // the page's node bytes, each record once
+    for (size_t k = 0; k < on_page[page].size(); ++k) {
+      const NodeRecord& n = reader.node(on_page[page][k]);
+      if (k == 0 || n.offset != reader.node(on_page[page][k - 1]).offset) page_raw += n.size;
+    }
+    for (size_t k = 0; k < on_page[page].size(); ++k) {
+      const uint32_t id = on_page[page][k];
       const NodeRecord& n = reader.node(id);
+      Level& l = levels[n.level];
+      l.account.level = n.level;
+      ++l.account.nodes, l.account.triangles += n.triangles;
+      // A record's bytes and stored vertices go to the level of its first cluster (a DAG group's input
+      // clusters: one level, but for a cluster left over from an abandoned group).
+      if (k > 0 && n.offset == reader.node(on_page[page][k - 1]).offset) continue;
       const std::span<const uint8_t> bytes = reader.node_bytes(id, raw);
       const NodeSizeBreakdown b = reader.codec().breakdown(bytes, "node " + std::to_string(id));
       const size_t sizes[kNodeParts] = {b.header,     b.positions(), b.normals,
                                         b.attributes, b.locked,      b.indices};
-      Level& l = levels[n.level];
-      l.account.level = n.level;
-      ++l.account.nodes, l.account.triangles += n.triangles, l.account.vertices += n.vertices;
+      l.account.vertices += b.stored_vertices;
       l.account.page_bytes += double(ranges[page].size) * double(n.size) / double(page_raw);
       size_t at = 0;
       for (uint32_t p = 0; p < kNodeParts; ++p) {  // the parts are consecutive (node_codec.hpp)

@@ -1,8 +1,9 @@
 // Where a package's bytes go: per level, per part of the nodes (header, positions, normals, other attributes,
 // locked stream, connectivity), raw and after zstd, with the vertices each level stores per triangle (a
-// cluster's border vertices repeat in every cluster that holds them). The pages' zstd runs over whole pages,
-// so a part's bytes after zstd are measured by compressing that part alone: each level's bytes of that part,
-// in node order, cut into chunks of `chunk` bytes (the size of a page), each compressed as the writer
+// cluster's border vertices repeat in every record that holds it; a record of several clusters stores them
+// once, and its bytes and vertices count at the level of its first cluster). The pages' zstd runs over whole
+// pages, so a part's bytes after zstd are measured by compressing that part alone: each level's bytes of that
+// part, in node order, cut into chunks of `chunk` bytes (the size of a page), each compressed as the writer
 // compresses a page. The sum over parts is therefore close to, not equal to, the pages' stored bytes, which
 // are given per level as well (a page's stored bytes shared among the levels of its nodes by their raw
 // bytes). Used by `lodstream inspect --parts` and the package benchmark.

@@ -14,7 +14,7 @@ namespace {
 
 constexpr uint8_t kFormat = 2;
 constexpr uint8_t kOrderedFormat = 1;  // codec 2's bytes
-constexpr uint32_t kAllFlags = kHasNormals | kHasUvs | kHasColors | kHasVertexData;
+constexpr uint32_t kAllFlags = kHasNormals | kHasUvs | kHasColors | kHasVertexData | kClusters;
 
 const PredictiveCodec& ordered_codec() {
   static const PredictiveCodec codec;
@@ -27,6 +27,10 @@ bool order_is_significant(const NodeGeometry& g) {
 
 }  // namespace
 
+uint32_t TraversalCodec::max_record_clusters() const {
+  return kMaxRecordClusters;
+}
+
 std::vector<uint8_t> TraversalCodec::encode(const NodeGeometry& g, const PositionGrid& grid) const {
   if (g.mesh && order_is_significant(g)) return ordered_codec().encode(g, grid);
   NodeGeometry in_order = g;
@@ -36,7 +40,7 @@ std::vector<uint8_t> TraversalCodec::encode(const NodeGeometry& g, const Positio
   const uint32_t V = uint32_t(m.positions.size());
   const uint32_t flags = attribute_flags(g);
 
-  TraversalCode code = encode_traversal(n.indices, V);
+  TraversalCode code = encode_traversal(n.indices, V, g.cluster_triangles);
   reorder_vertices(n, code.order);
   n.indices = std::move(code.indices);
   const std::vector<uint8_t> locked_stream = encode_locked_stream(n, g.position_shift);
@@ -56,8 +60,10 @@ DecodedNode TraversalCodec::decode(std::span<const uint8_t> bytes, const Positio
   out.mesh.indices.resize(3 * size_t(p.triangles));
   thread_local std::vector<uint32_t> predictors;
   predictors.resize(3 * (size_t(V) + 1));
-  decode_traversal(p.connectivity, p.tail, p.triangles, V, out.mesh.indices.data(), predictors.data(), where);
+  decode_traversal(p.connectivity, p.tail, p.triangles, V, out.mesh.indices.data(), predictors.data(), where,
+                   p.cluster_triangles);
   decode_predicted_vertices(p, predictors, grid, out, where);
+  out.cluster_triangles = p.cluster_triangles;
   return out;
 }
 

@@ -11,8 +11,14 @@
 // codec 2 does (its bytes, format 1) and decodes by the format byte.
 //
 // Bytes of a traversal node: predictive_node.hpp's layout with format 2 and flags 1 normals, 2 uvs,
-//   4 colors, 8 vertex_data; the connectivity stream is the traversal's symbols, the tail its references.
-//   Vertices are numbered in traversal order and predicted by the traversal's predictors.
+//   4 colors, 8 vertex_data, 64 clusters (node_header.hpp); the connectivity stream is the traversal's
+//   symbols, the tail its references. Vertices are numbered in traversal order and predicted by the
+//   traversal's predictors.
+// Records: a page group's clusters encoded as one node (NodeGeometry::cluster_triangles) share one vertex
+//   pool, so a vertex that several of its clusters hold is stored and predicted once (a cluster alone
+//   stores its border vertices again and predicts them from half their fan); the traversal tags each
+//   triangle's cluster and the decoder returns each cluster's triangles as a consecutive range
+//   (traversal_connectivity.hpp). A record of progressive steps (order significant) is refused.
 #pragma once
 
 #include "package/node_codec.hpp"
@@ -23,6 +29,7 @@ class TraversalCodec final : public NodeCodec {
  public:
   static constexpr uint32_t kId = 3;
   uint32_t id() const override { return kId; }
+  uint32_t max_record_clusters() const override;
   std::vector<uint8_t> encode(const NodeGeometry& geometry, const PositionGrid& grid) const override;
   DecodedNode decode(std::span<const uint8_t> bytes, const PositionGrid& grid,
                      const std::string& where) const override;

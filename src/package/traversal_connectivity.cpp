@@ -15,6 +15,7 @@ class Front {
   enum State : uint32_t { kPending, kDone, kGone };  // to process; in its loop, processed; out of the loops
   struct Edge {
     uint32_t a, b, o, prev, next, state;
+    uint32_t cluster;  // of its triangle (records of several clusters; 0 otherwise)
   };
 
   // A front for T triangles in `storage` (reused between calls): its edges pointer and size live in the
@@ -47,32 +48,33 @@ class Front {
     return g.prev != g.next && edges_[g.next].next == g.prev;
   }
 
-  void start(uint32_t v0, uint32_t v1, uint32_t v2) {
+  // The new triangle's edges get its cluster k.
+  void start(uint32_t v0, uint32_t v1, uint32_t v2, uint32_t k) {
     const uint32_t at = size_;
-    push(v0, v1, v2, at + 2, at + 1);
-    push(v1, v2, v0, at, at + 2);
-    push(v2, v0, v1, at + 1, at);
+    push(v0, v1, v2, at + 2, at + 1, k);
+    push(v1, v2, v0, at, at + 2, k);
+    push(v2, v0, v1, at + 1, at, k);
   }
   // kVertex and kSplit: the gate a -> b becomes a -> c, c -> b.
-  void attach(uint32_t e, uint32_t c) {
+  void attach(uint32_t e, uint32_t c, uint32_t k) {
     const uint32_t a = edges_[e].a, b = edges_[e].b, prev = edges_[e].prev, next = edges_[e].next;
     const uint32_t x = size_, y = x + 1;
-    push(a, c, b, prev, y);
-    push(c, b, a, x, next);
+    push(a, c, b, prev, y, k);
+    push(c, b, a, x, next, k);
     edges_[prev].next = x;  // a loop has 2 edges or more: prev and next are not the gate
     edges_[next].prev = y;
     edges_[e].state = kGone;
   }
   // kLeft: P = p -> a and the gate become p -> b.
-  void close_left(uint32_t e) {
+  void close_left(uint32_t e, uint32_t k) {
     Edge &g = edges_[e], &p = edges_[g.prev];
-    link(p.prev, g.next, p.a, g.b, g.a);
+    link(p.prev, g.next, p.a, g.b, g.a, k);
     p.state = g.state = kGone;
   }
   // kRight: the gate and N = b -> n become a -> n.
-  void close_right(uint32_t e) {
+  void close_right(uint32_t e, uint32_t k) {
     Edge &g = edges_[e], &n = edges_[g.next];
-    link(g.prev, n.next, g.a, n.b, g.b);
+    link(g.prev, n.next, g.a, n.b, g.b, k);
     n.state = g.state = kGone;
   }
   // kEnd: the loop of 3 is gone.
@@ -84,14 +86,14 @@ class Front {
   void done(uint32_t e) { edges_[e].state = kDone; }
 
  private:
-  void push(uint32_t a, uint32_t b, uint32_t o, uint32_t prev, uint32_t next) {
+  void push(uint32_t a, uint32_t b, uint32_t o, uint32_t prev, uint32_t next, uint32_t k) {
     Edge& x = edges_[size_++];
-    x.a = a, x.b = b, x.o = o, x.prev = prev, x.next = next, x.state = kPending;
+    x.a = a, x.b = b, x.o = o, x.prev = prev, x.next = next, x.state = kPending, x.cluster = k;
   }
   // A new edge a -> b (third corner o) between `before` and `after`.
-  void link(uint32_t before, uint32_t after, uint32_t a, uint32_t b, uint32_t o) {
+  void link(uint32_t before, uint32_t after, uint32_t a, uint32_t b, uint32_t o, uint32_t k) {
     const uint32_t x = size_;
-    push(a, b, o, before, after);
+    push(a, b, o, before, after, k);
     edges_[before].next = x;
     edges_[after].prev = x;
   }
@@ -105,10 +107,38 @@ void put_varint(std::vector<uint8_t>& out, uint32_t v) {
   out.push_back(uint8_t(v));
 }
 
+// The symbol byte of a triangle of cluster k across a gate of cluster `gate` (traversal_connectivity.hpp).
+uint8_t tagged(TraversalSymbol symbol, uint32_t k, uint32_t gate) {
+  return uint8_t(symbol | (k == gate ? 0 : (k + 1) << 3));
+}
+
+// Writes the triangles `from` (3 indices each) into `to` in the clusters' ranges, in their order within each
+// cluster; false when the clusters' triangle counts differ from `cluster_triangles`. Cost: O(T).
+bool sort_by_cluster(const uint32_t* from, uint32_t* to, std::span<const uint8_t> cluster_of,
+                     std::span<const uint32_t> cluster_triangles) {
+  thread_local std::vector<uint32_t> at;
+  at.assign(cluster_triangles.size() + 1, 0);
+  for (uint8_t k : cluster_of) ++at[k + 1];  // k < cluster_triangles.size(), checked by the callers
+  for (size_t k = 0; k < cluster_triangles.size(); ++k) {
+    if (at[k + 1] != cluster_triangles[k]) return false;
+    at[k + 1] += at[k];
+  }
+  for (size_t t = 0; t < cluster_of.size(); ++t) {
+    uint32_t* x = to + 3 * size_t(at[cluster_of[t]]++);
+    x[0] = from[3 * t], x[1] = from[3 * t + 1], x[2] = from[3 * t + 2];
+  }
+  return true;
+}
+
 }  // namespace
 
-TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V) {
+TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
+                               std::span<const uint32_t> cluster_triangles) {
   const uint32_t T = uint32_t(indices.size() / 3);
+  const bool clustered = cluster_triangles.size() > 1;
+  std::vector<uint8_t> cluster_of(T, 0), emitted_cluster;  // by input triangle; by emitted triangle
+  for (uint32_t c = 0, t = 0; c < cluster_triangles.size(); ++c)
+    for (uint32_t k = 0; k < cluster_triangles[c] && t < T; ++k) cluster_of[t++] = uint8_t(c);
   TraversalCode code;
   code.indices.reserve(indices.size());
   code.predictors.reserve(3 * size_t(V));
@@ -129,7 +159,10 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V) {
     code.predictors.insert(code.predictors.end(), {o1, o2, o});
     return decoded[input];
   };
-  auto emit = [&](uint32_t a, uint32_t b, uint32_t c) { code.indices.insert(code.indices.end(), {a, b, c}); };
+  auto emit = [&](uint32_t a, uint32_t b, uint32_t c, uint8_t k) {
+    code.indices.insert(code.indices.end(), {a, b, c});
+    emitted_cluster.push_back(k);
+  };
 
   std::vector<Front::Edge> edges;
   Front front(edges, T);
@@ -141,6 +174,8 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V) {
     if (e == front.size()) {
       while (encoded[scan]) ++scan;
       encoded[scan] = 1;
+      const uint8_t k = cluster_of[scan];
+      if (clustered) put_varint(code.references, k);
       uint32_t corner[3];
       for (int k = 0; k < 3; ++k) {
         const uint32_t input = indices[3 * scan + k];
@@ -154,8 +189,8 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V) {
           corner[k] = add_vertex(input, from, from, from);
         }
       }
-      front.start(corner[0], corner[1], corner[2]);
-      emit(corner[0], corner[1], corner[2]);
+      front.start(corner[0], corner[1], corner[2], k);
+      emit(corner[0], corner[1], corner[2], k);
       ++done;
       continue;
     }
@@ -173,27 +208,28 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V) {
       continue;
     }
     encoded[across / 3] = 1;
+    const uint8_t k = cluster_of[across / 3];
     const uint32_t c_in = indices[next_corner(next_corner(across))];
     uint32_t c = decoded[c_in];
     if (c == kNone) {
-      code.symbols.push_back(kVertex);
+      code.symbols.push_back(tagged(kVertex, k, g.cluster));
       c = add_vertex(c_in, g.a, g.b, g.o);
-      front.attach(e, c);
+      front.attach(e, c, k);
     } else if (front.closes(e) && c == front.left(e)) {
-      code.symbols.push_back(kEnd);
+      code.symbols.push_back(tagged(kEnd, k, g.cluster));
       front.close_loop(e);
     } else if (c == front.left(e)) {
-      code.symbols.push_back(kLeft);
-      front.close_left(e);
+      code.symbols.push_back(tagged(kLeft, k, g.cluster));
+      front.close_left(e, k);
     } else if (c == front.right(e)) {
-      code.symbols.push_back(kRight);
-      front.close_right(e);
+      code.symbols.push_back(tagged(kRight, k, g.cluster));
+      front.close_right(e, k);
     } else {
-      code.symbols.push_back(kSplit);
+      code.symbols.push_back(tagged(kSplit, k, g.cluster));
       put_varint(code.references, uint32_t(code.order.size()) - 1 - c);
-      front.attach(e, c);
+      front.attach(e, c, k);
     }
-    emit(g.b, g.a, c);
+    emit(g.b, g.a, c, k);
     ++done;
   }
   for (uint32_t v = 0; v < V; ++v) {
@@ -201,11 +237,16 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V) {
     const uint32_t from = code.order.empty() ? V : uint32_t(code.order.size()) - 1;
     add_vertex(v, from, from, from);
   }
+  if (clustered) {
+    const std::vector<uint32_t> traversal_order = code.indices;
+    sort_by_cluster(traversal_order.data(), code.indices.data(), emitted_cluster, cluster_triangles);
+  }
   return code;
 }
 
 void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t> references, uint32_t T,
-                      uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where) {
+                      uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where,
+                      std::span<const uint32_t> cluster_triangles) {
   ByteReader refs(references, where);
   auto fail = [&](const char* what) { throw Error(where + ": corrupted connectivity (" + what + ")"); };
   thread_local std::vector<Front::Edge> edges;
@@ -213,12 +254,26 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
   uint32_t next = 0;  // the next new vertex
   const uint8_t* symbol = symbols.data();
   const uint8_t* const symbols_end = symbol + symbols.size();
-  uint32_t* out = indices;
-  const uint32_t* const end = indices + 3 * size_t(T);
+  // Clusters of a record: each triangle's, the triangles decoded into `traversal_order` and then sorted into
+  // the clusters' ranges of `indices`; C = 1 otherwise (every symbol's cluster code must then be 0).
+  const uint32_t C = cluster_triangles.size() > 1 ? uint32_t(cluster_triangles.size()) : 1;
+  thread_local std::vector<uint8_t> cluster_of;
+  thread_local std::vector<uint32_t> traversal_order;
+  if (C > 1) cluster_of.resize(T), traversal_order.resize(3 * size_t(T));
+  uint32_t* out = C > 1 ? traversal_order.data() : indices;
+  const uint32_t* const end = out + 3 * size_t(T);
+  uint8_t* cluster = cluster_of.data();
   uint32_t e = 0;  // the gate
   while (out != end) {
     e = front.gate(e);
     if (e == front.size()) {
+      uint32_t k = 0;
+      if (C > 1) {
+        const uint64_t read = refs.varint();
+        if (read >= C) fail("cluster out of range");
+        k = uint32_t(read);
+        *cluster++ = uint8_t(k);
+      }
       uint32_t corner[3];
       for (int k = 0; k < 3; ++k) {
         const uint64_t r = refs.varint();
@@ -232,7 +287,7 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
           corner[k] = next - uint32_t(r);
         }
       }
-      front.start(corner[0], corner[1], corner[2]);
+      front.start(corner[0], corner[1], corner[2], k);
       out[0] = corner[0], out[1] = corner[1], out[2] = corner[2];
       out += 3;
       continue;
@@ -240,23 +295,26 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
     if (symbol == symbols_end) fail("symbols end early");
     const Front::Edge& g = front.edge(e);
     const uint32_t a = g.a, b = g.b;
+    const uint32_t code = *symbol >> 3;  // 0: the gate's cluster, else cluster code - 1
+    const uint32_t k = code == 0 ? g.cluster : code - 1;
+    if (k >= C) fail("cluster out of range");
     uint32_t c;
-    switch (*symbol++) {
+    switch (*symbol++ & 7) {
       case kVertex:
         if (next == V) fail("more vertices than the node holds");
         c = next++;
         predictors[3 * c] = a, predictors[3 * c + 1] = b, predictors[3 * c + 2] = g.o;
-        front.attach(e, c);
+        front.attach(e, c, k);
         break;
       case kLeft:
         c = front.left(e);
         if (c == kNone) fail("left turn in a loop of 2");
-        front.close_left(e);
+        front.close_left(e, k);
         break;
       case kRight:
         c = front.right(e);
         if (c == kNone) fail("right turn in a loop of 2");
-        front.close_right(e);
+        front.close_right(e, k);
         break;
       case kEnd:
         if (!front.closes(e)) fail("end of a loop that is not 3 edges");
@@ -267,7 +325,7 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
         const uint64_t r = refs.varint();
         if (r >= next) fail("reference to a vertex not decoded yet");
         c = next - 1 - uint32_t(r);
-        front.attach(e, c);
+        front.attach(e, c, k);
         break;
       }
       case kBoundary:
@@ -278,10 +336,14 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
     }
     out[0] = b, out[1] = a, out[2] = c;
     out += 3;
+    if (C > 1) *cluster++ = uint8_t(k);
     ++e;
   }
   if (symbol != symbols_end) fail("symbols left over");
   if (!refs.at_end()) fail("references left over");
+  if (C > 1 &&
+      !sort_by_cluster(traversal_order.data(), indices, std::span(cluster_of).first(T), cluster_triangles))
+    fail("triangles per cluster differ from the header's");
   for (; next < V; ++next) {
     const uint32_t from = next > 0 ? next - 1 : V;
     predictors[3 * next] = predictors[3 * next + 1] = predictors[3 * next + 2] = from;

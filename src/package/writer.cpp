@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "package/meshopt_codec.hpp"
 #include "package/page_parts.hpp"
+#include "package/quantized_node.hpp"
 
 namespace lodstream::package {
 
@@ -58,13 +59,22 @@ Range PackageWriter::write_stored(std::span<const uint8_t> bytes, uint32_t raw_s
 }
 
 void PackageWriter::add_node(uint32_t id, std::span<const uint8_t> bytes) {
-  if (bytes.size() > kMaxPageRawBytes) {
-    throw Error(file_.string() + ": node " + std::to_string(id) + " is larger than a page may be");
+  add_record(std::span(&id, 1), bytes);
+}
+
+void PackageWriter::add_record(std::span<const uint32_t> ids, std::span<const uint8_t> bytes) {
+  if (ids.empty() || ids.size() > kMaxRecordClusters) {
+    throw Error(file_.string() + ": a record of " + std::to_string(ids.size()) + " clusters");
   }
-  if (id >= locations_.size()) locations_.resize(size_t(id) + 1);
-  if (locations_[id].added) throw Error(file_.string() + ": node " + std::to_string(id) + " added twice");
-  locations_[id].added = true;
-  group_.push_back({id, group_bytes_.size(), bytes.size()});
+  if (bytes.size() > kMaxPageRawBytes) {
+    throw Error(file_.string() + ": node " + std::to_string(ids[0]) + " is larger than a page may be");
+  }
+  for (uint32_t id : ids) {
+    if (id >= locations_.size()) locations_.resize(size_t(id) + 1);
+    if (locations_[id].added) throw Error(file_.string() + ": node " + std::to_string(id) + " added twice");
+    locations_[id].added = true;
+  }
+  group_.push_back({{ids.begin(), ids.end()}, group_bytes_.size(), bytes.size()});
   group_bytes_.insert(group_bytes_.end(), bytes.begin(), bytes.end());
 }
 
@@ -72,8 +82,10 @@ void PackageWriter::place(size_t first, size_t end) {
   for (size_t i = first; i < end; ++i) {
     const Entry& e = group_[i];
     if (!page_.empty() && page_.size() + e.size > options_.page_bytes) flush_page();
-    locations_[e.id] = {uint32_t(pages_.size() + pending_.size()), uint32_t(page_.size()), uint32_t(e.size),
-                        true};
+    for (uint32_t c = 0; c < e.ids.size(); ++c) {
+      locations_[e.ids[c]] = {uint32_t(pages_.size() + pending_.size()), uint32_t(page_.size()),
+                              uint32_t(e.size), c, true};
+    }
     page_.insert(page_.end(), group_bytes_.begin() + e.offset, group_bytes_.begin() + e.offset + e.size);
     page_nodes_.push_back(uint32_t(e.size));
   }
@@ -134,6 +146,7 @@ WrittenPackage PackageWriter::finish(PackageScene scene, std::vector<NodeRecord>
     nodes[id].page = locations_[id].page;
     nodes[id].offset = locations_[id].offset;
     nodes[id].size = locations_[id].size;
+    nodes[id].cluster = locations_[id].cluster;
   }
 
   RootIndex root;

@@ -13,6 +13,7 @@
 // Typical use (encoding may run in parallel; adding is serial):
 //   PackageWriter w("scene.lods");
 //   for each group in page order: for each node: w.add_node(id, codec.encode(geometry, grid)); w.end_group();
+//   (or, for a record of several clusters, w.add_record(ids, codec.encode(record, grid)))
 //   w.finish(scene, records, root_node_count);
 #pragma once
 
@@ -62,6 +63,10 @@ class PackageWriter {
   // Appends node `id`'s bytes (from the package's codec, or raw bytes for NodeEncoding::raw) to the current
   // group. Each id once.
   void add_node(uint32_t id, std::span<const uint8_t> bytes);
+  // Appends a record of several clusters (NodeGeometry::cluster_triangles: the codec's bytes of them all) to
+  // the current group: node ids[c] is its cluster c (NodeRecord::cluster), all of them pointing at these
+  // bytes. 1..kMaxRecordClusters ids, each id once.
+  void add_record(std::span<const uint32_t> ids, std::span<const uint8_t> bytes);
   // Closes the current group (see the packing rule above).
   void end_group();
   // Stores an opaque byte string (an embedded texture file) uncompressed in its own range; returns its blob
@@ -81,11 +86,11 @@ class PackageWriter {
   void write(std::span<const uint8_t> bytes, bool hashed);
 
   struct Entry {
-    uint32_t id;
-    size_t offset, size;  // in group_bytes_
+    std::vector<uint32_t> ids;  // the record's clusters
+    size_t offset, size;        // in group_bytes_
   };
   struct Location {
-    uint32_t page = kNone, offset = 0, size = 0;
+    uint32_t page = kNone, offset = 0, size = 0, cluster = 0;
     bool added = false;
   };
 

@@ -113,6 +113,9 @@ size_t CutGeometry::update(const schedule::Cut& cut, const PageSource& pages) {
   size_t decoded = 0;
   for (auto& [page, ids] : missing_by_page) {
     const std::vector<uint8_t> bytes = pages(page);
+    // In id order: the clusters of one record are consecutive ids, decoded from one decode of the record
+    // (PackageReader::decode_node keeps the last).
+    std::sort(ids.begin(), ids.end());
     for (uint32_t id : ids) {
       if (decoded_.count(id)) continue;  // an instanced node listed once per object
       package::DecodedNode node = reader_->decode_node(id, bytes);

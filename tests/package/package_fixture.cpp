@@ -1,10 +1,14 @@
 #include "package_fixture.hpp"
 
+#include "package/records.hpp"
+
+#include <algorithm>
 #include <map>
 #include <set>
 #include <tuple>
 
 #include "package/meshopt_codec.hpp"
+#include "package/records.hpp"
 #include "support/shapes.hpp"
 
 namespace lodstream::test {
@@ -80,15 +84,41 @@ TestPackage write_test_package(const std::filesystem::path& file, uint32_t codec
     std::vector<std::vector<uint8_t>> locked;
     std::vector<Mesh> chunks = split_into_chunks(*meshes[r], r == 0 ? 40 : 18, locked);
     const uint32_t first = uint32_t(t.records.size());
+    // The sphere's page groups as records when the codec stores them (package/records.hpp).
+    const bool records = r == 0 && node_codec(codec).max_record_clusters() >= 3;
     for (size_t i = 0; i < chunks.size(); ++i) {
       const uint32_t id = uint32_t(t.records.size());
       const uint32_t shift = uint32_t(i % 4);
-      NodeGeometry g;
-      g.mesh = &chunks[i];
-      g.locked = locked[i];
-      g.position_shift = shift;
-      g.normal_bits = 12;
-      writer.add_node(id, node_codec(codec).encode(g, rep.grid));
+      uint32_t vertices = uint32_t(chunks[i].vertex_count());
+      if (!records) {
+        NodeGeometry g;
+        g.mesh = &chunks[i];
+        g.locked = locked[i];
+        g.position_shift = shift;
+        g.normal_bits = 12;
+        writer.add_node(id, node_codec(codec).encode(g, rep.grid));
+      } else if (i % 3 == 2 || i + 1 == chunks.size()) {  // the group's last chunk: its record
+        const size_t group = i - i % 3;
+        std::vector<const Mesh*> meshes;
+        std::vector<std::span<const uint8_t>> group_locked;
+        std::vector<uint32_t> ids;
+        uint32_t smallest_shift = UINT32_MAX;
+        for (size_t k = group; k <= i; ++k) {
+          meshes.push_back(&chunks[k]), group_locked.push_back(locked[k]),
+              ids.push_back(id - uint32_t(i - k));
+          smallest_shift = std::min(smallest_shift, uint32_t(k % 4));
+        }
+        const RecordMesh record = weld_record(meshes, group_locked);
+        NodeGeometry g;
+        g.mesh = &record.mesh;
+        g.locked = record.locked;
+        g.position_shift = smallest_shift;
+        g.normal_bits = 12;
+        g.cluster_triangles = record.cluster_triangles;
+        writer.add_record(ids, node_codec(codec).encode(g, rep.grid));
+        for (size_t k = group; k < i; ++k) t.records[first + k].vertices = record.cluster_vertices[k - group];
+        vertices = record.cluster_vertices.back();
+      }
       if (i % 3 == 2) writer.end_group();
 
       NodeRecord n;
@@ -97,7 +127,7 @@ TestPackage write_test_package(const std::filesystem::path& file, uint32_t codec
       n.material = chunks[i].material;
       n.level = shift;
       n.triangles = uint32_t(chunks[i].triangle_count());
-      n.vertices = uint32_t(chunks[i].vertex_count());
+      n.vertices = vertices;
       Bounds b = chunks[i].bounds();
       n.sphere = {b.center(), 0.5f * b.diagonal()};
       n.error = 0.001f * float(shift);

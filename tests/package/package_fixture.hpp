@@ -1,6 +1,8 @@
 // A small multi-object package built in code for the package tests: two representations (a UV sphere with
 // normals and UVs, a cube with seams and colours) cut into chunks of a few dozen triangles, one node per
-// chunk, each chunk at its own position shift, with every vertex that two chunks share flagged as locked;
+// chunk (with codec 3, each page group of 3 sphere chunks is one record of 3 clusters, package/records.hpp,
+// at its chunks' smallest shift), each chunk at its own position shift, with every vertex that two chunks
+// share flagged as locked;
 // three objects (two instances of the sphere). Written with small pages (2 KB raw for codec 1, 4 KB for codec
 // 2, whose raw nodes are about twice as large) so that it has several data and index pages.
 #pragma once

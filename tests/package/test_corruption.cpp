@@ -12,6 +12,7 @@
 #include "package/bytes.hpp"
 #include "package/meshopt_codec.hpp"
 #include "package/predictive_codec.hpp"
+#include "package/quantized_node.hpp"
 #include "package/reader.hpp"
 #include "package/traversal_codec.hpp"
 #include "package_fixture.hpp"
@@ -58,9 +59,9 @@ bool same(const Content& a, const Content& b) {
     return false;
   for (size_t i = 0; i < a.records.size(); ++i) {
     const NodeRecord &x = a.records[i], &y = b.records[i];
-    if (x.page != y.page || x.offset != y.offset || x.size != y.size || x.children != y.children ||
-        x.parents != y.parents || x.objects != y.objects || x.triangles != y.triangles ||
-        x.error != y.error) {
+    if (x.page != y.page || x.offset != y.offset || x.size != y.size || x.cluster != y.cluster ||
+        x.children != y.children || x.parents != y.parents || x.objects != y.objects ||
+        x.triangles != y.triangles || x.error != y.error) {
       return false;
     }
   }
@@ -236,6 +237,7 @@ TEST_P(Corruption, HostileRootIndicesAreErrors) {
       {"infinite centre", [](RootIndex& r) { r.root_nodes[0].sphere.center.x = INFINITY; }},
       {"wrong triangle count", [](RootIndex& r) { r.root_nodes[0].triangles += 1; }},
       {"wrong vertex count", [](RootIndex& r) { r.root_nodes[1].vertices = 1u << 30; }},
+      {"cluster past its record's", [](RootIndex& r) { r.root_nodes[0].cluster = kMaxRecordClusters - 1; }},
       {"NaN transform", [](RootIndex& r) { r.scene.objects[0].transform[1][1] = std::nanf(""); }},
       {"object representation", [](RootIndex& r) { r.scene.objects[0].representation = 2; }},
       {"zero grid step", [](RootIndex& r) { r.scene.representations[0].grid.step = 0.0f; }},

@@ -8,6 +8,7 @@
 #include "core/error.hpp"
 #include "package/bytes.hpp"
 #include "package/index.hpp"
+#include "package/quantized_node.hpp"
 
 namespace lodstream::test {
 namespace {
@@ -69,6 +70,7 @@ void expect_same(const std::vector<NodeRecord>& a, const std::vector<NodeRecord>
     EXPECT_EQ(a[i].page, b[i].page);
     EXPECT_EQ(a[i].offset, b[i].offset);
     EXPECT_EQ(a[i].size, b[i].size);
+    EXPECT_EQ(a[i].cluster, b[i].cluster);
     EXPECT_EQ(a[i].triangles, b[i].triangles);
     EXPECT_EQ(a[i].vertices, b[i].vertices);
     EXPECT_EQ(a[i].error, b[i].error);
@@ -123,13 +125,31 @@ TEST(IndexRecords, SharedPairsAreStoredOnce) {
   expect_same(parse_nodes(raw, tables(), 0, 16, "run"), in);
 }
 
-// The hand-written run: one record with the given head, list and pair codes.
-std::vector<uint8_t> one_record(uint8_t head, uint64_t own_code, uint64_t parent_code, bool with_parent) {
+TEST(IndexRecords, TheClustersOfARecordShareItsBytesAndStoreThemOnce) {
+  std::vector<NodeRecord> in = records(0, 12);
+  const size_t alone = serialize_nodes(in, 0).size();
+  // Records 1-3 are clusters 1-3 of record 0's bytes, record 7 is cluster 5 of record 6's (not stored as
+  // "the next cluster": record 6 is its cluster 0), record 9 is cluster 30 (the last possible) of its own.
+  for (uint32_t i = 1; i <= 3; ++i) {
+    in[i].page = in[0].page, in[i].offset = in[0].offset, in[i].size = in[0].size, in[i].cluster = i;
+  }
+  in[7].page = in[6].page, in[7].offset = in[6].offset, in[7].size = in[6].size, in[7].cluster = 5;
+  in[9].cluster = kMaxRecordClusters - 1;
+  const std::vector<uint8_t> raw = serialize_nodes(in, 0);
+  EXPECT_LT(raw.size(), alone);  // clusters 1-3 store neither page, offset, size nor cluster
+  expect_same(parse_nodes(raw, tables(), 0, 12, "run"), in);
+}
+
+// The hand-written run: one record with the given head, list and pair codes (and cluster, unless head bit 5
+// says it is the previous record's next cluster).
+std::vector<uint8_t> one_record(uint8_t head, uint64_t own_code, uint64_t parent_code, bool with_parent,
+                                uint64_t cluster = 0) {
   ByteWriter w;
   w.u8(head);
-  for (int field = 0; field < 5; ++field) w.svarint(0);  // representation, material, level, page, offset
-  w.varint(10), w.varint(1), w.varint(3);                // size, triangles, vertices
-  if (!(head & 8)) w.varint(0);                          // no children
+  for (int field = 0; field < 3; ++field) w.svarint(0);  // representation, material, level
+  if (!(head & 32)) w.svarint(0), w.svarint(0), w.varint(10), w.varint(cluster);  // page, offset, size
+  w.varint(1), w.varint(3);                                                       // triangles, vertices
+  if (!(head & 8)) w.varint(0);                                                   // no children
   if (!(head & 16)) {
     w.varint(with_parent ? 1 : 0);
     if (with_parent) w.svarint(-1);  // parent id 4: the record before the run
@@ -153,7 +173,10 @@ TEST(IndexRecords, HostileReferencesAreErrors) {
       {"parents' pair from a node without parents", one_record(0, 0, 0, false)},
       {"same children as a record the run does not have", one_record(8, 0, 1, false)},
       {"same parents as a record the run does not have", one_record(16, 0, 1, false)},
-      {"unknown record flag", one_record(32, 0, 1, false)},
+      {"the next cluster of a record the run does not have", one_record(32, 0, 1, false)},
+      {"cluster index past the most a record holds", one_record(0, 0, 1, false, kMaxRecordClusters)},
+      {"huge cluster index", one_record(0, 0, 1, false, uint64_t(1) << 40)},
+      {"unknown record flag", one_record(64, 0, 1, false)},
   };
   for (const auto& [name, raw] : cases) {
     try {

@@ -1,0 +1,49 @@
+// Records (node_codec.hpp, NodeGeometry::cluster_triangles): a page group's clusters stored as one node
+// with one vertex pool, each cluster's triangles a consecutive range. A cluster alone stores its border
+// vertices again and predicts them from half their fan; in a record, a vertex that several of its clusters
+// hold is stored and predicted once. Measured (bake, codec 3, records of one precision): elephant_1m
+// 6,542,992 -> 5,462,790 B (-16.5 %; stored vertices per level-0 triangle 0.653 -> 0.559), elephant_5m
+// 26,432,899 -> 22,003,743 (4.64 -> 3.87 B per input triangle), refined_elephant 519,852 -> 424,956,
+// motorBike 2,323,447 -> 2,034,070, bunny 446,246 -> 374,365. Decoding a record's clusters one by one costs
+// 1.32x the instructions of decoding them as separate nodes (callgrind, bench_package argument 4 vs 3,
+// decode_node: 345 vs 262 per triangle): the extraction's copies and the cluster sort.
+//
+// weld_record builds a record from clusters; extract_cluster gives one cluster back from a decoded record,
+// what the reader returns for a cluster's node id, so that a record is invisible above the package: the
+// cluster's triangles with its vertices compacted (numbered in first-use order), the same DecodedNode as a
+// node of one cluster. A vertex that several clusters share decodes once, so it is bit-identical in each.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "package/node_codec.hpp"
+
+namespace lodstream::package {
+
+struct RecordMesh {
+  Mesh mesh;                                // the clusters' triangles in cluster order, welded vertices
+  std::vector<uint8_t> locked;              // per vertex: locked in any cluster that holds it
+  std::vector<uint32_t> cluster_triangles;  // per cluster (NodeGeometry::cluster_triangles)
+  std::vector<uint32_t> cluster_vertices;   // per cluster: its distinct vertices (extract_cluster's count)
+};
+
+// Welds `clusters` (meshes with the same attributes; `locked[c]` per vertex of cluster c, or empty) on
+// identical vertices: same bits of position, normal, UV and colour, so seams stay split. Cost: O(V + T)
+// expected (a hash table of the record's vertices).
+RecordMesh weld_record(std::span<const Mesh* const> clusters,
+                       std::span<const std::span<const uint8_t>> locked);
+
+// The number of clusters of a decoded record (1 for a node of one cluster).
+inline uint32_t record_clusters(const DecodedNode& record) {
+  return record.cluster_triangles.empty() ? 1u : uint32_t(record.cluster_triangles.size());
+}
+
+// Cluster `cluster` of `record`; of a node of one cluster (progressive steps included), the node itself (a
+// copy). Throws lodstream::Error starting with `where` when the record has no such cluster. Cost: O(the
+// cluster's triangles and vertices) plus a per-thread table of the record's vertex count.
+DecodedNode extract_cluster(const DecodedNode& record, uint32_t cluster, const std::string& where);
+
+}  // namespace lodstream::package

@@ -1,0 +1,229 @@
+// Records (package/records.hpp): a page group's clusters welded into one node of codec 3. Each cluster comes
+// back exactly (its triangles, positions and attributes), a vertex that several clusters share decodes to the
+// same bits in each, the reader decodes a record once for its clusters in any order, and corrupted record
+// bytes or fields are errors, never a crash.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <map>
+#include <random>
+
+#include "core/error.hpp"
+#include "package/meshopt_codec.hpp"
+#include "package/predictive_codec.hpp"
+#include "package/quantized_node.hpp"
+#include "package/reader.hpp"
+#include "package/records.hpp"
+#include "package/traversal_codec.hpp"
+#include "package_fixture.hpp"
+#include "support/run.hpp"
+#include "support/shapes.hpp"
+
+namespace lodstream::test {
+namespace {
+
+using namespace package;
+
+// A triangle as its three corners' position bits, rotated to start at the smallest (the codec may rotate).
+using Corners = std::array<std::array<uint32_t, 3>, 3>;
+std::vector<Corners> triangles_of(const Mesh& m) {
+  std::vector<Corners> out;
+  for (size_t t = 0; t < m.triangle_count(); ++t) {
+    Corners c;
+    for (int k = 0; k < 3; ++k) std::memcpy(c[k].data(), &m.positions[m.indices[3 * t + k]], 12);
+    std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
+    out.push_back(c);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+struct Record {
+  PositionGrid grid;
+  std::vector<Mesh> clusters;
+  std::vector<std::vector<uint8_t>> locked;
+  RecordMesh welded;
+  std::vector<uint8_t> bytes;
+};
+
+// Six chunks of 40 triangles of a UV sphere (normals, UVs, seams), snapped to the grid so that shift 0
+// decodes every position exactly.
+Record sphere_record(uint32_t shift) {
+  Record r;
+  Mesh sphere = uv_sphere(1.0f, 16, 32);
+  r.grid = PositionGrid::for_bounds(sphere.bounds(), 14);
+  r.grid.snap(sphere);
+  std::vector<std::vector<uint8_t>> locked;
+  std::vector<Mesh> chunks = split_into_chunks(sphere, 40, locked);
+  r.clusters.assign(chunks.begin(), chunks.begin() + 6);
+  r.locked.assign(locked.begin(), locked.begin() + 6);
+  std::vector<const Mesh*> meshes;
+  std::vector<std::span<const uint8_t>> spans;
+  for (size_t c = 0; c < r.clusters.size(); ++c)
+    meshes.push_back(&r.clusters[c]), spans.push_back(r.locked[c]);
+  r.welded = weld_record(meshes, spans);
+  NodeGeometry g;
+  g.mesh = &r.welded.mesh;
+  g.locked = r.welded.locked;
+  g.position_shift = shift;
+  g.normal_bits = 12;
+  g.cluster_triangles = r.welded.cluster_triangles;
+  r.bytes = TraversalCodec().encode(g, r.grid);
+  return r;
+}
+
+TEST(Records, WeldingStoresASharedVertexOnce) {
+  const Record r = sphere_record(0);
+  size_t separate = 0;
+  for (const Mesh& m : r.clusters) separate += m.vertex_count();
+  EXPECT_LT(r.welded.mesh.vertex_count(), separate);  // neighbouring chunks share their borders
+  for (size_t c = 0; c < r.clusters.size(); ++c) {
+    EXPECT_EQ(r.welded.cluster_triangles[c], r.clusters[c].triangle_count());
+    EXPECT_EQ(r.welded.cluster_vertices[c], r.clusters[c].vertex_count());  // no duplicates within a chunk
+  }
+}
+
+TEST(Records, EachClusterComesBackExactlyAndSharedVerticesAreIdentical) {
+  const Record r = sphere_record(0);
+  const DecodedNode record = TraversalCodec().decode(r.bytes, r.grid, "record");
+  ASSERT_EQ(record_clusters(record), r.clusters.size());
+  EXPECT_EQ(record.mesh.vertex_count(), r.welded.mesh.vertex_count());
+  // (position, UV) bits -> normal bits over every cluster: a shared vertex decodes alike in each.
+  std::map<std::array<uint32_t, 5>, std::array<uint32_t, 3>> normal_of;
+  size_t shared = 0;
+  for (uint32_t c = 0; c < r.clusters.size(); ++c) {
+    const DecodedNode d = extract_cluster(record, c, "record");
+    EXPECT_EQ(d.mesh.triangle_count(), r.clusters[c].triangle_count()) << c;
+    EXPECT_EQ(d.mesh.vertex_count(), r.welded.cluster_vertices[c]) << c;
+    EXPECT_EQ(triangles_of(d.mesh), triangles_of(r.clusters[c])) << c;  // positions exact at shift 0
+    ASSERT_EQ(d.mesh.normals.size(), d.mesh.vertex_count());
+    ASSERT_EQ(d.mesh.uvs.size(), d.mesh.vertex_count());
+    for (size_t v = 0; v < d.mesh.vertex_count(); ++v) {
+      std::array<uint32_t, 5> key;
+      std::array<uint32_t, 3> normal;
+      std::memcpy(key.data(), &d.mesh.positions[v], 12);
+      std::memcpy(key.data() + 3, &d.mesh.uvs[v], 8);
+      std::memcpy(normal.data(), &d.mesh.normals[v], 12);
+      const auto [it, added] = normal_of.emplace(key, normal);
+      shared += !added;
+      EXPECT_EQ(it->second, normal) << "cluster " << c << " vertex " << v;
+    }
+  }
+  EXPECT_GT(shared, 20u);  // the chunks' borders
+}
+
+TEST(Records, FreeVerticesKeepTheShiftsBoundAndLockedOnesStayExact) {
+  const uint32_t shift = 3;
+  const Record r = sphere_record(shift);
+  const DecodedNode record = TraversalCodec().decode(r.bytes, r.grid, "record");
+  // Every decoded position lies within sqrt(3)/2 (2^k + 1) steps of an original vertex of its cluster, and
+  // each locked original is decoded exactly in its cluster.
+  const float bound = 0.5f * std::sqrt(3.0f) * float((1 << shift) + 1) * r.grid.step * 1.001f;
+  for (uint32_t c = 0; c < r.clusters.size(); ++c) {
+    const DecodedNode d = extract_cluster(record, c, "record");
+    for (const glm::vec3& p : d.mesh.positions) {
+      float nearest = INFINITY;
+      for (const glm::vec3& q : r.clusters[c].positions) nearest = std::min(nearest, glm::length(p - q));
+      EXPECT_LE(nearest, bound);
+    }
+    for (size_t v = 0; v < r.clusters[c].vertex_count(); ++v) {
+      if (!r.locked[c][v]) continue;
+      EXPECT_NE(std::find(d.mesh.positions.begin(), d.mesh.positions.end(), r.clusters[c].positions[v]),
+                d.mesh.positions.end())
+          << "locked vertex " << v << " of cluster " << c;
+    }
+  }
+}
+
+TEST(Records, InvalidClusterCountsAndOtherCodecsAreRefused) {
+  Record r = sphere_record(0);
+  NodeGeometry g;
+  g.mesh = &r.welded.mesh;
+  std::vector<uint32_t> counts = r.welded.cluster_triangles;
+  g.cluster_triangles = counts;
+  EXPECT_THROW(MeshoptCodec().encode(g, r.grid), Error);
+  EXPECT_THROW(PredictiveCodec().encode(g, r.grid), Error);
+  counts[0] += 1;  // one more than the mesh holds
+  EXPECT_THROW(TraversalCodec().encode(g, r.grid), Error);
+  counts[0] -= 1, counts.push_back(0);  // an empty cluster
+  EXPECT_THROW(TraversalCodec().encode(g, r.grid), Error);
+  std::vector<uint32_t> many(kMaxRecordClusters + 1, 1);  // more clusters than a record may hold
+  Mesh strip;
+  for (uint32_t t = 0; t < many.size(); ++t) {
+    strip.positions.push_back({float(t), 0.0f, 0.0f});
+    strip.indices.insert(strip.indices.end(), {0, t + 1, t + 2});
+  }
+  strip.positions.resize(many.size() + 2, glm::vec3(1.0f));
+  NodeGeometry h;
+  h.mesh = &strip;
+  h.cluster_triangles = many;
+  EXPECT_THROW(TraversalCodec().encode(h, PositionGrid::for_bounds(strip.bounds())), Error);
+  const DecodedNode record = TraversalCodec().decode(r.bytes, r.grid, "record");
+  try {
+    extract_cluster(record, uint32_t(r.clusters.size()), "node 7");
+    ADD_FAILURE() << "a cluster past the record's was extracted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("node 7: cluster 6 out of range", 0), 0u) << e.what();
+  }
+}
+
+TEST(Records, CorruptedRecordsAreErrorsOrValidRecords) {
+  // Every byte of the header region set to several values, and random bytes flipped anywhere: decoding is
+  // an Error, or a record whose clusters add up to its triangles and extract without fault.
+  const Record r = sphere_record(2);
+  auto check = [&](const std::vector<uint8_t>& bytes) {
+    try {
+      const DecodedNode d = TraversalCodec().decode(bytes, r.grid, "fuzz");
+      size_t sum = 0;
+      for (uint32_t t : d.cluster_triangles) sum += t;
+      if (!d.cluster_triangles.empty()) {
+        EXPECT_EQ(sum, d.mesh.triangle_count());
+      }
+      for (uint32_t c = 0; c < record_clusters(d); ++c) {
+        const DecodedNode cluster = extract_cluster(d, c, "fuzz");
+        for (uint32_t i : cluster.mesh.indices) ASSERT_LT(i, cluster.mesh.vertex_count());
+      }
+    } catch (const Error&) {
+    }
+  };
+  for (size_t at = 0; at < std::min<size_t>(48, r.bytes.size()); ++at)
+    for (uint8_t value : {0, 1, 2, 31, 32, 64, 127, 255}) {
+      std::vector<uint8_t> bytes = r.bytes;
+      bytes[at] = value;
+      check(bytes);
+    }
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<size_t> position(0, r.bytes.size() - 1);
+  for (int i = 0; i < 2000; ++i) {
+    std::vector<uint8_t> bytes = r.bytes;
+    bytes[position(rng)] ^= uint8_t(1 + rng() % 255);
+    check(bytes);
+  }
+}
+
+TEST(Records, TheReaderGivesEachClusterInAnyOrder) {
+  // The test package's sphere page groups are records (codec 3): its clusters decode to the same meshes in
+  // id order (one decode per record) and in reverse order (a decode per cluster).
+  const auto file = temp_dir() / "records.lods";
+  write_test_package(file, TraversalCodec::kId);
+  PackageReader forward = PackageReader::open(file), backward = PackageReader::open(file);
+  size_t in_records = 0;
+  std::vector<DecodedNode> first(forward.node_count());
+  for (uint32_t id = 0; id < forward.node_count(); ++id) {
+    first[id] = forward.load_node(id);
+    in_records += forward.node(id).cluster > 0;
+  }
+  EXPECT_GT(in_records, 4u);
+  for (uint32_t id = backward.node_count(); id-- > 0;) {
+    const DecodedNode d = backward.load_node(id);
+    EXPECT_EQ(d.mesh.indices, first[id].mesh.indices) << id;
+    EXPECT_EQ(d.mesh.positions, first[id].mesh.positions) << id;
+    EXPECT_EQ(d.mesh.normals, first[id].mesh.normals) << id;
+    EXPECT_EQ(d.mesh.uvs, first[id].mesh.uvs) << id;
+  }
+}
+
+}  // namespace
+}  // namespace lodstream::test
