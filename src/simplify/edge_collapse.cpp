@@ -204,7 +204,8 @@ class Simplifier {
   // run grows as the mesh shrinks), shifted by region_shift_, which turns each pass so that no band of the
   // mesh is always left to the serial part.
   // region_start_: where each region's candidates begin in sorted_ (grouped by region after the cost sort, as
-  // (cost, order_ index)); pending_: per order_ entry, whether the serial part is to try it.
+  // (cost, order_ index); then the serial part's list); pending_: per order_ entry, whether the serial part
+  // is to try it.
   static constexpr uint32_t kRegionVertices = 16384, kMinRegions = 2;
   uint32_t region_vertices_ = kRegionVertices, region_shift_ = 0;
   std::vector<uint32_t> region_start_;
@@ -832,9 +833,16 @@ class Simplifier {
     for (size_t b = 0; b < blocks; ++b) start[b + 1] += start[b];
     const size_t n = start[blocks];
     order_.resize(n);
+    if (n == 0) return;
+    // k P mod n stepped by P mod n: one division per block instead of one per candidate.
+    const uint64_t step = kScatter % n;
     for_each(size_t(0), blocks, [&](size_t b) {
-      uint64_t k = start[b];
-      block(b, [&](const Candidate& c, size_t i) { order_[k++ * kScatter % n] = {c.cost, uint32_t(i)}; });
+      uint64_t at = start[b] * kScatter % n;
+      block(b, [&](const Candidate& c, size_t i) {
+        order_[at] = {c.cost, uint32_t(i)};
+        at += step;
+        if (at >= n) at -= n;
+      });
     });
   }
 
@@ -889,14 +897,21 @@ class Simplifier {
       });
       collapsed = count;
       for (Scratch& s : scratch) gather(s);
-    } else {
-      pending_.assign(order_.size(), 1);
     }
+    // The serial part: every candidate, or what the regions left pending, in cost order, listed in sorted_
+    // (the regions are done with it) so that prefetch can look ahead along it (on large meshes: on a small
+    // one everything is in cache and the prefetch chain would only cost instructions). Costs ascend, so
+    // stopping at the first listed candidate over the limit stops where a scan of all of order_ would.
+    uint32_t end = 0;
+    sorted_.resize(order_.size());
+    for (uint32_t i = 0; i < order_.size(); ++i)
+      if (!parallel || pending_[i]) sorted_[end++] = {order_[i].cost, i};
     Scratch& s = serial_;
     s.region = kAnyRegion;
-    for (size_t i = 0; i < order_.size(); ++i) {
+    for (uint32_t k = 0; k < end; ++k) {
+      const uint32_t i = sorted_[k].slot;
       if (order_[i].cost > limit || alive_triangles_ - s.removed_triangles <= target) break;
-      if (!pending_[i]) continue;
+      if (!small_) prefetch(k, end);
       const Candidate& c = slots_[order_[i].slot];
       Plan p;
       if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
