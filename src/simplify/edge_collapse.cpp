@@ -1338,21 +1338,31 @@ class Simplifier {
       const glm::dvec2 rel = o.origin - yx;
       // s = cross2(rel, od) / den, t = cross2(rel, nd) / den, both strictly inside (0, 1), with den =
       // cross2(nd, od). sn is the same for every spoke, so its sign fixes den's: negating od, sn and tn
-      // (exact) makes it positive and leaves s and t as they are, so the first test is one comparison
-      // (spoke ends on the other side of the old edge's line than x).
+      // (exact) makes it positive and leaves s and t as they are, so the tests are sn < den and 0 < tn < den
+      // (spoke ends on the other side of the old edge's line than x, old edge's origin on the spoke's left).
       const double sign = cross2(rel, o.direction) > 0 ? 1.0 : -1.0;
       const double sn = sign * cross2(rel, o.direction), dx = sign * o.direction.x, dy = sign * o.direction.y;
       if (sn == 0) continue;
-      for (size_t k = 0; k < spokes; ++k) {
-        const double den = sc.spoke_x[k] * dy - sc.spoke_y[k] * dx;
-        if (den <= sn || den < 1e-30) continue;
-        const Segment& e = sc.spokes[k];
-        const double tn = sign * cross2(rel, e.direction);
-        if (tn <= 0 || tn >= den) continue;
-        const double s = sn / den, t = tn / den;
-        if (!(s > 0 && s < 1 && t > 0 && t < 1)) continue;
-        const double gap = std::abs((1 - s) * hx + s * e.h0 - ((1 - t) * o.h0 + t * o.h1));
-        if (!require(1 - s, s * e.r0, gap + (1 - t) * o.r0 + t * o.r1)) return kInf;
+      // The tests for up to 64 spokes at a time without branches (about 40 % of pairs pass the first, at
+      // random: as branches they were mostly mispredictions), then the crossings among them in order.
+      for (size_t k0 = 0; k0 < spokes; k0 += 64) {
+        const size_t k1 = std::min(spokes, k0 + 64);
+        uint64_t crossing = 0;
+        for (size_t k = k0; k < k1; ++k) {
+          const double den = sc.spoke_x[k] * dy - sc.spoke_y[k] * dx;
+          const double tn = sign * (rel.x * sc.spoke_y[k] - rel.y * sc.spoke_x[k]);  // sign cross2(rel, nd)
+          crossing |= uint64_t((den > sn) & (den >= 1e-30) & (tn > 0) & (tn < den)) << (k - k0);
+        }
+        for (; crossing != 0; crossing &= crossing - 1) {
+          const size_t k = k0 + size_t(__builtin_ctzll(crossing));
+          const Segment& e = sc.spokes[k];
+          const double den = sc.spoke_x[k] * dy - sc.spoke_y[k] * dx;
+          const double tn = sign * (rel.x * sc.spoke_y[k] - rel.y * sc.spoke_x[k]);
+          const double s = sn / den, t = tn / den;
+          if (!(s > 0 && s < 1 && t > 0 && t < 1)) continue;
+          const double gap = std::abs((1 - s) * hx + s * e.h0 - ((1 - t) * o.h0 + t * o.h1));
+          if (!require(1 - s, s * e.r0, gap + (1 - t) * o.r0 + t * o.r1)) return kInf;
+        }
       }
     }
     return need;
