@@ -340,7 +340,7 @@ class Simplifier {
   // which is random in space, and on a large mesh in input order most of their time went to cache misses
   // (with the quadrics' origins at the current positions: elephant_1m 10 %, CPU s under load 4-6, default
   // weights 7.5-7.8 -> 6.1-7.6, positions only 5.9-7.0 -> 5.4-6.7; the same collapses up to ties). The faces
-  // follow (sort_faces). O(V log V).
+  // follow (sort_faces). O(V log V), on every core.
   void renumber_spatially() {
     const size_t m = source_.size();
     auto spread = [](uint64_t x) {  // bit i of x to bit 3i (21 bits)
@@ -350,23 +350,24 @@ class Simplifier {
       return (x | x << 2) & 0x1249249249249249ull;
     };
     std::vector<std::pair<uint64_t, uint32_t>> code(m);
-    for (uint32_t v = 0; v < m; ++v) {
+    for_each(uint32_t(0), uint32_t(m), [&](uint32_t v) {
       const glm::vec3 q = glm::clamp(pos_[v], 0.0f, 1.0f) * 2097151.0f;  // pos_ is in [0, 1]^3
       code[v] = {spread(uint64_t(q.x)) | spread(uint64_t(q.y)) << 1 | spread(uint64_t(q.z)) << 2, v};
-    }
+    });
     tbb::parallel_sort(code.begin(), code.end());  // ties (wedges share a position) by old number
     std::vector<uint32_t> renumbered(m);
-    for (uint32_t i = 0; i < m; ++i) renumbered[code[i].second] = i;
+    for_each(uint32_t(0), uint32_t(m), [&](uint32_t i) { renumbered[code[i].second] = i; });
     auto permute = [&](auto& values) {
       if (values.size() != m) return;
       auto old = values;
-      for (uint32_t i = 0; i < m; ++i) values[i] = old[code[i].second];
+      for_each(uint32_t(0), uint32_t(m), [&](uint32_t i) { values[i] = old[code[i].second]; });
     };
     permute(source_), permute(pos_), permute(nrm_), permute(uv_), permute(col_), permute(wedge_),
         permute(pid_);
-    for (uint32_t& v : wedge_) v = renumbered[v];
-    for (uint32_t& v : pid_) v = renumbered[v];
-    for (uint32_t& v : weld_remap_) v = renumbered[v];
+    auto rename = [&](std::vector<uint32_t>& vertices) {
+      for_each(size_t(0), vertices.size(), [&](size_t i) { vertices[i] = renumbered[vertices[i]]; });
+    };
+    rename(wedge_), rename(pid_), rename(weld_remap_);
   }
 
   // Drops dead faces; their corners' cached candidates move with them.
