@@ -957,7 +957,8 @@ class Simplifier {
 
   // Candidates come in cost order, random in their region, so each try starts with cache misses on a chain of
   // loads (order_ entry, slot, the ends' offsets_, their face lists, those faces' corners). This loads each
-  // link of the chain for a candidate further on in the region's list (sorted_, before `end`), the link
+  // link of the chain for a candidate further on in the list being walked (sorted_, before `end`: a region's
+  // candidates or the serial part's), the link
   // before it having been loaded some tries earlier: order_ kOrderAhead places on, the slot kSlotAhead, the
   // ends' per-vertex data kEndAhead, their face lists kFacesAhead and those faces' indices kCornersAhead, so
   // that the misses overlap the tries between instead of stalling each one in turn. Always inlined: called,
@@ -976,6 +977,13 @@ class Simplifier {
         __builtin_prefetch(&touched_[v]), __builtin_prefetch(&offsets_[v]), __builtin_prefetch(&pos_[v]);
         __builtin_prefetch(&quadric_[v]), __builtin_prefetch(&radius_[v]), __builtin_prefetch(&pid_[v]);
         __builtin_prefetch(&wedge_[v]);
+        // A quadric (44 bytes) and a vertex's attribute terms (16 bytes per channel) often end in the next
+        // cache line: their last bytes too.
+        __builtin_prefetch(reinterpret_cast<const char*>(&quadric_[v] + 1) - 1);
+        if (channels_ > 0) {
+          const AttributeTerm* t = &attr_[v * size_t(channels_)];
+          __builtin_prefetch(t), __builtin_prefetch(reinterpret_cast<const char*>(t + channels_) - 1);
+        }
       }
     }
     if (k + kFacesAhead < end) {
