@@ -2,7 +2,6 @@
 
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
-#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cmath>
@@ -126,10 +125,9 @@ void build_level0(Builder& b, Mesh mesh) {
   });
 }
 
-// Marks the positions of edges that no other cluster shares (the mesh's open boundary).
-void mark_open_boundary(Builder& b, std::vector<ClusterEdge>& edges) {
+// Marks the positions of edges that no other cluster shares (the mesh's open boundary); `edges` sorted.
+void mark_open_boundary(Builder& b, std::span<const ClusterEdge> edges) {
   b.open_boundary.assign(b.next_position_id, 0);
-  tbb::parallel_sort(edges.begin(), edges.end());
   for (size_t i = 0; i < edges.size();) {
     size_t j = i;
     while (j < edges.size() && edges[j].first == edges[i].first) ++j;
@@ -310,6 +308,7 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
     for (uint32_t i = 0; i < active.size(); ++i)
       for (uint64_t e : boundary[i]) edges.emplace_back(e, i);
     boundary.clear();
+    sort_edges(edges, b.next_position_id);
     if (level == 1) mark_open_boundary(b, edges);
     std::vector<uint32_t> triangles(active.size());
     std::vector<glm::vec3> centroids(active.size());

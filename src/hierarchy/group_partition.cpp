@@ -1,9 +1,8 @@
 #include "hierarchy/group_partition.hpp"
 
 #include <metis.h>
-#include <tbb/parallel_sort.h>
-
 #include <algorithm>
+#include <bit>
 #include <mutex>
 #include <numeric>
 
@@ -36,9 +35,29 @@ constexpr size_t kRecursiveMin = 64;
 
 }  // namespace
 
+void sort_edges(std::vector<ClusterEdge>& edges, uint32_t ids) {
+  // An edge's rank smaller * ids + larger orders it as its key does and is below ids^2. Its digits, lowest
+  // first, each a stable counting-sort pass; a digit has about log2(E) - 2 bits (8 to 16), so that the
+  // counters (cleared and summed each pass) cost less than the edges.
+  auto rank = [ids](uint64_t key) { return (key >> 32) * ids + uint32_t(key); };
+  const int bits = int(std::bit_width(uint64_t(ids) * ids));
+  const int digit_bits = std::clamp(int(std::bit_width(edges.size())) - 2, 8, 16);
+  const uint32_t digit_mask = (1u << digit_bits) - 1;
+  std::vector<ClusterEdge> scratch(edges.size());
+  std::vector<uint32_t> start(size_t(digit_mask) + 2);
+  for (int shift = 0; shift < bits; shift += digit_bits) {
+    auto digit = [&](const ClusterEdge& e) { return uint32_t(rank(e.first) >> shift) & digit_mask; };
+    std::fill(start.begin(), start.end(), 0u);
+    for (const ClusterEdge& e : edges) ++start[digit(e) + 1];
+    for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+    for (const ClusterEdge& e : edges) scratch[start[digit(e)]++] = e;
+    edges.swap(scratch);
+  }
+}
+
 std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> triangles,
                                                       std::span<const glm::vec3> centroids,
-                                                      std::vector<ClusterEdge>& edges,
+                                                      std::span<const ClusterEdge> edges,
                                                       size_t group_clusters) {
   const size_t n = triangles.size();
   std::vector<std::vector<uint32_t>> groups;
@@ -65,7 +84,6 @@ std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> 
   }
 
   // Cluster pairs sharing an edge: runs of equal edge keys.
-  tbb::parallel_sort(edges.begin(), edges.end());  // total order: the result does not depend on timing
   std::vector<std::pair<uint32_t, uint32_t>> pairs;
   for (size_t i = 0; i < edges.size();) {
     size_t j = i;
