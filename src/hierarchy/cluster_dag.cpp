@@ -308,8 +308,6 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
     for (uint32_t i = 0; i < active.size(); ++i)
       for (uint64_t e : boundary[i]) edges.emplace_back(e, i);
     boundary.clear();
-    sort_edges(edges, b.next_position_id);
-    if (level == 1) mark_open_boundary(b, edges);
     std::vector<uint32_t> triangles(active.size());
     std::vector<glm::vec3> centroids(active.size());
     for (size_t i = 0; i < active.size(); ++i) {
@@ -319,7 +317,8 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
     // Near the root, one group takes everything: no border left to lock, so small meshes with thin parts
     // still reach a small root.
     const bool last = active_triangles <= 2 * options.group_clusters * options.max_cluster_triangles;
-    // Grouping runs on one core (METIS); the clusters the previous level finished are handed over beside it.
+    // Sorting the edges, the open boundary (level 1) and the grouping (METIS) run on one core; the clusters
+    // the previous level finished are handed over beside them.
     // No group is complete before level 3, so level 1 keeps a fifth of the level-0 clusters back for level
     // 2's grouping, which would otherwise run alone (elephant_1m: level 2's METIS takes about a fifth of the
     // time level 1 spends encoding the level-0 clusters beside its own).
@@ -327,6 +326,8 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
     std::vector<std::vector<uint32_t>> groups;
     tbb::parallel_invoke(
         [&] {
+          sort_edges(edges, b.next_position_id);
+          if (level == 1) mark_open_boundary(b, edges);
           groups =
               partition_clusters(triangles, centroids, edges, last ? active.size() : options.group_clusters);
         },
