@@ -153,7 +153,8 @@ struct GroupResult {
   uint32_t new_ids = 0;  // ids kNewId | [0, new_ids) in `clusters`
 };
 
-// Merges, simplifies with the border locked and re-splits one group (formula of error_g in the header).
+// Merges, simplifies with the border locked and re-splits one group (formula of error_g in the header); once
+// accepted, flags the locked positions of its input clusters.
 GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
                            const std::vector<uint8_t>& border, uint32_t level) {
   const DagOptions& o = b.options;
@@ -253,6 +254,14 @@ GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
       nc.locked.push_back(result_locked[v]);
     }
     out.clusters.push_back(std::move(nc));
+  }
+  // Positions locked in this simplification are shared with other groups' clusters: codec-locked in the
+  // input clusters (each is consumed by this group alone, so groups running in parallel set their own).
+  size_t offset = 0;
+  for (uint32_t c : members) {
+    std::vector<uint8_t>& locked = b.dag.clusters[c].locked;
+    for (size_t v = 0; v < locked.size(); ++v) locked[v] |= so.locked[offset + v];
+    offset += locked.size();
   }
   out.accepted = true;
   return out;
@@ -381,12 +390,6 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
         child.parent_group = gid;
         child.parent_error = r.group.error;
         child.parent_sphere = r.group.sphere;
-        // Positions locked in this simplification are shared with other groups' clusters: codec-locked.
-        const auto& ids = b.position_ids[c];
-        for (size_t v = 0; v < ids.size(); ++v)
-          if (border[ids[v]] ||
-              (options.lock_open_boundary && ids[v] < b.open_boundary.size() && b.open_boundary[ids[v]]))
-            child.locked[v] = 1;
         if (child.group != kNoGroup && --unconsumed[child.group] == 0)
           completed_groups.push_back(child.group);
       }
