@@ -85,6 +85,7 @@ std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> 
 
   // Cluster pairs sharing an edge: runs of equal edge keys.
   std::vector<std::pair<uint32_t, uint32_t>> pairs;
+  pairs.reserve(edges.size());  // an edge shared by two clusters: two entries, two pairs
   for (size_t i = 0; i < edges.size();) {
     size_t j = i;
     while (j < edges.size() && edges[j].first == edges[i].first) ++j;
@@ -118,8 +119,8 @@ std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> 
 
   // CSR graph with multiplicities as edge weights: each cluster's neighbours in increasing order, a
   // neighbour once with the number of pairs as its weight. The pairs are grouped by their first cluster (a
-  // counting sort) and each group, a few dozen, sorted: the order of one sort of all the pairs in O(P) rather
-  // than O(P log P).
+  // counting sort); each group's repeats are counted through a per-neighbour slot and only its few distinct
+  // neighbours sorted: the order of one sort of all the pairs in O(P) rather than O(P log P).
   std::vector<idx_t> xadj(n + 1, 0), adjncy, adjwgt, vwgt(n);
   std::vector<uint32_t> start(n + 1, 0), neighbours(pairs.size());
   for (const auto& p : pairs) ++start[p.first + 1];
@@ -129,14 +130,21 @@ std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> 
     for (const auto& p : pairs) neighbours[fill[p.first]++] = p.second;
   }
   pairs = {};
+  adjncy.reserve(neighbours.size()), adjwgt.reserve(neighbours.size());
+  std::vector<uint32_t> slot(n, UINT32_MAX);         // neighbour -> its entry in `distinct`, for one cluster
+  std::vector<std::pair<uint32_t, idx_t>> distinct;  // (neighbour, pairs) of one cluster
   for (size_t c = 0; c < n; ++c) {
-    const auto begin = neighbours.begin() + start[c], end = neighbours.begin() + start[c + 1];
-    std::sort(begin, end);
-    for (auto i = begin; i != end;) {
-      const auto j = std::find_if(i, end, [&](uint32_t other) { return other != *i; });
-      adjncy.push_back(idx_t(*i));
-      adjwgt.push_back(idx_t(j - i));
-      i = j;
+    distinct.clear();
+    for (uint32_t k = start[c]; k < start[c + 1]; ++k) {
+      const uint32_t other = neighbours[k];
+      if (slot[other] == UINT32_MAX) slot[other] = uint32_t(distinct.size()), distinct.emplace_back(other, 0);
+      ++distinct[slot[other]].second;
+    }
+    std::sort(distinct.begin(), distinct.end());
+    for (const auto& [other, weight] : distinct) {
+      slot[other] = UINT32_MAX;
+      adjncy.push_back(idx_t(other));
+      adjwgt.push_back(weight);
     }
     xadj[c + 1] = idx_t(adjncy.size());
   }
