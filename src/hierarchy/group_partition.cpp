@@ -1,6 +1,7 @@
 #include "hierarchy/group_partition.hpp"
 
 #include <metis.h>
+
 #include <algorithm>
 #include <bit>
 #include <mutex>
