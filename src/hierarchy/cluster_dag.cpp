@@ -2,7 +2,6 @@
 
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
-#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cmath>
@@ -126,10 +125,9 @@ void build_level0(Builder& b, Mesh mesh) {
   });
 }
 
-// Marks the positions of edges that no other cluster shares (the mesh's open boundary).
-void mark_open_boundary(Builder& b, std::vector<ClusterEdge>& edges) {
+// Marks the positions of edges that no other cluster shares (the mesh's open boundary); `edges` sorted.
+void mark_open_boundary(Builder& b, std::span<const ClusterEdge> edges) {
   b.open_boundary.assign(b.next_position_id, 0);
-  tbb::parallel_sort(edges.begin(), edges.end());
   for (size_t i = 0; i < edges.size();) {
     size_t j = i;
     while (j < edges.size() && edges[j].first == edges[i].first) ++j;
@@ -155,7 +153,8 @@ struct GroupResult {
   uint32_t new_ids = 0;  // ids kNewId | [0, new_ids) in `clusters`
 };
 
-// Merges, simplifies with the border locked and re-splits one group (formula of error_g in the header).
+// Merges, simplifies with the border locked and re-splits one group (formula of error_g in the header); once
+// accepted, flags the locked positions of its input clusters.
 GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
                            const std::vector<uint8_t>& border, uint32_t level) {
   const DagOptions& o = b.options;
@@ -256,6 +255,14 @@ GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
     }
     out.clusters.push_back(std::move(nc));
   }
+  // Positions locked in this simplification are shared with other groups' clusters: codec-locked in the
+  // input clusters (each is consumed by this group alone, so groups running in parallel set their own).
+  size_t offset = 0;
+  for (uint32_t c : members) {
+    std::vector<uint8_t>& locked = b.dag.clusters[c].locked;
+    for (size_t v = 0; v < locked.size(); ++v) locked[v] |= so.locked[offset + v];
+    offset += locked.size();
+  }
   out.accepted = true;
   return out;
 }
@@ -316,7 +323,6 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
     for (uint32_t i = 0; i < active.size(); ++i)
       for (uint64_t e : boundary[i]) edges.emplace_back(e, i);
     boundary.clear();
-    if (level == 1) mark_open_boundary(b, edges);
     std::vector<uint32_t> triangles(active.size());
     std::vector<glm::vec3> centroids(active.size());
     for (size_t i = 0; i < active.size(); ++i) {
@@ -326,10 +332,13 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
     // Near the root, one group takes everything: no border left to lock, so small meshes with thin parts
     // still reach a small root.
     const bool last = active_triangles <= 2 * options.group_clusters * options.max_cluster_triangles;
-    // Grouping runs on one core (METIS); the groups whose inputs became final are handed over beside it.
+    // Sorting the edges, the open boundary (level 1) and the grouping (METIS) run on one core; the groups
+    // whose inputs became final are handed over beside them.
     std::vector<std::vector<uint32_t>> groups;
     tbb::parallel_invoke(
         [&] {
+          sort_edges(edges, b.next_position_id);
+          if (level == 1) mark_open_boundary(b, edges);
           groups =
               partition_clusters(triangles, centroids, edges, last ? active.size() : options.group_clusters);
         },
@@ -384,12 +393,6 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
         child.parent_group = gid;
         child.parent_error = r.group.error;
         child.parent_sphere = r.group.sphere;
-        // Positions locked in this simplification are shared with other groups' clusters: codec-locked.
-        const auto& ids = b.position_ids[c];
-        for (size_t v = 0; v < ids.size(); ++v)
-          if (border[ids[v]] ||
-              (options.lock_open_boundary && ids[v] < b.open_boundary.size() && b.open_boundary[ids[v]]))
-            child.locked[v] = 1;
         if (child.group != kNoGroup && --unconsumed[child.group] == 0)
           completed_groups.push_back(child.group);
         inputs += child.group != kNoGroup;  // level-0 clusters are final once consumed

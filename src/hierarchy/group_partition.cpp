@@ -1,9 +1,9 @@
 #include "hierarchy/group_partition.hpp"
 
 #include <metis.h>
-#include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <bit>
 #include <mutex>
 #include <numeric>
 
@@ -36,9 +36,29 @@ constexpr size_t kRecursiveMin = 64;
 
 }  // namespace
 
+void sort_edges(std::vector<ClusterEdge>& edges, uint32_t ids) {
+  // An edge's rank smaller * ids + larger orders it as its key does and is below ids^2. Its digits, lowest
+  // first, each a stable counting-sort pass; a digit has about log2(E) - 2 bits (8 to 16), so that the
+  // counters (cleared and summed each pass) cost less than the edges.
+  auto rank = [ids](uint64_t key) { return (key >> 32) * ids + uint32_t(key); };
+  const int bits = int(std::bit_width(uint64_t(ids) * ids));
+  const int digit_bits = std::clamp(int(std::bit_width(edges.size())) - 2, 8, 16);
+  const uint32_t digit_mask = (1u << digit_bits) - 1;
+  std::vector<ClusterEdge> scratch(edges.size());
+  std::vector<uint32_t> start(size_t(digit_mask) + 2);
+  for (int shift = 0; shift < bits; shift += digit_bits) {
+    auto digit = [&](const ClusterEdge& e) { return uint32_t(rank(e.first) >> shift) & digit_mask; };
+    std::fill(start.begin(), start.end(), 0u);
+    for (const ClusterEdge& e : edges) ++start[digit(e) + 1];
+    for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+    for (const ClusterEdge& e : edges) scratch[start[digit(e)]++] = e;
+    edges.swap(scratch);
+  }
+}
+
 std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> triangles,
                                                       std::span<const glm::vec3> centroids,
-                                                      std::vector<ClusterEdge>& edges,
+                                                      std::span<const ClusterEdge> edges,
                                                       size_t group_clusters) {
   const size_t n = triangles.size();
   std::vector<std::vector<uint32_t>> groups;
@@ -65,8 +85,8 @@ std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> 
   }
 
   // Cluster pairs sharing an edge: runs of equal edge keys.
-  tbb::parallel_sort(edges.begin(), edges.end());  // total order: the result does not depend on timing
   std::vector<std::pair<uint32_t, uint32_t>> pairs;
+  pairs.reserve(edges.size());  // an edge shared by two clusters: two entries, two pairs
   for (size_t i = 0; i < edges.size();) {
     size_t j = i;
     while (j < edges.size() && edges[j].first == edges[i].first) ++j;
@@ -100,8 +120,8 @@ std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> 
 
   // CSR graph with multiplicities as edge weights: each cluster's neighbours in increasing order, a
   // neighbour once with the number of pairs as its weight. The pairs are grouped by their first cluster (a
-  // counting sort) and each group, a few dozen, sorted: the order of one sort of all the pairs in O(P) rather
-  // than O(P log P).
+  // counting sort); each group's repeats are counted through a per-neighbour slot and only its few distinct
+  // neighbours sorted: the order of one sort of all the pairs in O(P) rather than O(P log P).
   std::vector<idx_t> xadj(n + 1, 0), adjncy, adjwgt, vwgt(n);
   std::vector<uint32_t> start(n + 1, 0), neighbours(pairs.size());
   for (const auto& p : pairs) ++start[p.first + 1];
@@ -111,14 +131,21 @@ std::vector<std::vector<uint32_t>> partition_clusters(std::span<const uint32_t> 
     for (const auto& p : pairs) neighbours[fill[p.first]++] = p.second;
   }
   pairs = {};
+  adjncy.reserve(neighbours.size()), adjwgt.reserve(neighbours.size());
+  std::vector<uint32_t> slot(n, UINT32_MAX);         // neighbour -> its entry in `distinct`, for one cluster
+  std::vector<std::pair<uint32_t, idx_t>> distinct;  // (neighbour, pairs) of one cluster
   for (size_t c = 0; c < n; ++c) {
-    const auto begin = neighbours.begin() + start[c], end = neighbours.begin() + start[c + 1];
-    std::sort(begin, end);
-    for (auto i = begin; i != end;) {
-      const auto j = std::find_if(i, end, [&](uint32_t other) { return other != *i; });
-      adjncy.push_back(idx_t(*i));
-      adjwgt.push_back(idx_t(j - i));
-      i = j;
+    distinct.clear();
+    for (uint32_t k = start[c]; k < start[c + 1]; ++k) {
+      const uint32_t other = neighbours[k];
+      if (slot[other] == UINT32_MAX) slot[other] = uint32_t(distinct.size()), distinct.emplace_back(other, 0);
+      ++distinct[slot[other]].second;
+    }
+    std::sort(distinct.begin(), distinct.end());
+    for (const auto& [other, weight] : distinct) {
+      slot[other] = UINT32_MAX;
+      adjncy.push_back(idx_t(other));
+      adjwgt.push_back(weight);
     }
     xadj[c + 1] = idx_t(adjncy.size());
   }

@@ -104,13 +104,16 @@ std::vector<uint32_t> representatives(const VertexKey& key, size_t n) {
   return rep;
 }
 
-// Keeps the vertices listed in `keep` order; `remap[old]` gives each old vertex's new index.
+// Keeps the vertices listed in `keep` order; `remap[old]` gives each old vertex's new index. Gathers on
+// every core.
 void compact(Mesh& mesh, const std::vector<uint32_t>& keep) {
   auto pick = [&keep](auto& array) {
     if (array.empty()) return;
-    std::remove_reference_t<decltype(array)> out;
-    out.reserve(keep.size());
-    for (uint32_t k : keep) out.push_back(array[k]);
+    std::remove_reference_t<decltype(array)> out(keep.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, keep.size(), 1 << 14),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                        for (size_t i = r.begin(); i < r.end(); ++i) out[i] = array[keep[i]];
+                      });
     array.swap(out);
   };
   pick(mesh.positions);

@@ -37,8 +37,8 @@ struct PositionGrid {
   // step (0.017) of its 279-unit diagonal, and also holds near-duplicate vertices 1e-5 apart (float noise,
   // which no grid separates): it gets max_bits, and the 92 near-duplicates that still collide there are
   // welded by snap(). Only the finest level pays for the extra bits: coarser nodes drop low bits in
-  // proportion to their error (the bake's position_shift). Requires max_bits <= 20. Cost: O(V log V) per bit
-  // count tried.
+  // proportion to their error (the bake's position_shift). Requires max_bits <= 20. Cost: O(V) per bit count
+  // tried, on every core; 32 bytes per vertex of scratch.
   static PositionGrid separating(const Mesh& mesh, int min_bits = 14, int max_bits = 20);
   // Moves every position to the grid point the codec decodes it to and drops the triangles this makes
   // degenerate (two corners on one grid point). A hierarchy built on the snapped mesh has a finest level

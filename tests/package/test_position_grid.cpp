@@ -3,7 +3,9 @@
 // and drops the triangles that degenerate.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <map>
 
 #include "package/node_codec.hpp"
 
@@ -41,6 +43,46 @@ TEST(PositionGrid, SeparatingSpendsTheBitsThatKeepVerticesApart) {
   capped.snap(welded);
   EXPECT_EQ(welded.positions[1], welded.positions[4]);
   EXPECT_EQ(welded.triangle_count(), 2u);
+}
+
+// The fewest bits in [14, 20] whose grid (the codec's rounding) maps no two distinct positions of `m` to one
+// point, found with an ordered map: what separating() must return.
+int reference_bits(const Mesh& m) {
+  for (int bits = 14; bits < 20; ++bits) {
+    const PositionGrid g = PositionGrid::for_bounds(m.bounds(), bits);
+    std::map<std::array<long long, 3>, glm::vec3> seen;
+    bool collision = false;
+    for (const glm::vec3& p : m.positions) {
+      std::array<long long, 3> key;
+      for (int a = 0; a < 3; ++a)
+        key[a] = std::llround((double(p[a]) - double(g.origin[a])) / double(g.step));
+      const auto [it, added] = seen.emplace(key, p);
+      collision = collision || (!added && it->second != p);
+    }
+    if (!collision) return bits;
+  }
+  return 20;
+}
+
+TEST(PositionGrid, SeparatingOnALargeMeshMatchesAPlainCheck) {
+  // A 300 x 300 grid of vertices (many buckets, every core), every fifth position repeated by a second
+  // vertex (seams: equal positions never count as a collision), and one vertex `gap` beside another.
+  std::vector<int> expected_bits;
+  for (const float gap : {0.3f, 2e-5f, 1e-7f}) {
+    Mesh m;
+    constexpr int kSide = 300;
+    for (int y = 0; y < kSide; ++y)
+      for (int x = 0; x < kSide; ++x) m.positions.push_back({x / float(kSide), y / float(kSide), 0.01f * x});
+    for (size_t v = 0; v < size_t(kSide) * kSide; v += 5) m.positions.push_back(m.positions[v]);
+    m.positions.push_back(m.positions[4321] + glm::vec3(gap, 0.0f, 0.0f));
+    const int expected = reference_bits(m);
+    EXPECT_EQ(PositionGrid::separating(m).bits(m.bounds()), expected) << "gap " << gap;
+    expected_bits.push_back(expected);
+  }
+  // The cases span the range: no collision at 14 bits, one that needs more, one that no count separates.
+  EXPECT_EQ(expected_bits, (std::vector<int>{14, expected_bits[1], 20}));
+  EXPECT_GT(expected_bits[1], 14);
+  EXPECT_LT(expected_bits[1], 20);
 }
 
 TEST(PositionGrid, SnappedPositionsAreWhatTheCodecDecodes) {
