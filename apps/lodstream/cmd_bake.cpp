@@ -14,8 +14,9 @@
 // in order (a page group each), then, from the coarsest level down, the input clusters of each group
 // simplification as one page group: refining a group needs exactly its input clusters, so they travel
 // together. With a codec that stores records (codec 3), each page group of DAG clusters (a group's input
-// clusters, a DAG's roots) is one record (package/records.hpp): one vertex pool for all its clusters, encoded
-// after the DAG is built (encode_record).
+// clusters, a DAG's roots) is one record per precision (package/records.hpp): one vertex pool for all its
+// clusters. A group's records are encoded as soon as its input clusters are final, beside the next level's
+// grouping (DagOptions::inputs_final), which leaves the other core idle; the roots' at the end.
 //
 // Precision (how the codec's position_shift is spent): level-0 clusters are stored on the finest grid of
 // their mesh: 2^-b of its diagonal with b the fewest bits in [14, --max-grid-bits = 20] that keep its
@@ -177,6 +178,40 @@ std::vector<uint8_t> encode_record(const NodeCodec& codec, const hierarchy::Clus
   return codec.encode(geometry, grid);
 }
 
+// Group `group`'s input clusters in page order: by precision (stable), so that the clusters stored alike are
+// consecutive (a record holds clusters of one precision).
+std::vector<uint32_t> page_order(const hierarchy::ClusterDag& dag, uint32_t group, const PositionGrid& grid,
+                                 const BakeArgs& args) {
+  std::vector<uint32_t> children = dag.groups[group].children;
+  std::stable_sort(children.begin(), children.end(), [&](uint32_t a, uint32_t b) {
+    return precision(dag.clusters[a], grid, args) < precision(dag.clusters[b], grid, args);
+  });
+  return children;
+}
+
+// The records of a page group's DAG clusters (in page order): its runs of consecutive clusters of one
+// precision, each cut at `max` clusters; returns the runs' lengths.
+std::vector<uint32_t> record_runs(const hierarchy::ClusterDag& dag, std::span<const uint32_t> clusters,
+                                  const PositionGrid& grid, const BakeArgs& args, uint32_t max) {
+  std::vector<uint32_t> runs;
+  for (size_t i = 0; i < clusters.size();) {
+    uint32_t count = 1;
+    while (i + count < clusters.size() && count < max &&
+           precision(dag.clusters[clusters[i + count]], grid, args) ==
+               precision(dag.clusters[clusters[i]], grid, args))
+      ++count;
+    runs.push_back(count);
+    i += count;
+  }
+  return runs;
+}
+
+// A record encoded during the build (DagOptions::inputs_final): its bytes and each cluster's vertices.
+struct EncodedRecord {
+  std::vector<uint8_t> bytes;
+  std::vector<uint32_t> vertices;
+};
+
 Sphere float_sphere(const schedule::WorldSphere& w) {
   return {glm::vec3(w.center), std::nextafter(float(w.radius), INFINITY)};
 }
@@ -287,6 +322,8 @@ int run_bake(const BakeArgs& args) {
   std::vector<Bounds> bounds(scene.meshes.size());
   std::vector<PositionGrid> grids(scene.meshes.size());
   const NodeCodec& codec = node_codec(args.codec);
+  // Records encoded during the build, by mesh and by their first cluster (DagOptions::inputs_final).
+  std::vector<std::vector<EncodedRecord>> early(scene.meshes.size());
   std::atomic<size_t> done_triangles{0};
   std::mutex progress_mutex;
   int shown_percent = -1;  // the bar is redrawn when the percentage changes (not per cluster batch)
@@ -319,6 +356,22 @@ int run_bake(const BakeArgs& args) {
       // Level l removes about half of what is left: count the removed triangles as done.
       const size_t done_here = triangles - std::min(triangles, active);
       if (done_here > reported) report(done_here - reported), reported = done_here;
+    };
+    options.inputs_final = [&, m](const hierarchy::ClusterDag& dag, std::span<const uint32_t> groups) {
+      std::vector<EncodedRecord>& out = early[m];
+      out.resize(dag.clusters.size());
+      tbb::parallel_for(size_t(0), groups.size(), [&](size_t i) {
+        const std::vector<uint32_t> children = page_order(dag, groups[i], grids[m], args);
+        size_t first = 0;
+        for (uint32_t count : record_runs(dag, children, grids[m], args, codec.max_record_clusters())) {
+          EncodedRecord& r = out[children[first]];
+          r.vertices.resize(count);
+          r.bytes = encode_record(codec, dag, std::span(children).subspan(first, count), grids[m], args,
+                                  r.vertices);
+          r.bytes.shrink_to_fit();  // kept until the pages are written: no growth slack
+          first += count;
+        }
+      });
     };
     dags[m] = hierarchy::build_cluster_dag(std::move(scene.meshes[m]), options);  // the DAG holds it now
     report(triangles - reported);
@@ -470,15 +523,7 @@ int run_bake(const BakeArgs& args) {
   std::stable_sort(groups.begin(), groups.end(),
                    [](const GroupRef& a, const GroupRef& b) { return a.level > b.level; });
   for (const GroupRef& gr : groups) {
-    // By precision (stable), so that the clusters stored alike are consecutive: a record holds clusters of
-    // one precision (encode_record).
-    std::vector<uint32_t> children = dags[gr.mesh].groups[gr.group].children;
-    const hierarchy::ClusterDag& dag = dags[gr.mesh];
-    std::stable_sort(children.begin(), children.end(), [&](uint32_t a, uint32_t b) {
-      return precision(dag.clusters[a], grids[gr.mesh], args) <
-             precision(dag.clusters[b], grids[gr.mesh], args);
-    });
-    for (uint32_t c : children) {
+    for (uint32_t c : page_order(dags[gr.mesh], gr.group, grids[gr.mesh], args)) {
       node_id[gr.mesh][c] = uint32_t(order.size());
       order.push_back({gr.mesh, c});
     }
@@ -554,9 +599,6 @@ int run_bake(const BakeArgs& args) {
   PackageWriter writer(args.output, writer_options);
   NodeSizeBreakdown breakdown;
   auto is_cluster = [&](size_t id) { return order[id].mesh != kNone && pms[order[id].mesh].steps.empty(); };
-  auto precision_of = [&](size_t id) {
-    return precision(dags[order[id].mesh].clusters[order[id].cluster], grids[order[id].mesh], args);
-  };
   struct Record {
     size_t first, count;  // node ids [first, first + count)
   };
@@ -566,14 +608,15 @@ int run_bake(const BakeArgs& args) {
   for (size_t g = 0; g < page_group_ends.size();) {
     batch.clear();
     for (size_t nodes = 0; g < page_group_ends.size() && (batch.empty() || nodes < 4096); ++g) {
-      for (size_t id = first; id < page_group_ends[g];) {
-        size_t count = 1;
-        while (is_cluster(id) && id + count < page_group_ends[g] && is_cluster(id + count) &&
-               order[id + count].mesh == order[id].mesh && count < codec.max_record_clusters() &&
-               precision_of(id + count) == precision_of(id))
-          ++count;
-        batch.push_back({id, count});
-        id += count;
+      if (is_cluster(first)) {  // one DAG's clusters (a group's inputs, or its roots)
+        const uint32_t m = order[first].mesh;
+        std::vector<uint32_t> clusters;
+        for (size_t id = first; id < page_group_ends[g]; ++id) clusters.push_back(order[id].cluster);
+        size_t id = first;
+        for (uint32_t count : record_runs(dags[m], clusters, grids[m], args, codec.max_record_clusters()))
+          batch.push_back({id, count}), id += count;
+      } else {
+        for (size_t id = first; id < page_group_ends[g]; ++id) batch.push_back({id, 1});
       }
       nodes += page_group_ends[g] - first;
       first = page_group_ends[g];
@@ -602,11 +645,17 @@ int run_bake(const BakeArgs& args) {
         encoded[r] = codec.encode(geometry, ps.representations[order[id].mesh].grid);
         return;
       }
-      std::vector<uint32_t> clusters, vertices(batch[r].count);
-      for (size_t k = 0; k < batch[r].count; ++k) clusters.push_back(order[id + k].cluster);
-      encoded[r] = encode_record(codec, dags[order[id].mesh], clusters,
-                                 ps.representations[order[id].mesh].grid, args, vertices);
-      for (size_t k = 0; k < batch[r].count; ++k) records[id + k].vertices = vertices[k];
+      const uint32_t m = order[id].mesh;
+      EncodedRecord record;
+      if (order[id].cluster < early[m].size()) record = std::move(early[m][order[id].cluster]);
+      if (record.bytes.empty()) {  // not encoded during the build (the roots)
+        std::vector<uint32_t> clusters;
+        for (size_t k = 0; k < batch[r].count; ++k) clusters.push_back(order[id + k].cluster);
+        record.vertices.resize(batch[r].count);
+        record.bytes = encode_record(codec, dags[m], clusters, grids[m], args, record.vertices);
+      }
+      encoded[r] = std::move(record.bytes);
+      for (size_t k = 0; k < batch[r].count; ++k) records[id + k].vertices = record.vertices[k];
     });
     for (size_t r = 0; r < batch.size(); ++r) {
       if (batch[r].count == 0) {
@@ -622,6 +671,7 @@ int run_bake(const BakeArgs& args) {
     }
   }
   encoded = {};
+  early = {};
   size_t stored_triangles = 0;
   for (const NodeRecord& n : records) stored_triangles += n.triangles;
   int grid_bits = 14;

@@ -269,9 +269,11 @@ GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
 
 // A position locked in one cluster of a group is locked in every cluster of that group holding it: the
 // group's clusters share one position shift, so a vertex they share must decode the same way in all. Run
-// once every cluster of the group has been consumed (or the build ended), when its flags are complete; the
-// groups' clusters are appended to `finished`.
-void finish_groups(Builder& b, const std::vector<uint32_t>& groups, std::vector<uint32_t>& finished) {
+// once every cluster of the group has been consumed (or the build ended), when its flags are complete. Each
+// consumed cluster is then final: its consumer's `pending` count (inputs not yet final) drops, and a consumer
+// whose inputs are all final is appended to `ready`.
+void finish_groups(Builder& b, const std::vector<uint32_t>& groups, std::vector<uint32_t>& pending,
+                   std::vector<uint32_t>& ready) {
   ClusterDag& dag = b.dag;
   tbb::parallel_for(size_t(0), groups.size(), [&](size_t i) {
     const DagGroup& group = dag.groups[groups[i]];
@@ -286,7 +288,10 @@ void finish_groups(Builder& b, const std::vector<uint32_t>& groups, std::vector<
           dag.clusters[c].locked[v] = 1;
   });
   for (uint32_t g : groups)
-    finished.insert(finished.end(), dag.groups[g].clusters.begin(), dag.groups[g].clusters.end());
+    for (uint32_t c : dag.groups[g].clusters) {
+      const uint32_t consumer = dag.clusters[c].parent_group;
+      if (consumer != kNoGroup && --pending[consumer] == 0) ready.push_back(consumer);
+    }
 }
 
 }  // namespace
@@ -300,8 +305,9 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
 
   std::vector<uint32_t> active(dag.clusters.size());
   for (uint32_t c = 0; c < active.size(); ++c) active[c] = c;
-  std::vector<uint32_t> finished = active;  // final clusters not yet handed to options.finished
-  std::vector<uint32_t> unconsumed;         // by group: its clusters no accepted group has consumed yet
+  std::vector<uint32_t> unconsumed;  // by group: its clusters no accepted group has consumed yet
+  std::vector<uint32_t> pending;     // by group: its input clusters not yet final
+  std::vector<uint32_t> ready;       // groups whose inputs are final, not yet handed to options.inputs_final
   for (uint32_t level = 1; level <= options.max_levels; ++level) {
     size_t active_triangles = 0;
     for (uint32_t c : active) active_triangles += dag.clusters[c].mesh.triangle_count();
@@ -326,12 +332,8 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
     // Near the root, one group takes everything: no border left to lock, so small meshes with thin parts
     // still reach a small root.
     const bool last = active_triangles <= 2 * options.group_clusters * options.max_cluster_triangles;
-    // Sorting the edges, the open boundary (level 1) and the grouping (METIS) run on one core; the clusters
-    // the previous level finished are handed over beside them.
-    // No group is complete before level 3, so level 1 keeps a fifth of the level-0 clusters back for level
-    // 2's grouping, which would otherwise run alone (elephant_1m: level 2's METIS takes about a fifth of the
-    // time level 1 spends encoding the level-0 clusters beside its own).
-    const size_t handed = level == 1 ? finished.size() - finished.size() / 5 : finished.size();
+    // Sorting the edges, the open boundary (level 1) and the grouping (METIS) run on one core; the groups
+    // whose inputs became final are handed over beside them.
     std::vector<std::vector<uint32_t>> groups;
     tbb::parallel_invoke(
         [&] {
@@ -341,9 +343,9 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
               partition_clusters(triangles, centroids, edges, last ? active.size() : options.group_clusters);
         },
         [&] {
-          if (options.finished && handed > 0) options.finished(dag, std::span(finished).first(handed));
+          if (options.inputs_final && !ready.empty()) options.inputs_final(dag, ready);
         });
-    finished.erase(finished.begin(), finished.begin() + handed);
+    ready.clear();
     edges = {};
     for (auto& g : groups)
       for (uint32_t& i : g) i = active[i];  // active position -> cluster id
@@ -385,6 +387,7 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
         for (uint32_t& id : nc.ids)
           if (id & kNewId) id = first_new_id + (id & ~kNewId);
       const uint32_t gid = uint32_t(dag.groups.size());
+      uint32_t inputs = 0;  // of its children, those not final yet
       for (uint32_t c : r.group.children) {
         DagCluster& child = dag.clusters[c];
         child.parent_group = gid;
@@ -392,7 +395,10 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
         child.parent_sphere = r.group.sphere;
         if (child.group != kNoGroup && --unconsumed[child.group] == 0)
           completed_groups.push_back(child.group);
+        inputs += child.group != kNoGroup;  // level-0 clusters are final once consumed
       }
+      pending.push_back(inputs);
+      if (inputs == 0) ready.push_back(gid);
       for (NewCluster& nc : r.clusters) {
         const uint32_t cid = uint32_t(dag.clusters.size());
         DagCluster cluster;
@@ -411,7 +417,7 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
       dag.groups.push_back(std::move(r.group));
       dag.levels = std::max(dag.levels, level + 1);
     }
-    finish_groups(b, completed_groups, finished);
+    finish_groups(b, completed_groups, pending, ready);
     active = std::move(next);
     if (!any) {
       dag.stalled = true;
@@ -422,8 +428,7 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
   std::vector<uint32_t> open_groups;
   for (uint32_t g = 0; g < dag.groups.size(); ++g)
     if (unconsumed[g] > 0) open_groups.push_back(g);
-  finish_groups(b, open_groups, finished);
-  if (options.finished && !finished.empty()) options.finished(dag, finished);
+  finish_groups(b, open_groups, pending, ready);
   for (uint32_t c : active) {
     DagCluster& root = dag.clusters[c];
     root.parent_group = kNoGroup;
@@ -431,6 +436,7 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
     root.parent_sphere = root.sphere;
   }
   dag.roots = std::move(active);
+  if (options.inputs_final && !ready.empty()) options.inputs_final(dag, ready);
   return std::move(dag);
 }
 

@@ -52,15 +52,14 @@ struct DagOptions {
   float normal_weight = 0.01f, uv_weight = 0.05f, color_weight = 0.05f;
   // Called with (level, active triangles) after each level.
   std::function<void(uint32_t, size_t)> progress;
-  // Called with clusters that are final (mesh, locked flags, error and sphere; the parent fields of roots are
-  // set afterwards), each cluster exactly once, in an order that does not depend on thread timing, at the
-  // same time as the next level's grouping (METIS, one core), so that work on them (encoding) fills the other
-  // core: four fifths of the level-0 clusters with the first level's grouping and the rest with the second's
-  // (no group is complete before the third), then the clusters of each group once every one of them has been
-  // consumed, the rest (roots, their siblings) once the build ends. Exception: a level-0
-  // cluster's locked flags are set later, when a group consumes it (its mesh is exact, error 0). During a
-  // call nothing modifies the DAG; the call may use every core (TBB).
-  std::function<void(const ClusterDag&, std::span<const uint32_t>)> finished;
+  // Called with groups whose input clusters (DagGroup::children) are final (mesh, locked flags, error,
+  // sphere and parent fields), each group exactly once, in an order that does not depend on thread timing,
+  // at the same time as the next level's grouping (METIS, one core), so that work on them (encoding a page
+  // group) fills the other core: a group of level-0 clusters once it is accepted, a coarser group once every
+  // group that made one of its inputs has had all its clusters consumed (their locked flags are complete
+  // then); what is left when the build ends, at the end. During a call nothing modifies the DAG; the call
+  // may use every core (TBB).
+  std::function<void(const ClusterDag&, std::span<const uint32_t>)> inputs_final;
 };
 
 struct DagCluster {
@@ -105,12 +104,12 @@ struct ClusterDag {
   bool stalled = false;         // the build ended because no group of a level could be reduced
 };
 
-// Builds the DAG (options.finished receives its clusters as they become final). Degenerate triangles (a
-// repeated index) are dropped; an empty mesh gives an empty DAG. Cost: about twice the cost of simplifying
-// the whole mesh once (every level simplifies half the previous one), groups of a level in parallel (TBB);
-// memory about 60 bytes per input triangle for the clusters. Never throws on odd input (non-manifold, many
-// tiny components, degenerate). The mesh is taken by value and released once split into clusters: move it in
-// to avoid a copy (18 bytes per triangle of peak memory).
+// Builds the DAG (options.inputs_final receives its groups as their input clusters become final). Degenerate
+// triangles (a repeated index) are dropped; an empty mesh gives an empty DAG. Cost: about twice the cost of
+// simplifying the whole mesh once (every level simplifies half the previous one), groups of a level in
+// parallel (TBB); memory about 60 bytes per input triangle for the clusters. Never throws on odd input
+// (non-manifold, many tiny components, degenerate). The mesh is taken by value and released once split into
+// clusters: move it in to avoid a copy (18 bytes per triangle of peak memory).
 ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options = {});
 
 }  // namespace lodstream::hierarchy

@@ -216,50 +216,44 @@ Mesh tetrahedra_soup(int count) {
   return soup;
 }
 
-// DagOptions::finished hands over every cluster exactly once, already as the build leaves it, and most of
-// them while later levels are still being built (what lets the bake encode beside the grouping), level-0
-// clusters beside the second level's grouping too (no group is complete then).
-void check_finished(const Mesh& mesh) {
+// DagOptions::inputs_final hands over every group exactly once, its input clusters already as the build
+// leaves them, and most groups while later levels are still being built (what lets the bake encode beside
+// the grouping), groups of level-0 clusters beside the second level's grouping.
+void check_inputs_final(const Mesh& mesh) {
   struct Snapshot {
-    std::vector<glm::vec3> positions;
     std::vector<uint32_t> indices;
     std::vector<uint8_t> locked;
-    float error;
-    size_t dag_clusters;  // how many clusters the DAG had when this one was handed over
+    float error, parent_error;
   };
-  std::map<uint32_t, Snapshot> seen;
-  size_t calls = 0, level0_beside_level2 = 0;
+  std::map<uint32_t, Snapshot> seen;                // by input cluster
+  std::map<uint32_t, size_t> handed_with_clusters;  // by group: how many clusters the DAG had then
+  size_t level0_beside_level2 = 0;
   DagOptions options;
-  options.finished = [&](const ClusterDag& dag, std::span<const uint32_t> clusters) {
-    ++calls;
-    if (dag.levels == 2)
-      for (uint32_t c : clusters) level0_beside_level2 += dag.clusters[c].level == 0;
-    for (uint32_t c : clusters) {
-      const DagCluster& cluster = dag.clusters[c];
-      const bool fresh = seen.emplace(c, Snapshot{cluster.mesh.positions, cluster.mesh.indices,
-                                                  cluster.locked, cluster.error, dag.clusters.size()})
-                             .second;
-      EXPECT_TRUE(fresh) << "cluster " << c << " handed over twice";
+  options.inputs_final = [&](const ClusterDag& dag, std::span<const uint32_t> groups) {
+    for (uint32_t g : groups) {
+      EXPECT_TRUE(handed_with_clusters.emplace(g, dag.clusters.size()).second) << "group " << g << " twice";
+      for (uint32_t c : dag.groups[g].children) {
+        const DagCluster& cluster = dag.clusters[c];
+        EXPECT_EQ(cluster.parent_group, g);
+        if (dag.levels == 2) level0_beside_level2 += cluster.level == 0;
+        seen.emplace(c, Snapshot{cluster.mesh.indices, cluster.locked, cluster.error, cluster.parent_error});
+      }
     }
   };
   const ClusterDag dag = build_cluster_dag(mesh, options);
   ASSERT_GE(dag.levels, 4u);
-  EXPECT_EQ(seen.size(), dag.clusters.size());
-  EXPECT_GE(calls, size_t(dag.levels) - 1);
-  size_t early = 0;
+  EXPECT_EQ(handed_with_clusters.size(), dag.groups.size());
+  EXPECT_EQ(seen.size() + dag.roots.size(), dag.clusters.size()) << "every cluster but the roots is an input";
   for (const auto& [c, s] : seen) {
     const DagCluster& cluster = dag.clusters[c];
-    EXPECT_EQ(s.positions, cluster.mesh.positions);
     EXPECT_EQ(s.indices, cluster.mesh.indices);
-    if (cluster.level > 0) {  // level 0 is handed over before any group consumed it (cluster_dag.hpp)
-      EXPECT_EQ(s.locked, cluster.locked) << "cluster " << c << " changed its locked flags after hand-over";
-    } else {
-      EXPECT_EQ(s.error, 0.0f);
-    }
+    EXPECT_EQ(s.locked, cluster.locked) << "cluster " << c << " changed its locked flags after hand-over";
     EXPECT_EQ(s.error, cluster.error);
-    early += s.dag_clusters < dag.clusters.size();
+    EXPECT_EQ(s.parent_error, cluster.parent_error);
   }
-  EXPECT_GE(early, dag.clusters.size() / 2) << "clusters should be handed over level by level";
+  size_t early = 0;
+  for (const auto& [g, clusters] : handed_with_clusters) early += clusters < dag.clusters.size();
+  EXPECT_GE(early, dag.groups.size() / 2) << "groups should be handed over level by level";
   EXPECT_GT(level0_beside_level2, 0u) << "the second level's grouping should have level-0 clusters beside it";
   // The same build without the callback is the same DAG.
   const ClusterDag plain = build_cluster_dag(mesh);
@@ -270,12 +264,12 @@ void check_finished(const Mesh& mesh) {
   }
 }
 
-TEST(ClusterDag, FinishedClustersAreReportedOnceAndStayUnchanged) {
-  check_finished(test::sphere(1.0f, 64, 128));
+TEST(ClusterDag, GroupsAreHandedOverOnceWithFinalInputs) {
+  check_inputs_final(test::sphere(1.0f, 64, 128));
   Mesh grid = test::grid(64);
   for (glm::vec3& p : grid.positions) p.z = 0.02f * std::sin(9.0f * p.x) * std::cos(7.0f * p.y);
   grid.normals.clear();
-  check_finished(grid);
+  check_inputs_final(grid);
 }
 
 TEST(ClusterDag, TerminatesOnNonManifoldAndManyTinyComponents) {
