@@ -2,11 +2,24 @@
 
 #include <array>
 #include <cstring>
+#include <ranges>
 #include <unordered_map>
 
 #include "core/error.hpp"
 
 namespace lodstream::package {
+
+namespace {
+
+// to[k] = from[order[k]], allocated once and copied without value-initialising `to` first (the view's
+// iterators are random access because they yield references). Cost: O(order.size()).
+template <class T>
+void gather(const std::vector<T>& from, std::span<const uint32_t> order, std::vector<T>& to) {
+  auto values = std::views::transform(order, [&from](uint32_t v) -> const T& { return from[v]; });
+  to.assign(values.begin(), values.end());
+}
+
+}  // namespace
 
 RecordMesh weld_record(std::span<const Mesh* const> clusters,
                        std::span<const std::span<const uint8_t>> locked) {
@@ -75,37 +88,24 @@ DecodedNode extract_cluster(const DecodedNode& record, uint32_t cluster, const s
   DecodedNode out;
   Mesh& m = out.mesh;
   m.material = in.material;
-  m.indices.resize(3 * count);
-  const uint32_t* from = in.indices.data() + 3 * first;  // < V: the codec checked every index
-  uint32_t* to = m.indices.data();
+  // Copied, then renumbered in place: no value-initialisation of a buffer that is overwritten anyway.
+  m.indices.assign(in.indices.begin() + std::ptrdiff_t(3 * first),
+                   in.indices.begin() + std::ptrdiff_t(3 * (first + count)));  // < V: the codec checked them
   uint32_t* const map = compact.data();
   uint32_t* const first_use = used.data();
   uint32_t n = 0;
-  for (size_t i = 0; i < 3 * count; ++i) {
-    const uint32_t v = from[i];
+  for (uint32_t& v : m.indices) {
     uint32_t c = map[v];
     if (c == UINT32_MAX) c = map[v] = n, first_use[n++] = v;
-    to[i] = c;
+    v = c;
   }
   for (uint32_t k = 0; k < n; ++k) map[first_use[k]] = UINT32_MAX;  // before anything may throw
-  m.positions.resize(n);
-  for (size_t k = 0; k < n; ++k) m.positions[k] = in.positions[used[k]];
-  if (in.has_normals()) {
-    m.normals.resize(n);
-    for (size_t k = 0; k < n; ++k) m.normals[k] = in.normals[used[k]];
-  }
-  if (in.has_uvs()) {
-    m.uvs.resize(n);
-    for (size_t k = 0; k < n; ++k) m.uvs[k] = in.uvs[used[k]];
-  }
-  if (in.has_colors()) {
-    m.colors.resize(n);
-    for (size_t k = 0; k < n; ++k) m.colors[k] = in.colors[used[k]];
-  }
-  if (!record.vertex_data.empty()) {
-    out.vertex_data.resize(n);
-    for (size_t k = 0; k < n; ++k) out.vertex_data[k] = record.vertex_data[used[k]];
-  }
+  const std::span<const uint32_t> order(first_use, n);
+  gather(in.positions, order, m.positions);
+  if (in.has_normals()) gather(in.normals, order, m.normals);
+  if (in.has_uvs()) gather(in.uvs, order, m.uvs);
+  if (in.has_colors()) gather(in.colors, order, m.colors);
+  if (!record.vertex_data.empty()) gather(record.vertex_data, order, out.vertex_data);
   out.index_end = n;
   return out;
 }

@@ -5,8 +5,10 @@
 // 6,542,992 -> 5,462,790 B (-16.5 %; stored vertices per level-0 triangle 0.653 -> 0.559), elephant_5m
 // 26,432,899 -> 22,003,743 (4.64 -> 3.87 B per input triangle), refined_elephant 519,852 -> 424,956,
 // motorBike 2,323,447 -> 2,034,070, bunny 446,246 -> 374,365. Decoding a record's clusters one by one costs
-// 1.32x the instructions of decoding them as separate nodes (callgrind, bench_package argument 4 vs 3,
-// decode_node: 345 vs 262 per triangle): the extraction's copies and the cluster sort.
+// 1.17x the instructions of decoding them as separate nodes (callgrind, bench_package argument 4 vs 3,
+// decode_node: 307 vs 263 per triangle; 344 before the decoder placed triangles straight into their
+// clusters' ranges and the extraction stopped value-initialising its copies): the extraction's remap and
+// copies.
 //
 // weld_record builds a record from clusters; extract_cluster gives one cluster back from a decoded record,
 // what the reader returns for a cluster's node id, so that a record is invisible above the package: the

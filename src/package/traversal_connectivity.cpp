@@ -1,7 +1,10 @@
 #include "package/traversal_connectivity.hpp"
 
+#include <array>
+
 #include "core/error.hpp"
 #include "package/bytes.hpp"
+#include "package/quantized_node.hpp"
 
 namespace lodstream::package {
 
@@ -254,17 +257,31 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
   uint32_t next = 0;  // the next new vertex
   const uint8_t* symbol = symbols.data();
   const uint8_t* const symbols_end = symbol + symbols.size();
-  // Clusters of a record: each triangle's, the triangles decoded into `traversal_order` and then sorted into
-  // the clusters' ranges of `indices`; C = 1 otherwise (every symbol's cluster code must then be 0).
+  // Clusters of a record: each triangle goes straight to the next free place in its cluster's range of
+  // `indices` (the ranges are consecutive, in cluster order, sized by `cluster_triangles`), so the triangles
+  // of each cluster stay in traversal order, as the encoder's counting sort leaves them; C = 1 otherwise
+  // (every symbol's cluster code must then be 0).
   const uint32_t C = cluster_triangles.size() > 1 ? uint32_t(cluster_triangles.size()) : 1;
-  thread_local std::vector<uint8_t> cluster_of;
-  thread_local std::vector<uint32_t> traversal_order;
-  if (C > 1) cluster_of.resize(T), traversal_order.resize(3 * size_t(T));
-  uint32_t* out = C > 1 ? traversal_order.data() : indices;
-  const uint32_t* const end = out + 3 * size_t(T);
-  uint8_t* cluster = cluster_of.data();
+  if (C > kMaxRecordClusters) fail("more clusters than a record may hold");
+  std::array<uint32_t*, kMaxRecordClusters> at, range_end;  // per cluster: next place, end of its range
+  size_t placed = 0;                                        // triangles of the clusters before k
+  for (uint32_t k = 0; k < C; ++k) placed += C > 1 ? cluster_triangles[k] : T;
+  if (placed != T) fail("triangles per cluster differ from the header's");
+  placed = 0;
+  for (uint32_t k = 0; k < C; ++k) {
+    at[k] = indices + 3 * placed;
+    placed += C > 1 ? cluster_triangles[k] : T;
+    range_end[k] = indices + 3 * placed;
+  }
+  // Triangle (v0, v1, v2) of cluster k < C into its range.
+  auto emit = [&](uint32_t v0, uint32_t v1, uint32_t v2, uint32_t k) {
+    uint32_t*& out = at[k];
+    if (out == range_end[k]) fail("triangles per cluster differ from the header's");
+    out[0] = v0, out[1] = v1, out[2] = v2;
+    out += 3;
+  };
   uint32_t e = 0;  // the gate
-  while (out != end) {
+  for (uint32_t left = T; left > 0;) {
     e = front.gate(e);
     if (e == front.size()) {
       uint32_t k = 0;
@@ -272,7 +289,6 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
         const uint64_t read = refs.varint();
         if (read >= C) fail("cluster out of range");
         k = uint32_t(read);
-        *cluster++ = uint8_t(k);
       }
       uint32_t corner[3];
       for (int k = 0; k < 3; ++k) {
@@ -288,8 +304,8 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
         }
       }
       front.start(corner[0], corner[1], corner[2], k);
-      out[0] = corner[0], out[1] = corner[1], out[2] = corner[2];
-      out += 3;
+      emit(corner[0], corner[1], corner[2], k);
+      --left;
       continue;
     }
     if (symbol == symbols_end) fail("symbols end early");
@@ -334,16 +350,12 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
       default:
         fail("unknown symbol");
     }
-    out[0] = b, out[1] = a, out[2] = c;
-    out += 3;
-    if (C > 1) *cluster++ = uint8_t(k);
+    emit(b, a, c, k);
+    --left;
     ++e;
   }
   if (symbol != symbols_end) fail("symbols left over");
   if (!refs.at_end()) fail("references left over");
-  if (C > 1 &&
-      !sort_by_cluster(traversal_order.data(), indices, std::span(cluster_of).first(T), cluster_triangles))
-    fail("triangles per cluster differ from the header's");
   for (; next < V; ++next) {
     const uint32_t from = next > 0 ? next - 1 : V;
     predictors[3 * next] = predictors[3 * next + 1] = predictors[3 * next + 2] = from;

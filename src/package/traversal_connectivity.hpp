@@ -27,8 +27,9 @@
 // Records of several clusters (NodeGeometry::cluster_triangles; C clusters, C <= 31): the traversal runs
 // over the whole record as over one mesh, and each triangle's cluster is tagged: bits 3-7 of its symbol are 0
 // when it is the cluster of the gate's triangle, else 1 + its cluster; a piece start's references begin with
-// a varint cluster. After the traversal both sides move the triangles into the clusters' ranges, in
-// traversal order within each (a counting sort), so a decoded record's cluster c is a consecutive range.
+// a varint cluster. The encoder moves the triangles into the clusters' ranges after the traversal, in
+// traversal order within each (a counting sort); the decoder puts each triangle straight into its cluster's
+// range (known from the counts), so a decoded record's cluster c is a consecutive range.
 // Measured on elephant_1m (bake, codec 3, records of mixed precision): 5,382,094 B, level-0 connectivity
 // 0.25 B/tri after zstd; the tags cost 4.7 % (5,142,369 B untagged, which cannot be split back into
 // clusters); a first version that kept each cluster's triangles together in the traversal (deferring gates
@@ -70,7 +71,7 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
 // TraversalCode's), a record's with the encoder's `cluster_triangles` (which must add up to T, each at least
 // 1, at most 31: the caller checks; the decoded triangles of each cluster then form its range); every
 // symbol, reference, cluster and vertex count is checked: corrupted streams throw lodstream::Error starting
-// with `where`. Cost: O(T + V), one pass over the symbols (and one over the triangles for a record).
+// with `where`. Cost: O(T + V), one pass over the symbols.
 void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t> references, uint32_t T,
                       uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where,
                       std::span<const uint32_t> cluster_triangles = {});

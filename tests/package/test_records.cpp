@@ -17,6 +17,7 @@
 #include "package/reader.hpp"
 #include "package/records.hpp"
 #include "package/traversal_codec.hpp"
+#include "package/traversal_connectivity.hpp"
 #include "package_fixture.hpp"
 #include "support/run.hpp"
 #include "support/shapes.hpp"
@@ -167,6 +168,40 @@ TEST(Records, InvalidClusterCountsAndOtherCodecsAreRefused) {
   } catch (const Error& e) {
     EXPECT_EQ(std::string(e.what()).rfind("node 7: cluster 6 out of range", 0), 0u) << e.what();
   }
+}
+
+TEST(Records, TheDecoderPlacesEachClusterInItsRangeAndRefusesOtherCounts) {
+  // The decoder writes each triangle straight into its cluster's range: the encoder's clustered indices
+  // come back exactly, and counts that differ from the stream's (other splits of T, or not adding up to T)
+  // are errors, never a write outside `indices`.
+  const Record r = sphere_record(0);
+  const RecordMesh& w = r.welded;
+  const uint32_t T = uint32_t(w.mesh.triangle_count()), V = uint32_t(w.mesh.vertex_count());
+  const TraversalCode code = encode_traversal(w.mesh.indices, V, w.cluster_triangles);
+  auto decode = [&](std::span<const uint32_t> counts) {
+    std::vector<uint32_t> indices(3 * size_t(T) + 3, UINT32_MAX), predictors(3 * (size_t(V) + 1));
+    decode_traversal(code.symbols, code.references, T, V, indices.data(), predictors.data(), "node 5",
+                     counts);
+    EXPECT_EQ(indices.back(), UINT32_MAX) << "written past the triangles";
+    indices.resize(3 * size_t(T));
+    return indices;
+  };
+  EXPECT_EQ(decode(w.cluster_triangles), code.indices);
+  auto refused = [&](std::vector<uint32_t> counts) {
+    try {
+      decode(counts);
+      ADD_FAILURE() << "counts " << counts[0] << ", " << counts[1] << "... were accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("node 5: corrupted connectivity (triangles per cluster", 0), 0u)
+          << e.what();
+    }
+  };
+  std::vector<uint32_t> moved = w.cluster_triangles;  // one triangle moved from cluster 1 to cluster 0
+  moved[0] += 1, moved[1] -= 1;
+  refused(moved);
+  std::vector<uint32_t> more = w.cluster_triangles;  // adding up to T + 1
+  more.back() += 1;
+  refused(more);
 }
 
 TEST(Records, CorruptedRecordsAreErrorsOrValidRecords) {
