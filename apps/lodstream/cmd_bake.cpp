@@ -14,8 +14,9 @@
 // in order (a page group each), then, from the coarsest level down, the input clusters of each group
 // simplification as one page group: refining a group needs exactly its input clusters, so they travel
 // together. With a codec that stores records (codec 3), each page group of DAG clusters (a group's input
-// clusters, a DAG's roots) is one record per precision (package/records.hpp): one vertex pool for all its
-// clusters. A group's records are encoded as soon as its input clusters are final, beside the next level's
+// clusters, a DAG's roots) is one record (package/records.hpp; several past
+// NodeCodec::max_record_clusters()), one vertex pool for all its clusters, stored at the page group's finest
+// precision. A group's records are encoded as soon as its input clusters are final, beside the next level's
 // grouping (DagOptions::inputs_final), which leaves the other core idle; the roots' at the end.
 //
 // Precision (how the codec's position_shift is spent): level-0 clusters are stored on the finest grid of
@@ -34,8 +35,8 @@
 // PSNR at 1 / 2 / 5 s of 55.9 / 57.2 / 51.0 dB instead of 50.5 / 52.4 / 49.3 (push), refined_elephant +1.6 %
 // bytes with PSNR 52.0 / 51.8 / 48.4 instead of 51.4 / 50.3 / 48.2. Vertices on the border of the group that
 // made or consumes a cluster are flagged locked and decode exactly, so cuts stay crack-free (free vertices
-// are shared only by clusters of one group, which use one shift). HLOD proxies are stored on a 2^-14 grid of
-// the scene's world bounds, shift 0; the rounding is part of their errors.
+// are shared only by clusters of one page group, stored at one shift: page_group_precision). HLOD proxies are
+// stored on a 2^-14 grid of the scene's world bounds, shift 0; the rounding is part of their errors.
 #include <tbb/parallel_for.h>
 
 #include <atomic>
@@ -149,23 +150,39 @@ std::pair<uint32_t, uint32_t> precision(const hierarchy::DagCluster& c, const Po
   return {position_shift(c.error, grid), cluster_normal_bits(c.error, args)};
 }
 
-// A record (package/records.hpp): DAG clusters of one page group and one precision welded into one mesh on
-// their identical vertices (same position and attributes: seams stay split), each cluster's triangles a
-// consecutive range, stored as one node with one vertex pool, free vertices at the clusters' shift, every
-// vertex locked in any of them exactly. Each vertex decodes to what it decodes to in a node of its cluster
-// alone (the same grid value, the same octahedral normal), so cuts stay crack-free and renders unchanged:
-// a free vertex is shared only by clusters of one producing group and one consuming group (the header
-// comment), that is only inside one page group and at one precision. (Records of mixed precision, free
-// vertices at the clusters' smallest shift and normals at their largest bits, were 1.5 % smaller on
-// elephant_1m and motorBike, but changed coarse positions.) `vertices[c]` receives cluster c's distinct
-// vertices (what a reader's cluster holds: welding also merges identical vertices within a cluster).
+// How a page group's DAG clusters (a group's input clusters, or a DAG's roots) are stored, in every record
+// of the group: the smallest position shift and the largest normal bits of its clusters. A free vertex is
+// shared only by clusters of one producing group and one consuming group (the header comment), that is only
+// inside one page group, so it decodes alike wherever it is stored, even when the page group is cut into
+// several records (more than NodeCodec::max_record_clusters() clusters: a stalled DAG's roots). Precision
+// per record instead cracked the city: 32 roots of mixed levels cut 31 + 1, a free vertex shared by two
+// siblings (roots of one group) decoded at shift 10 in one record and 13 in the other. Costs O(clusters).
+std::pair<uint32_t, uint32_t> page_group_precision(const hierarchy::ClusterDag& dag,
+                                                   std::span<const uint32_t> clusters,
+                                                   const PositionGrid& grid, const BakeArgs& args) {
+  std::pair<uint32_t, uint32_t> stored = precision(dag.clusters[clusters[0]], grid, args);
+  for (uint32_t c : clusters) {
+    const auto [shift, normal_bits] = precision(dag.clusters[c], grid, args);
+    stored = {std::min(stored.first, shift), std::max(stored.second, normal_bits)};
+  }
+  return stored;
+}
+
+// A record (package/records.hpp): DAG clusters of one page group welded into one mesh on their identical
+// vertices (same position and attributes: seams stay split), each cluster's triangles a consecutive range,
+// stored as one node with one vertex pool, free vertices at the page group's precision `stored`
+// (page_group_precision), every vertex locked in any of them exactly. A vertex thus decodes alike in every
+// record of its page group and locked vertices everywhere, so cuts stay crack-free. Against one record per
+// precision this rounds a coarse cluster's free vertices finer than its error allows and stores coarse
+// normals at the page group's largest bits. `vertices[c]` receives cluster c's distinct vertices (what a
+// reader's cluster holds: welding also merges identical vertices within a cluster).
 std::vector<uint8_t> encode_record(const NodeCodec& codec, const hierarchy::ClusterDag& dag,
-                                   std::span<const uint32_t> clusters, const PositionGrid& grid,
-                                   const BakeArgs& args, std::span<uint32_t> vertices) {
+                                   std::span<const uint32_t> clusters, std::pair<uint32_t, uint32_t> stored,
+                                   const PositionGrid& grid, std::span<uint32_t> vertices) {
   std::vector<const Mesh*> meshes;
   std::vector<std::span<const uint8_t>> locked;
   NodeGeometry geometry;
-  std::tie(geometry.position_shift, geometry.normal_bits) = precision(dag.clusters[clusters[0]], grid, args);
+  std::tie(geometry.position_shift, geometry.normal_bits) = stored;
   for (uint32_t c : clusters) {
     meshes.push_back(&dag.clusters[c].mesh);
     locked.push_back(dag.clusters[c].locked);
@@ -178,31 +195,11 @@ std::vector<uint8_t> encode_record(const NodeCodec& codec, const hierarchy::Clus
   return codec.encode(geometry, grid);
 }
 
-// Group `group`'s input clusters in page order: by precision (stable), so that the clusters stored alike are
-// consecutive (a record holds clusters of one precision).
-std::vector<uint32_t> page_order(const hierarchy::ClusterDag& dag, uint32_t group, const PositionGrid& grid,
-                                 const BakeArgs& args) {
-  std::vector<uint32_t> children = dag.groups[group].children;
-  std::stable_sort(children.begin(), children.end(), [&](uint32_t a, uint32_t b) {
-    return precision(dag.clusters[a], grid, args) < precision(dag.clusters[b], grid, args);
-  });
-  return children;
-}
-
-// The records of a page group's DAG clusters (in page order): its runs of consecutive clusters of one
-// precision, each cut at `max` clusters; returns the runs' lengths.
-std::vector<uint32_t> record_runs(const hierarchy::ClusterDag& dag, std::span<const uint32_t> clusters,
-                                  const PositionGrid& grid, const BakeArgs& args, uint32_t max) {
+// The records of a page group of `clusters` DAG clusters (in page order): runs of `max` consecutive
+// clusters, the last one shorter; returns the runs' lengths.
+std::vector<uint32_t> record_runs(size_t clusters, uint32_t max) {
   std::vector<uint32_t> runs;
-  for (size_t i = 0; i < clusters.size();) {
-    uint32_t count = 1;
-    while (i + count < clusters.size() && count < max &&
-           precision(dag.clusters[clusters[i + count]], grid, args) ==
-               precision(dag.clusters[clusters[i]], grid, args))
-      ++count;
-    runs.push_back(count);
-    i += count;
-  }
+  for (size_t i = 0; i < clusters; i += max) runs.push_back(uint32_t(std::min<size_t>(max, clusters - i)));
   return runs;
 }
 
@@ -361,12 +358,13 @@ int run_bake(const BakeArgs& args) {
       std::vector<EncodedRecord>& out = early[m];
       out.resize(dag.clusters.size());
       tbb::parallel_for(size_t(0), groups.size(), [&](size_t i) {
-        const std::vector<uint32_t> children = page_order(dag, groups[i], grids[m], args);
+        const std::vector<uint32_t>& children = dag.groups[groups[i]].children;
+        const auto stored = page_group_precision(dag, children, grids[m], args);
         size_t first = 0;
-        for (uint32_t count : record_runs(dag, children, grids[m], args, codec.max_record_clusters())) {
+        for (uint32_t count : record_runs(children.size(), codec.max_record_clusters())) {
           EncodedRecord& r = out[children[first]];
           r.vertices.resize(count);
-          r.bytes = encode_record(codec, dag, std::span(children).subspan(first, count), grids[m], args,
+          r.bytes = encode_record(codec, dag, std::span(children).subspan(first, count), stored, grids[m],
                                   r.vertices);
           r.bytes.shrink_to_fit();  // kept until the pages are written: no growth slack
           first += count;
@@ -523,7 +521,7 @@ int run_bake(const BakeArgs& args) {
   std::stable_sort(groups.begin(), groups.end(),
                    [](const GroupRef& a, const GroupRef& b) { return a.level > b.level; });
   for (const GroupRef& gr : groups) {
-    for (uint32_t c : page_order(dags[gr.mesh], gr.group, grids[gr.mesh], args)) {
+    for (uint32_t c : dags[gr.mesh].groups[gr.group].children) {
       node_id[gr.mesh][c] = uint32_t(order.size());
       order.push_back({gr.mesh, c});
     }
@@ -600,7 +598,8 @@ int run_bake(const BakeArgs& args) {
   NodeSizeBreakdown breakdown;
   auto is_cluster = [&](size_t id) { return order[id].mesh != kNone && pms[order[id].mesh].steps.empty(); };
   struct Record {
-    size_t first, count;  // node ids [first, first + count)
+    size_t first, count;                   // node ids [first, first + count)
+    std::pair<uint32_t, uint32_t> stored;  // a DAG record's page_group_precision
   };
   std::vector<Record> batch;
   std::vector<std::vector<uint8_t>> encoded;
@@ -612,15 +611,16 @@ int run_bake(const BakeArgs& args) {
         const uint32_t m = order[first].mesh;
         std::vector<uint32_t> clusters;
         for (size_t id = first; id < page_group_ends[g]; ++id) clusters.push_back(order[id].cluster);
+        const auto stored = page_group_precision(dags[m], clusters, grids[m], args);
         size_t id = first;
-        for (uint32_t count : record_runs(dags[m], clusters, grids[m], args, codec.max_record_clusters()))
-          batch.push_back({id, count}), id += count;
+        for (uint32_t count : record_runs(clusters.size(), codec.max_record_clusters()))
+          batch.push_back({id, count, stored}), id += count;
       } else {
-        for (size_t id = first; id < page_group_ends[g]; ++id) batch.push_back({id, 1});
+        for (size_t id = first; id < page_group_ends[g]; ++id) batch.push_back({id, 1, {}});
       }
       nodes += page_group_ends[g] - first;
       first = page_group_ends[g];
-      batch.push_back({first, 0});  // the page group's end
+      batch.push_back({first, 0, {}});  // the page group's end
     }
     encoded.assign(batch.size(), {});
     tbb::parallel_for(size_t(0), batch.size(), [&](size_t r) {
@@ -652,7 +652,7 @@ int run_bake(const BakeArgs& args) {
         std::vector<uint32_t> clusters;
         for (size_t k = 0; k < batch[r].count; ++k) clusters.push_back(order[id + k].cluster);
         record.vertices.resize(batch[r].count);
-        record.bytes = encode_record(codec, dags[m], clusters, grids[m], args, record.vertices);
+        record.bytes = encode_record(codec, dags[m], clusters, batch[r].stored, grids[m], record.vertices);
       }
       encoded[r] = std::move(record.bytes);
       for (size_t k = 0; k < batch[r].count; ++k) records[id + k].vertices = record.vertices[k];
