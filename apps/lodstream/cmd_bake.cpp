@@ -49,7 +49,6 @@
 #include <numeric>
 #include <span>
 #include <tuple>
-#include <unordered_map>
 #include <utility>
 
 #include "bake_textures.hpp"
