@@ -6,10 +6,12 @@
 // Unit of benefit: a group exchange (schedule/cut.hpp) of a view's ideal cut whose G is not all held. Its
 // benefit is the screen area it refines times the error it removes on a log scale, summed over the weighted
 // views:
-//   benefit = sum_v w_v * A_i * min(1, |P| a(P) / W_i) * ln(max(e_P, tau) / max(e_G, tau)) / sum_j A_j,
+//   benefit = sum_v w_v * A_i * min(1, |P| a(P) / W_i) * gain(P, G) / sum_j A_j,
+//   gain(P, G) = sum_g a(g) ln(max(e_P, tau) / max(e_g, tau)) / sum_g a(g) over G's members g,
 // A_i the clipped screen area of the exchange's object, a(P) that of P's bounding sphere (shared by P's
 // nodes), W_i the screen area of the nodes drawn now for object i (so |P| a(P) / W_i is P's weight in
-// alpha_i's area-weighted mean), e_P and e_G the projected errors of P and G, sum_j A_j the screen area of
+// alpha_i's area-weighted mean), e_P and e_g the projected errors of P and of a member g (members come from
+// different groups: their errors differ), a(g) the screen area of g's sphere, sum_j A_j the screen area of
 // the objects in view v's frustum. For an object's roots the share is 1 and the gain a constant 10 (drawing
 // something where nothing is drawn comes before refining). Measured alternatives (motorBike, gen:fly, 10
 // Mbit/s): the one-step accuracy gain min(1, tau/e_G) - min(1, tau/e_P) starves coarse exchanges, whose own

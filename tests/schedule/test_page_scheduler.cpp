@@ -51,6 +51,19 @@ size_t position(const std::vector<PageRef>& order, PageKind kind, uint32_t id) {
                 order.begin());
 }
 
+// Adds object i (0: left, 1: right of the -z axis, 10 units away) of a unit-cube representation whose root
+// is node i.
+void add_object_beside_the_axis(package::PackageScene& scene, uint32_t i) {
+  package::Representation rep;
+  rep.bounds.add(glm::vec3(-0.5f));
+  rep.bounds.add(glm::vec3(0.5f));
+  rep.roots = {i};
+  scene.representations.push_back(rep);
+  glm::mat4 t(1.0f);
+  t[3] = glm::vec4(i == 0 ? -3.0f : 3.0f, 0.0f, -10.0f, 1.0f);
+  scene.objects.push_back({"o", t, i});
+}
+
 }  // namespace
 
 TEST(PageScheduler, ConvergesToTheIdealCutWithRecordsBeforeTheirPages) {
@@ -138,14 +151,7 @@ TEST(PageScheduler, SmallerPageFirstAtEqualBenefit) {
       records[i].triangles = 10;
       records[i].error = 0.0f;
       records[i].sphere = {{0.0f, 0.0f, 0.0f}, 1.0f};
-      package::Representation rep;
-      rep.bounds.add(glm::vec3(-0.5f));
-      rep.bounds.add(glm::vec3(0.5f));
-      rep.roots = {i};
-      scene.representations.push_back(rep);
-      glm::mat4 t(1.0f);
-      t[3] = glm::vec4(i == 0 ? -3.0f : 3.0f, 0.0f, -10.0f, 1.0f);
-      scene.objects.push_back({"o", t, i});
+      add_object_beside_the_axis(scene, i);
     }
     const uint32_t small = small_first_id ? 0 : 1;
     auto reader = write_package("two.lods", records, scene, 2,
@@ -157,6 +163,51 @@ TEST(PageScheduler, SmallerPageFirstAtEqualBenefit) {
     ASSERT_EQ(order.size(), 2u);
     EXPECT_EQ(order[0].id, reader.root().root_nodes[small].page) << "small page has id " << small;
     EXPECT_LT(order[0].bytes, order[1].bytes);
+  }
+}
+
+TEST(PageScheduler, AnExchangeIsWorthWhatAllItsMembersGainWhicheverComesFirst) {
+  // Two objects placed symmetrically about the view axis, each a root P (error 1, about 60 px) over a group
+  // G of three leaves. Object 0's G: one leaf barely better than P (error 0.99) and two exact ones, so on
+  // average its members remove 2/3 of ln(e_P / tau); object 1's: three leaves of error 0.13 (about 8 px),
+  // half of ln(e_P / tau) each. Object 0's G comes first wherever its nearly-useless leaf is in id order.
+  for (uint32_t useless : {0u, 2u}) {
+    std::vector<package::NodeRecord> records(8);
+    package::PackageScene scene;
+    for (uint32_t i = 0; i < 2; ++i) {
+      package::NodeRecord& p = records[i];
+      p.representation = i;
+      p.level = 1;
+      p.triangles = 10;
+      p.error = 1.0f;
+      p.sphere = {{0.0f, 0.0f, 0.0f}, 1.0f};
+      for (uint32_t k = 0; k < 3; ++k) {
+        const uint32_t id = 2 + 3 * i + k;
+        p.children.push_back(id);
+        package::NodeRecord& g = records[id];
+        g.representation = i;
+        g.triangles = 10;
+        g.error = i == 1 ? 0.13f : (k == useless ? 0.99f : 0.0f);
+        g.sphere = {{0.0f, 0.0f, 0.0f}, 0.6f};
+        g.parents = {i};
+        g.parent_error = p.error;
+        g.parent_sphere = p.sphere;
+      }
+      add_object_beside_the_axis(scene, i);
+    }
+    auto reader = write_package("gain.lods", records, scene, 8, [](uint32_t) -> size_t { return 500; });
+    PageScheduler s(reader.root());
+    PackageRecords all(reader);
+    const WeightedView views[] = {{look({0, 0, 0}, {0, 0, -1}), 1.0, 0.0}};
+    const auto order = drain(s, reader.scene(), all, views, 1.0, 1);
+    ASSERT_EQ(order.size(), 8u);
+    auto first_of = [&](uint32_t object) {
+      size_t first = order.size();
+      for (uint32_t k = 0; k < 3; ++k)
+        first = std::min(first, position(order, PageKind::data, all.record(2 + 3 * object + k)->page));
+      return first;
+    };
+    EXPECT_LT(first_of(0), first_of(1)) << "the nearly-useless leaf is member " << useless;
   }
 }
 
