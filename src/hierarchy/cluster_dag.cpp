@@ -27,6 +27,12 @@ struct Builder {
   // grouping, which needs only the clusters' indices, position ids and spheres).
   Mesh input;
   std::vector<ClusterPart> input_parts;
+  // Per level, reused (fresh pages cost 4 s/GB to touch): the active clusters' boundary edges, and by
+  // position id the group holding it (UINT32_MAX) and whether clusters of two groups hold it (0), both
+  // reset to those values after each level.
+  std::vector<ClusterEdge> edges;
+  std::vector<uint32_t> owner;
+  std::vector<uint8_t> border;
 };
 
 // Positions a group simplification creates get ids kNewId | k while groups run in parallel; the ids are made
@@ -335,7 +341,11 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
     tbb::parallel_for(size_t(0), active.size(), [&](size_t i) {
       boundary[i] = cluster_boundary(dag.clusters[active[i]].mesh, b.position_ids[active[i]]);
     });
-    std::vector<ClusterEdge> edges;
+    std::vector<ClusterEdge>& edges = b.edges;
+    size_t boundary_edges = 0;
+    for (const std::vector<uint64_t>& once : boundary) boundary_edges += once.size();
+    edges.clear();
+    edges.reserve(boundary_edges);
     for (uint32_t i = 0; i < active.size(); ++i)
       for (uint64_t e : boundary[i]) edges.emplace_back(e, i);
     boundary.clear();
@@ -364,13 +374,17 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
           if (options.inputs_final && !ready.empty()) options.inputs_final(dag, ready);
         });
     ready.clear();
-    edges = {};
     for (auto& g : groups)
       for (uint32_t& i : g) i = active[i];  // active position -> cluster id
 
     // Group borders: positions used by clusters of more than one group.
-    std::vector<uint32_t> owner(b.next_position_id, UINT32_MAX);
-    std::vector<uint8_t> border(b.next_position_id, 0);
+    std::vector<uint32_t>& owner = b.owner;
+    std::vector<uint8_t>& border = b.border;
+    if (owner.size() < b.next_position_id) {
+      if (owner.capacity() < b.next_position_id)  // ids grow by about half the active positions a level
+        owner.reserve(b.next_position_id * 3 / 2), border.reserve(b.next_position_id * 3 / 2);
+      owner.resize(b.next_position_id, UINT32_MAX), border.resize(b.next_position_id, 0);
+    }
     for (uint32_t g = 0; g < groups.size(); ++g)
       for (uint32_t c : groups[g])
         for (uint32_t id : b.position_ids[c]) {
@@ -379,7 +393,6 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
           else if (owner[id] != g)
             border[id] = 1;
         }
-    owner = {};
 
     std::vector<GroupResult> results(groups.size());
     tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
@@ -387,6 +400,9 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
       if (groups[g].size() > 1 || groups.size() == 1)
         results[g] = simplify_group(b, groups[g], border, level);
     });
+    for (const std::vector<uint32_t>& group : groups)
+      for (uint32_t c : group)
+        for (uint32_t id : b.position_ids[c]) owner[id] = UINT32_MAX, border[id] = 0;
 
     std::vector<uint32_t> next, completed_groups;
     bool any = false;
