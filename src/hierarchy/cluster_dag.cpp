@@ -23,6 +23,16 @@ struct Builder {
   std::vector<std::vector<uint32_t>> position_ids;  // by cluster
   std::vector<uint8_t> open_boundary;               // by position id (ids of the input mesh)
   uint32_t next_position_id = 0;
+  // The input and its level-0 clusters' vertices until their vertex data is copied (beside level 1's
+  // grouping, which needs only the clusters' indices, position ids and spheres).
+  Mesh input;
+  std::vector<ClusterPart> input_parts;
+  // Per level, reused (fresh pages cost 4 s/GB to touch): the active clusters' boundary edges, and by
+  // position id the group holding it (UINT32_MAX) and whether clusters of two groups hold it (0), both
+  // reset to those values after each level.
+  std::vector<ClusterEdge> edges;
+  std::vector<uint32_t> owner;
+  std::vector<uint8_t> border;
 };
 
 // Positions a group simplification creates get ids kNewId | k while groups run in parallel; the ids are made
@@ -103,26 +113,38 @@ void build_level0(Builder& b, Mesh mesh) {
   b.dag.input_triangles = mesh.triangle_count();
   if (mesh.indices.empty()) return;
 
-  // Welding (one core) runs beside the clusterizer, whose spatial sort is on one core too.
-  std::vector<uint32_t> vertex_id(mesh.positions.size());
+  // Welding runs beside the clusterizer's spatial sort (one core).
+  std::vector<uint32_t> vertex_id;
   std::vector<ClusterPart> parts;
   tbb::parallel_invoke(
-      [&] {
-        PositionIndex index(mesh.positions.size());
-        for (size_t v = 0; v < mesh.positions.size(); ++v) vertex_id[v] = index.insert(mesh.positions[v]);
-        b.next_position_id = uint32_t(index.size());
-      },
+      [&] { vertex_id = weld_positions(mesh.positions, b.next_position_id); },
       [&] { parts = clusterize(mesh, b.options.max_cluster_vertices, b.options.max_cluster_triangles); });
   b.dag.clusters.resize(parts.size());
   b.position_ids.resize(parts.size());
   tbb::parallel_for(size_t(0), parts.size(), [&](size_t c) {
     DagCluster& cluster = b.dag.clusters[c];
-    cluster.mesh = cluster_mesh(mesh, parts[c]);
-    cluster.locked.assign(cluster.mesh.positions.size(), 0);
-    cluster.sphere = sphere_of_points(cluster.mesh.positions);
+    cluster.mesh.indices = std::move(parts[c].indices);
+    thread_local std::vector<glm::vec3> points;
+    points.clear();
+    for (uint32_t v : parts[c].vertices) points.push_back(mesh.positions[v]);
+    cluster.sphere = sphere_of_points(points);
     auto& ids = b.position_ids[c];
     for (uint32_t v : parts[c].vertices) ids.push_back(vertex_id[v]);
   });
+  b.input = std::move(mesh);
+  b.input_parts = std::move(parts);
+}
+
+// The level-0 clusters' positions, attributes and (cleared) locked flags, from the input, which is then
+// released; nothing once done. Clusters on every core.
+void copy_level0_vertices(Builder& b) {
+  tbb::parallel_for(size_t(0), b.input_parts.size(), [&](size_t c) {
+    DagCluster& cluster = b.dag.clusters[c];
+    copy_cluster_vertices(b.input, b.input_parts[c].vertices, cluster.mesh);
+    cluster.locked.assign(cluster.mesh.positions.size(), 0);
+  });
+  b.input = Mesh{};
+  b.input_parts = {};
 }
 
 // Marks the positions of edges that no other cluster shares (the mesh's open boundary); `edges` sorted.
@@ -319,7 +341,11 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
     tbb::parallel_for(size_t(0), active.size(), [&](size_t i) {
       boundary[i] = cluster_boundary(dag.clusters[active[i]].mesh, b.position_ids[active[i]]);
     });
-    std::vector<ClusterEdge> edges;
+    std::vector<ClusterEdge>& edges = b.edges;
+    size_t boundary_edges = 0;
+    for (const std::vector<uint64_t>& once : boundary) boundary_edges += once.size();
+    edges.clear();
+    edges.reserve(boundary_edges);
     for (uint32_t i = 0; i < active.size(); ++i)
       for (uint64_t e : boundary[i]) edges.emplace_back(e, i);
     boundary.clear();
@@ -332,8 +358,9 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
     // Near the root, one group takes everything: no border left to lock, so small meshes with thin parts
     // still reach a small root.
     const bool last = active_triangles <= 2 * options.group_clusters * options.max_cluster_triangles;
-    // Sorting the edges, the open boundary (level 1) and the grouping (METIS) run on one core; the groups
-    // whose inputs became final are handed over beside them.
+    // Sorting the edges, the open boundary (level 1) and the grouping (METIS) run on one core; beside them,
+    // the level-0 clusters' vertex data is copied (level 1) and the groups whose inputs became final are
+    // handed over.
     std::vector<std::vector<uint32_t>> groups;
     tbb::parallel_invoke(
         [&] {
@@ -343,16 +370,21 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
               partition_clusters(triangles, centroids, edges, last ? active.size() : options.group_clusters);
         },
         [&] {
+          copy_level0_vertices(b);
           if (options.inputs_final && !ready.empty()) options.inputs_final(dag, ready);
         });
     ready.clear();
-    edges = {};
     for (auto& g : groups)
       for (uint32_t& i : g) i = active[i];  // active position -> cluster id
 
     // Group borders: positions used by clusters of more than one group.
-    std::vector<uint32_t> owner(b.next_position_id, UINT32_MAX);
-    std::vector<uint8_t> border(b.next_position_id, 0);
+    std::vector<uint32_t>& owner = b.owner;
+    std::vector<uint8_t>& border = b.border;
+    if (owner.size() < b.next_position_id) {
+      if (owner.capacity() < b.next_position_id)  // ids grow by about half the active positions a level
+        owner.reserve(b.next_position_id * 3 / 2), border.reserve(b.next_position_id * 3 / 2);
+      owner.resize(b.next_position_id, UINT32_MAX), border.resize(b.next_position_id, 0);
+    }
     for (uint32_t g = 0; g < groups.size(); ++g)
       for (uint32_t c : groups[g])
         for (uint32_t id : b.position_ids[c]) {
@@ -361,7 +393,6 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
           else if (owner[id] != g)
             border[id] = 1;
         }
-    owner = {};
 
     std::vector<GroupResult> results(groups.size());
     tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
@@ -369,6 +400,9 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
       if (groups[g].size() > 1 || groups.size() == 1)
         results[g] = simplify_group(b, groups[g], border, level);
     });
+    for (const std::vector<uint32_t>& group : groups)
+      for (uint32_t c : group)
+        for (uint32_t id : b.position_ids[c]) owner[id] = UINT32_MAX, border[id] = 0;
 
     std::vector<uint32_t> next, completed_groups;
     bool any = false;
@@ -424,6 +458,7 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
       break;
     }
   }
+  copy_level0_vertices(b);  // when the build ended before level 1's grouping
   // The rest: the groups that made a root.
   std::vector<uint32_t> open_groups;
   for (uint32_t g = 0; g < dag.groups.size(); ++g)

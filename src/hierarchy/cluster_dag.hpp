@@ -108,8 +108,9 @@ struct ClusterDag {
 // triangles (a repeated index) are dropped; an empty mesh gives an empty DAG. Cost: about twice the cost of
 // simplifying the whole mesh once (every level simplifies half the previous one), groups of a level in
 // parallel (TBB); memory about 60 bytes per input triangle for the clusters. Never throws on odd input
-// (non-manifold, many tiny components, degenerate). The mesh is taken by value and released once split into
-// clusters: move it in to avoid a copy (18 bytes per triangle of peak memory).
+// (non-manifold, many tiny components, degenerate). The mesh is taken by value and released once its level-0
+// clusters have their vertex data (copied beside level 1's grouping): move it in to avoid a copy (18 bytes
+// per triangle of peak memory).
 ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options = {});
 
 }  // namespace lodstream::hierarchy

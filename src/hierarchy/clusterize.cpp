@@ -189,17 +189,23 @@ std::vector<ClusterPart> clusterize(const Mesh& mesh, size_t max_vertices, size_
 
 Mesh cluster_mesh(const Mesh& mesh, const ClusterPart& part) {
   Mesh c;
-  c.material = mesh.material;
   c.indices = part.indices;
-  c.positions.reserve(part.vertices.size());
-  for (uint32_t v : part.vertices) c.positions.push_back(mesh.positions[v]);
-  if (mesh.has_normals())
-    for (uint32_t v : part.vertices) c.normals.push_back(mesh.normals[v]);
-  if (mesh.has_uvs())
-    for (uint32_t v : part.vertices) c.uvs.push_back(mesh.uvs[v]);
-  if (mesh.has_colors())
-    for (uint32_t v : part.vertices) c.colors.push_back(mesh.colors[v]);
+  copy_cluster_vertices(mesh, part.vertices, c);
   return c;
+}
+
+void copy_cluster_vertices(const Mesh& mesh, std::span<const uint32_t> vertices, Mesh& cluster) {
+  cluster.material = mesh.material;
+  auto gather = [vertices](const auto& from, auto& to) {
+    to.clear();
+    if (from.empty()) return;
+    to.reserve(vertices.size());
+    for (uint32_t v : vertices) to.push_back(from[v]);
+  };
+  gather(mesh.positions, cluster.positions);
+  gather(mesh.normals, cluster.normals);
+  gather(mesh.uvs, cluster.uvs);
+  gather(mesh.colors, cluster.colors);
 }
 
 }  // namespace lodstream::hierarchy

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/mesh.hpp"
@@ -29,5 +30,9 @@ std::vector<ClusterPart> clusterize(const Mesh& mesh, size_t max_vertices, size_
 
 // The cluster's own mesh: positions and every attribute the mesh has, material copied.
 Mesh cluster_mesh(const Mesh& mesh, const ClusterPart& part);
+
+// Sets `cluster`'s material, positions and every attribute `mesh` has to those of `mesh`'s `vertices`
+// (cluster_mesh without the indices). Cost: O(vertices).
+void copy_cluster_vertices(const Mesh& mesh, std::span<const uint32_t> vertices, Mesh& cluster);
 
 }  // namespace lodstream::hierarchy

@@ -1,27 +1,46 @@
 #include "hierarchy/position_index.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
 #include <bit>
-#include <cstring>
 
 namespace lodstream::hierarchy {
+namespace {
+
+// A coordinate's bits with -0 folded into +0 (+ 0 turns -0 into +0), so equal values compare equal.
+uint32_t coordinate_bits(float f) {
+  return std::bit_cast<uint32_t>(f + 0.0f);
+}
+
+uint64_t hash_bits(uint32_t x, uint32_t y, uint32_t z) {
+  uint64_t h = (uint64_t(x) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(y) * 0xC2B2AE3D27D4EB4Full) ^
+               (uint64_t(z) * 0x165667B19E3779F9ull);
+  return h ^ (h >> 29);
+}
+
+uint64_t position_hash(const glm::vec3& p) {
+  return hash_bits(coordinate_bits(p.x), coordinate_bits(p.y), coordinate_bits(p.z));
+}
+
+bool same_position(const glm::vec3& a, const glm::vec3& b) {
+  return coordinate_bits(a.x) == coordinate_bits(b.x) && coordinate_bits(a.y) == coordinate_bits(b.y) &&
+         coordinate_bits(a.z) == coordinate_bits(b.z);
+}
+
+}  // namespace
 
 PositionIndex::PositionIndex(size_t expected) {
   slots_.assign(std::bit_ceil(std::max<size_t>(16, expected * 2)), Slot{0, 0, 0, kMissing});
 }
 
 PositionIndex::Slot PositionIndex::key(const glm::vec3& p, uint32_t id) {
-  Slot s;
-  const float c[3] = {p.x + 0.0f, p.y + 0.0f, p.z + 0.0f};  // + 0 turns -0 into +0
-  std::memcpy(&s.x, &c[0], 4), std::memcpy(&s.y, &c[1], 4), std::memcpy(&s.z, &c[2], 4);
-  s.id = id;
-  return s;
+  return Slot{coordinate_bits(p.x), coordinate_bits(p.y), coordinate_bits(p.z), id};
 }
 
 size_t PositionIndex::home(const Slot& s) const {
-  uint64_t h = (uint64_t(s.x) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(s.y) * 0xC2B2AE3D27D4EB4Full) ^
-               (uint64_t(s.z) * 0x165667B19E3779F9ull);
-  h ^= h >> 29;
-  return size_t(h) & (slots_.size() - 1);
+  return size_t(hash_bits(s.x, s.y, s.z)) & (slots_.size() - 1);
 }
 
 void PositionIndex::grow() {
@@ -55,6 +74,78 @@ uint32_t PositionIndex::find(const glm::vec3& p) const {
     i = (i + 1) & (slots_.size() - 1);
   }
   return kMissing;
+}
+
+std::vector<uint32_t> weld_positions(std::span<const glm::vec3> positions, uint32_t& distinct) {
+  const size_t n = positions.size();
+  std::vector<uint32_t> ids(n);
+  // Buckets by the hash's top bits, about 1024 positions each; positions in chunks, each chunk's bucket
+  // counts apart, so that the counting sort runs on every core and keeps increasing positions per bucket.
+  const int bucket_bits = std::min(16, int(std::bit_width(n / 1024)));
+  const size_t buckets = size_t(1) << bucket_bits;
+  auto bucket_of = [bucket_bits](uint64_t h) {
+    return bucket_bits == 0 ? size_t(0) : size_t(h >> (64 - bucket_bits));
+  };
+  constexpr size_t kChunk = size_t(1) << 16;
+  const size_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<uint32_t> start(chunks * buckets, 0);  // chunk-major: start[c * buckets + b]
+  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+    uint32_t* count = &start[c * buckets];
+    for (size_t v = c * kChunk; v < std::min(n, (c + 1) * kChunk); ++v)
+      ++count[bucket_of(position_hash(positions[v]))];
+  });
+  std::vector<uint32_t> bucket_begin(buckets + 1, 0);
+  uint32_t running = 0;
+  for (size_t b = 0; b < buckets; ++b) {
+    bucket_begin[b] = running;
+    for (size_t c = 0; c < chunks; ++c) {
+      const uint32_t k = start[c * buckets + b];
+      start[c * buckets + b] = running;
+      running += k;
+    }
+  }
+  bucket_begin[buckets] = running;
+  std::vector<uint32_t> order(n);
+  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+    uint32_t* next = &start[c * buckets];
+    for (size_t v = c * kChunk; v < std::min(n, (c + 1) * kChunk); ++v)
+      order[next[bucket_of(position_hash(positions[v]))]++] = uint32_t(v);
+  });
+  start = {};
+  // Each bucket: every position's first equal position (its representative), through a table of (32 hash
+  // bits, position) slots at load <= 0.5, reused by the thread.
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, buckets, 16), [&](const tbb::blocked_range<size_t>& r) {
+    constexpr uint64_t kEmpty = UINT64_MAX;
+    thread_local std::vector<uint64_t> table;
+    for (size_t b = r.begin(); b < r.end(); ++b) {
+      const uint32_t begin = bucket_begin[b], end = bucket_begin[b + 1];
+      const size_t capacity = std::bit_ceil(std::max<size_t>(16, 2 * size_t(end - begin)));
+      if (table.size() < capacity) table.resize(capacity);
+      std::fill_n(table.begin(), capacity, kEmpty);
+      for (uint32_t i = begin; i < end; ++i) {
+        const uint32_t v = order[i];
+        const uint64_t h = position_hash(positions[v]);
+        const uint64_t tag = uint32_t(h);
+        for (size_t slot = h & (capacity - 1);; slot = (slot + 1) & (capacity - 1)) {
+          const uint64_t e = table[slot];
+          if (e == kEmpty) {
+            table[slot] = tag << 32 | v;
+            ids[v] = v;
+            break;
+          }
+          if (e >> 32 == tag && same_position(positions[uint32_t(e)], positions[v])) {
+            ids[v] = uint32_t(e);
+            break;
+          }
+        }
+      }
+    }
+  });
+  // Representatives come first (they are the smallest of their positions): number them in order.
+  uint32_t next = 0;
+  for (size_t v = 0; v < n; ++v) ids[v] = ids[v] == v ? next++ : ids[ids[v]];
+  distinct = next;
+  return ids;
 }
 
 }  // namespace lodstream::hierarchy
