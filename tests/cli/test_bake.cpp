@@ -126,10 +126,14 @@ TEST(CliBake, DagShapeOptionsSetStoredTrianglesAndClusterSize) {
     EXPECT_EQ(inspect.status, 0) << inspect.err;
     return inspect.json()["per_level"][0]["nodes"].get<size_t>();
   };
-  auto half = bake_and_verify("bunny.obj", dir / "half.lods");
+  const std::vector<std::string> shape = {"--group-ratio", "0.5", "--cluster-triangles", "128"};
+  auto half = bake_and_verify("bunny.obj", dir / "half.lods", shape);
   auto third = bake_and_verify("bunny.obj", dir / "third.lods", {"--group-ratio", "0.33"});
-  auto large = bake_and_verify("bunny.obj", dir / "large.lods", {"--cluster-triangles", "256"});
-  auto many = bake_and_verify("bunny.obj", dir / "many.lods", {"--group-clusters", "16"});
+  auto large = bake_and_verify("bunny.obj", dir / "large.lods",
+                               {"--group-ratio", "0.5", "--cluster-triangles", "256"});
+  auto many =
+      bake_and_verify("bunny.obj", dir / "many.lods",
+                      {"--group-ratio", "0.5", "--cluster-triangles", "128", "--group-clusters", "16"});
   const double input = half["input_triangles"].get<double>();
   EXPECT_GT(half["stored_triangles"].get<double>(), 1.8 * input);
   EXPECT_LT(third["stored_triangles"].get<double>(), 1.6 * input);
