@@ -381,7 +381,7 @@ int run_bake(const BakeArgs& args) {
     hierarchy::DagOptions options = dag_shape;
     size_t reported = 0;
     options.progress = [&](uint32_t, size_t active) {
-      // Level l removes about half of what is left: count the removed triangles as done.
+      // Each level removes about 1 - group_ratio of what is left: count the removed triangles as done.
       const size_t done_here = triangles - std::min(triangles, active);
       if (done_here > reported) report(done_here - reported), reported = done_here;
     };
