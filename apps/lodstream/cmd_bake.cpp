@@ -91,7 +91,38 @@ struct BakeArgs {
   int max_grid_bits = 20;
   uint32_t codec = default_node_codec().id();
   uint32_t pm_max_triangles = kDefaultPmMaxTriangles;
+  // The DAG's shape (--group-ratio, --group-clusters, --cluster-triangles): dag_options() checks it and
+  // fills the vertex limit.
+  hierarchy::DagOptions dag;
+  uint32_t cluster_triangles = uint32_t(hierarchy::DagOptions{}.max_cluster_triangles);
 };
+
+// Limits of the DAG's shape options. A group's target must stay under DagOptions::stuck_ratio (0.85) with
+// the 10 % slack a group may miss it by and still count as reaching it. A cluster's vertices must fit
+// cluster_dag.cpp's per-cluster edge table (255) and its triangles meshoptimizer's meshlet limit (512). A
+// group of one cluster has no neighbour to simplify across its locked border; 31 clusters is the most a
+// record holds (NodeCodec::max_record_clusters), so a group's input clusters stay one record.
+constexpr double kMinGroupRatio = 0.1, kMaxGroupRatio = 0.75;
+constexpr uint32_t kMinClusterTriangles = 16, kMaxClusterTriangles = 512, kMaxClusterVertices = 255;
+constexpr size_t kMinGroupClusters = 2, kMaxGroupClusters = 31;
+
+// The DAG options of --group-ratio, --group-clusters and --cluster-triangles; throws lodstream::Error (one
+// line naming the option) outside their ranges. A cluster of N triangles may have N vertices (what 128 / 128
+// gave), at most 255: an open patch of N triangles has about N / 2 vertices plus half its border, so the
+// vertex limit binds only on seams or past ~400 triangles.
+hierarchy::DagOptions dag_options(const BakeArgs& args) {
+  hierarchy::DagOptions o = args.dag;
+  if (!(o.group_ratio >= kMinGroupRatio && o.group_ratio <= kMaxGroupRatio))
+    throw Error("--group-ratio: must be in 0.1..0.75");
+  if (o.group_clusters < kMinGroupClusters || o.group_clusters > kMaxGroupClusters)
+    throw Error("--group-clusters: must be in 2..31");
+  if (args.cluster_triangles < kMinClusterTriangles || args.cluster_triangles > kMaxClusterTriangles ||
+      args.cluster_triangles % 4 != 0)
+    throw Error("--cluster-triangles: must be a multiple of 4 in 16..512");
+  o.max_cluster_triangles = args.cluster_triangles;
+  o.max_cluster_vertices = std::min(args.cluster_triangles, kMaxClusterVertices);
+  return o;
+}
 
 uint64_t peak_rss_bytes() {
   std::ifstream status("/proc/self/status");
@@ -305,6 +336,7 @@ int run_bake(const BakeArgs& args) {
   }
   if (args.pm_max_triangles > kMaxPmTriangles)
     throw Error("--pm-max-triangles: must be in 0.." + std::to_string(kMaxPmTriangles));
+  const hierarchy::DagOptions dag_shape = dag_options(args);
   Scene scene = import_all(args.models);
   end_phase("import");
   const uint64_t input_triangles = scene.triangle_count();
@@ -346,10 +378,10 @@ int run_bake(const BakeArgs& args) {
         return;
       }
     }
-    hierarchy::DagOptions options;
+    hierarchy::DagOptions options = dag_shape;
     size_t reported = 0;
     options.progress = [&](uint32_t, size_t active) {
-      // Level l removes about half of what is left: count the removed triangles as done.
+      // Each level removes about 1 - group_ratio of what is left: count the removed triangles as done.
       const size_t done_here = triangles - std::min(triangles, active);
       if (done_here > reported) report(done_here - reported), reported = done_here;
     };
@@ -781,6 +813,21 @@ const bool registered = register_command(
                       "larger ones cluster DAGs (0 = every mesh a DAG; at most " +
                           std::to_string(kMaxPmTriangles) + "; default " +
                           std::to_string(kDefaultPmMaxTriangles) + ")");
+       const hierarchy::DagOptions shape;
+       char ratio[32];
+       std::snprintf(ratio, sizeof ratio, "%g", shape.group_ratio);
+       sub.add_option(
+           "--group-ratio", args->dag.group_ratio,
+           "each group of clusters is simplified to this fraction of its triangles, which sets how "
+           "many levels the DAG has and how many triangles it stores (0.1..0.75, default " +
+               std::string(ratio) + ")");
+       sub.add_option("--group-clusters", args->dag.group_clusters,
+                      "clusters per group simplified together (2..31, default " +
+                          std::to_string(shape.group_clusters) + ")");
+       sub.add_option("--cluster-triangles", args->cluster_triangles,
+                      "at most this many triangles (and vertices, at most 255) per DAG cluster, the unit of "
+                      "selection (a multiple of 4 in 16..512, default " +
+                          std::to_string(shape.max_cluster_triangles) + ")");
        sub.add_flag(
            "--hlod,!--no-hlod", args->hlod,
            "an HLOD over the objects (merged proxies: a distant group of objects is a few nodes); on "

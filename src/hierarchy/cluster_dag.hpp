@@ -3,10 +3,11 @@
 //   level 0: the mesh split into clusters of at most 128 triangles (clusterize.hpp);
 //   each level: the active clusters are partitioned into groups of about 8 neighbours (METIS on the cluster
 //   adjacency weighted by shared edges, group_partition.hpp); each group is merged and simplified to about
-//   half with its outer border locked (positions shared with clusters of other groups, and the mesh's own
-//   open boundary), and the result is split into new clusters (once the active clusters hold at most
-//   2 * group_clusters * max_cluster_triangles triangles, they form one group); repeat until the active
-//   clusters hold at most `root_triangles` triangles (or one cluster), or no group of a level can be reduced.
+//   group_ratio (0.45) of its triangles with its outer border locked (positions shared with clusters of other
+//   groups, and the mesh's own open boundary), and the result is split into new clusters (once the active
+//   clusters hold at most 2 * group_clusters * max_cluster_triangles triangles, they form one group); repeat
+//   until the active clusters hold at most `root_triangles` triangles (or one cluster), or no group of a
+//   level can be reduced.
 // Fallbacks (recorded per group, like meshoptimizer's clusterlod): a group that does not reach 85 % of its
 // triangles with attributes is retried positions-only with a looser normal limit; a group still above 85 %
 // is abandoned and its clusters stay active for the next level (with other neighbours); the build always
@@ -38,10 +39,27 @@ inline constexpr uint32_t kNoGroup = UINT32_MAX;
 struct ClusterDag;
 
 struct DagOptions {
+  // The DAG's shape (bake --cluster-triangles, --group-clusters, --group-ratio). A DAG stores about T / (1 -
+  // group_ratio) triangles in about log(T / root_triangles) / log(1 / group_ratio) levels; a smaller ratio
+  // stores fewer, but a cut then steps further past tau between levels and draws more. Measured (codec 3;
+  // package bytes; triangles drawn near / mid / far by render --pixel-error 1 at 1280x720 from eyes
+  // (0.5,0.2,0.6) / (1.5,0.5,1.5) / (4,1.5,4) at the origin, motorBike examples/cameras front / side /
+  // above; bench stream gen:fly at 10 Mbit/s 80 ms: oracle's mean triangles, push's time to benefit 0.95),
+  // ratio 0.5 -> 0.45 (0.4):
+  //   elephant_1m 5,382,094 -> 4,834,941 B, -10.2 % (-18.8 %), 14 -> 12 (11) levels, drawn 449k / 221k / 68k
+  //   -> 430k / 200k / 74k (443k / 211k / 79k), fly 413k -> 397k (406k), push 1.27 -> 1.23 (1.07) s;
+  //   elephant_5m 3.775 -> 3.374 (3.031) B per input triangle, drawn 943k / 317k / 95k -> 885k / 316k / 108k
+  //   (916k / 366k / 137k); city 5.852 -> 5.361 (4.966);
+  //   motorBike 2,006,676 -> 1,847,461 B, -7.9 % (-14.3 %), drawn 156k / 154k / 155k -> 160k / 155k / 158k
+  //   (172k / 172k / 171k), fly 163k -> 169k (180k), push 1.17 -> 1.13 (1.10) s.
+  // 0.45 is 8-11 % smaller, streams no slower and draws -10..+14 % per view (-5 / -3 / +2 % over the three
+  // views of elephant_1m / elephant_5m / motorBike); 0.4 draws up to +44 % (elephant_5m far), 0.33 up to +74
+  // % (elephant_1m far). Clusters of 256 triangles (elephant_1m -9.6 % bytes at 0.5) drew 5-22 % more, groups
+  // of 16 clusters (-6.3 %) 21-31 % more: a coarser unit of selection refines more than it needs.
   size_t max_cluster_triangles = 128;  // divisible by 4, at most 512 (meshoptimizer's meshlet limit)
   size_t max_cluster_vertices = 128;   // at most 255
   size_t group_clusters = 8;           // target clusters per group
-  double group_ratio = 0.5;            // target triangles after simplifying a group, as a fraction
+  double group_ratio = 0.45;           // target triangles after simplifying a group, as a fraction
   double stuck_ratio = 0.85;           // a group above this fraction after the fallback is abandoned
   size_t root_triangles = 256;         // stop when the active clusters hold at most this many
   uint32_t max_levels = 48;
@@ -106,8 +124,8 @@ struct ClusterDag {
 
 // Builds the DAG (options.inputs_final receives its groups as their input clusters become final). Degenerate
 // triangles (a repeated index) are dropped; an empty mesh gives an empty DAG. Cost: about twice the cost of
-// simplifying the whole mesh once (every level simplifies half the previous one), groups of a level in
-// parallel (TBB); memory about 60 bytes per input triangle for the clusters. Never throws on odd input
+// simplifying the whole mesh once (every level simplifies group_ratio of the previous one), groups of a level
+// in parallel (TBB); memory about 60 bytes per input triangle for the clusters. Never throws on odd input
 // (non-manifold, many tiny components, degenerate). The mesh is taken by value and released once its level-0
 // clusters have their vertex data (copied beside level 1's grouping): move it in to avoid a copy (18 bytes
 // per triangle of peak memory).

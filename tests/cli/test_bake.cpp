@@ -116,6 +116,56 @@ TEST(CliBake, BadInputIsAOneLineError) {
   EXPECT_NE(flipped.err.find(good.string()), std::string::npos) << flipped.err;
 }
 
+// The DAG's shape options: a smaller --group-ratio stores fewer triangles (about T / (1 - r): 2 T at 0.5,
+// 1.5 T at 0.33), --cluster-triangles 256 makes half as many full-resolution clusters (nodes of level 0), and
+// --group-clusters reaches the build, and every shape verifies (crack-free cuts, monotonic errors).
+TEST(CliBake, DagShapeOptionsSetStoredTrianglesAndClusterSize) {
+  const auto dir = temp_dir();
+  const auto level0_nodes = [](const std::filesystem::path& package) {
+    auto inspect = run_lodstream({"inspect", package.string(), "--json"});
+    EXPECT_EQ(inspect.status, 0) << inspect.err;
+    return inspect.json()["per_level"][0]["nodes"].get<size_t>();
+  };
+  const std::vector<std::string> shape = {"--group-ratio", "0.5", "--cluster-triangles", "128"};
+  auto half = bake_and_verify("bunny.obj", dir / "half.lods", shape);
+  auto third = bake_and_verify("bunny.obj", dir / "third.lods", {"--group-ratio", "0.33"});
+  auto large = bake_and_verify("bunny.obj", dir / "large.lods",
+                               {"--group-ratio", "0.5", "--cluster-triangles", "256"});
+  auto many =
+      bake_and_verify("bunny.obj", dir / "many.lods",
+                      {"--group-ratio", "0.5", "--cluster-triangles", "128", "--group-clusters", "16"});
+  const double input = half["input_triangles"].get<double>();
+  EXPECT_GT(half["stored_triangles"].get<double>(), 1.8 * input);
+  EXPECT_LT(third["stored_triangles"].get<double>(), 1.6 * input);
+  EXPECT_LT(third["levels"].get<int>(), half["levels"].get<int>());
+  const size_t clusters_128 = level0_nodes(dir / "half.lods"),
+               clusters_256 = level0_nodes(dir / "large.lods");
+  EXPECT_GE(clusters_128 * 128, size_t(input));
+  EXPECT_GE(clusters_256 * 256, size_t(input));
+  EXPECT_LT(double(clusters_256), 0.6 * double(clusters_128));
+  // Groups of 16 clusters make another DAG (fewer, larger groups), which verifies too.
+  EXPECT_NE(many["bytes"], half["bytes"]);
+}
+
+TEST(CliBake, DagShapeOutsideItsRangeIsAOneLineError) {
+  const auto dir = temp_dir();
+  for (const auto& [option, value] :
+       std::vector<std::pair<std::string, std::string>>{{"--group-ratio", "0.8"},
+                                                        {"--group-ratio", "0.05"},
+                                                        {"--group-clusters", "1"},
+                                                        {"--group-clusters", "32"},
+                                                        {"--cluster-triangles", "516"},
+                                                        {"--cluster-triangles", "130"},
+                                                        {"--cluster-triangles", "12"}}) {
+    auto bad = run_lodstream(
+        {"bake", data_file("elephant.off").string(), "-o", (dir / "x.lods").string(), option, value});
+    EXPECT_EQ(bad.status, 1) << option << " " << value;
+    EXPECT_EQ(bad.err.rfind("lodstream: error: " + option + ": must be", 0), 0u) << bad.err;
+    EXPECT_EQ(bad.err.find('\n'), bad.err.size() - 1) << bad.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "x.lods"));
+  }
+}
+
 // A scene of many meshes bakes its meshes in parallel: the package must not depend on thread timing (it did
 // while METIS calls ran concurrently and new position ids were numbered in completion order).
 TEST(CliBake, TheSameSceneBakesToTheSameBytes) {
