@@ -18,6 +18,7 @@
 #include "simplify/counting_sort.hpp"
 #include "simplify/quadric.hpp"
 #include "simplify/simplify.hpp"
+#include "simplify/uninitialized.hpp"
 
 namespace lodstream::simplify {
 namespace {
@@ -174,15 +175,17 @@ class Simplifier {
 
   // Welded vertices (input vertex -> welded) and their working data (normalized positions).
   std::vector<uint32_t> weld_remap_, source_;  // source_: welded vertex -> first input vertex
-  std::vector<glm::vec3> pos_;
-  std::vector<glm::vec3> nrm_;
-  std::vector<glm::vec2> uv_;
-  std::vector<glm::vec4> col_;
-  std::vector<uint32_t> wedge_, pid_;  // wedge ring (same position) and its representative
+  // The UninitializedVector members are first written by parallel loops (weld, renumber_spatially,
+  // build_quadrics, run_pass), so that their pages are first touched on every core.
+  UninitializedVector<glm::vec3> pos_;
+  UninitializedVector<glm::vec3> nrm_;
+  UninitializedVector<glm::vec2> uv_;
+  UninitializedVector<glm::vec4> col_;
+  UninitializedVector<uint32_t> wedge_, pid_;  // wedge ring (same position) and its representative
   std::vector<uint8_t> kind_, touched_, moved_;
   std::vector<float> radius_;  // bound radius r_v (simplify.hpp), normalized units
-  std::vector<Quadric> quadric_;
-  std::vector<AttributeTerm> attr_;  // channels_ per vertex
+  UninitializedVector<Quadric> quadric_;
+  UninitializedVector<AttributeTerm> attr_;  // channels_ per vertex
   // Weighted attribute channels in the cost: one component of the normal, UV or colour, with its weight.
   struct Channel {
     int attribute;  // 0 normal, 1 uv, 2 colour
@@ -200,18 +203,20 @@ class Simplifier {
   std::vector<uint32_t> indices_;  // alive faces; dead ones have indices_[3f] == kNone during a pass
   size_t alive_triangles_ = 0, welded_triangles_ = 0;  // welded_: before the first collapse
   std::vector<uint32_t> offsets_, faces_;              // vertex -> faces (CSR), rebuilt each pass
-  std::vector<Candidate> slots_;
+  UninitializedVector<Candidate> slots_;
   std::vector<Ranked> order_, sorted_;
   std::vector<float> bucket_;  // goal_cost's candidate costs in one histogram bucket
-  // Regions of the collapse loop's parallel part (region_of): runs of region_vertices_ vertex numbers in
+  // Regions of the collapse loop's parallel rounds (region_of): runs of region_vertices_ vertex numbers in
   // Morton order (about kRegionVertices alive vertices, at least kMinRegions regions on a smaller mesh; the
-  // run grows as the mesh shrinks), shifted by region_shift_, which turns each pass so that no band of the
-  // mesh is always left to the serial part.
+  // run grows as the mesh shrinks), shifted by round_shift_: region_shift_ in a pass's first round (it turns
+  // each pass so that no band of the mesh is always left to the serial part), half a region more in its
+  // second.
   // region_start_: where each region's candidates begin in sorted_ (grouped by region after the cost sort, as
   // (cost, order_ index); then the serial part's list); pending_: per order_ entry, whether the serial part
-  // is to try it.
+  // is to try it (pending_count_ of them when a round begins).
   static constexpr uint32_t kRegionVertices = 16384, kMinRegions = 2;
-  uint32_t region_vertices_ = kRegionVertices, region_shift_ = 0;
+  uint32_t region_vertices_ = kRegionVertices, region_shift_ = 0, round_shift_ = 0;
+  size_t pending_count_ = 0;
   std::vector<uint32_t> region_start_;
   std::vector<uint8_t> pending_;
   Scratch serial_;
@@ -240,7 +245,7 @@ class Simplifier {
       return (!hn || in_.normals[i] == in_.normals[j]) && (!hu || in_.uvs[i] == in_.uvs[j]) &&
              (!hc || in_.colors[i] == in_.colors[j]);
     };
-    std::vector<std::pair<uint32_t, uint32_t>> sorted(n);  // (position hash, input vertex)
+    UninitializedVector<std::pair<uint32_t, uint32_t>> sorted(n);  // (position hash, input vertex)
     for_each(size_t(0), n, [&](size_t v) { sorted[v] = {hash_bits(&in_.positions[v].x, 3), uint32_t(v)}; });
     tbb::parallel_sort(sorted.begin(), sorted.end());
     std::vector<uint32_t> run(n);  // where the run of sorted[i]'s hash begins
@@ -249,7 +254,7 @@ class Simplifier {
     // Per input vertex: the first input vertex at its position, and the first with its position and
     // attributes (its welded vertex's source). Positions compare with == (NaN never equal, as in a hash-table
     // weld).
-    std::vector<uint32_t> first_at(n), source(n);
+    UninitializedVector<uint32_t> first_at(n), source(n);
     for_each(size_t(0), n, [&](size_t i) {
       const uint32_t v = sorted[i].second;
       uint32_t at = v, same = v;
@@ -324,18 +329,38 @@ class Simplifier {
     sort_faces();
   }
 
-  // Orders the faces by their smallest vertex (a counting sort; vertices are in Morton order), so that the
-  // faces around a vertex lie in a few cache lines of indices_ and slots_: each collapse walks them in cost
-  // order, random in space, and in input order the first read of every face was a cache miss (about a third
-  // of try_collapse's samples on elephant_1m). O(T + V).
+  // Orders the faces by their smallest vertex, stably (vertices are in Morton order), so that the faces
+  // around a vertex lie in a few cache lines of indices_ and slots_: each collapse walks them in cost order,
+  // random in space, and in input order the first read of every face was a cache miss (about a third of
+  // try_collapse's samples on elephant_1m). Two stable counting sorts, on every core: by runs of `span`
+  // vertices (counting_sort), then each run's faces by their vertex. O(T + V).
   void sort_faces() {
-    std::vector<uint32_t> start(source_.size() + 1, 0);
-    auto key = [&](size_t f) { return std::min({indices_[f], indices_[f + 1], indices_[f + 2]}); };
-    for (size_t f = 0; f < indices_.size(); f += 3) ++start[key(f) + 1];
-    for (size_t v = 1; v < start.size(); ++v) start[v] += start[v - 1];
+    constexpr uint32_t kRuns = 4096;
+    const size_t faces = indices_.size() / 3;
+    const uint32_t span = uint32_t(source_.size() / kRuns + 1);
+    auto key = [&](size_t f) {
+      return std::min({indices_[3 * f], indices_[3 * f + 1], indices_[3 * f + 2]});
+    };
+    UninitializedVector<uint32_t> by_run(faces);
+    std::vector<uint32_t> run_start;
+    counting_sort(
+        faces, kRuns, [&](size_t f) { return key(f) / span; },
+        [&](size_t f, uint32_t position) { by_run[position] = uint32_t(f); }, &run_start);
     std::vector<uint32_t> sorted(indices_.size());
-    for (size_t f = 0; f < indices_.size(); f += 3)
-      std::copy_n(&indices_[f], 3, &sorted[3 * size_t(start[key(f)]++)]);
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, kRuns, 64), [&](const auto& runs) {
+      std::vector<uint32_t> start(span + 1);
+      for (uint32_t r = runs.begin(); r < runs.end(); ++r) {
+        const uint32_t first = r * span, begin = run_start[r], end = run_start[r + 1];
+        std::fill(start.begin(), start.end(), 0);
+        for (uint32_t i = begin; i < end; ++i) ++start[key(by_run[i]) - first + 1];
+        start[0] = begin;
+        for (uint32_t v = 1; v <= span; ++v) start[v] += start[v - 1];
+        for (uint32_t i = begin; i < end; ++i) {
+          const uint32_t f = by_run[i];
+          std::copy_n(&indices_[3 * size_t(f)], 3, &sorted[3 * size_t(start[key(f) - first]++)]);
+        }
+      }
+    });
     indices_.swap(sorted);
   }
 
@@ -353,22 +378,23 @@ class Simplifier {
       x = (x | x << 8) & 0x100f00f00f00f00full, x = (x | x << 4) & 0x10c30c30c30c30c3ull;
       return (x | x << 2) & 0x1249249249249249ull;
     };
-    std::vector<std::pair<uint64_t, uint32_t>> code(m);
+    UninitializedVector<std::pair<uint64_t, uint32_t>> code(m);
     for_each(uint32_t(0), uint32_t(m), [&](uint32_t v) {
       const glm::vec3 q = glm::clamp(pos_[v], 0.0f, 1.0f) * 2097151.0f;  // pos_ is in [0, 1]^3
       code[v] = {spread(uint64_t(q.x)) | spread(uint64_t(q.y)) << 1 | spread(uint64_t(q.z)) << 2, v};
     });
     tbb::parallel_sort(code.begin(), code.end());  // ties (wedges share a position) by old number
-    std::vector<uint32_t> renumbered(m);
+    UninitializedVector<uint32_t> renumbered(m);
     for_each(uint32_t(0), uint32_t(m), [&](uint32_t i) { renumbered[code[i].second] = i; });
     auto permute = [&](auto& values) {
       if (values.size() != m) return;
-      auto old = values;
+      UninitializedVector<typename std::decay_t<decltype(values)>::value_type> old(m);
+      for_each(uint32_t(0), uint32_t(m), [&](uint32_t i) { old[i] = values[i]; });
       for_each(uint32_t(0), uint32_t(m), [&](uint32_t i) { values[i] = old[code[i].second]; });
     };
     permute(source_), permute(pos_), permute(nrm_), permute(uv_), permute(col_), permute(wedge_),
         permute(pid_);
-    auto rename = [&](std::vector<uint32_t>& vertices) {
+    auto rename = [&](auto& vertices) {
       for_each(size_t(0), vertices.size(), [&](size_t i) { vertices[i] = renumbered[vertices[i]]; });
     };
     rename(wedge_), rename(pid_), rename(weld_remap_);
@@ -553,8 +579,8 @@ class Simplifier {
   void build_quadrics() {
     const size_t m = source_.size();
     choose_channels();
-    quadric_.assign(m, Quadric{});
-    attr_.assign(m * size_t(channels_), AttributeTerm{});
+    quadric_.clear(), attr_.clear();
+    quadric_.resize(m), attr_.resize(m * size_t(channels_));  // zeroed per chunk below
     // Vertex ranges, one per chunk of faces (faces are sorted by their smallest vertex, sort_faces): a
     // chunk's faces add to their corners in its range; a face with a corner in a later range is also listed
     // for that range, which adds it before its own faces. Every vertex then sums its faces in face order, as
@@ -587,6 +613,9 @@ class Simplifier {
       std::vector<float> s(3 * size_t(channels_));
       std::vector<AttributeTerm> gradient(channels_);
       const uint32_t lo = first_vertex[k], hi = first_vertex[k + 1];
+      std::fill(quadric_.data() + lo, quadric_.data() + hi, Quadric{});
+      std::fill(attr_.data() + lo * size_t(channels_), attr_.data() + hi * size_t(channels_),
+                AttributeTerm{});
       for (uint32_t earlier = 0; earlier < k; ++earlier)
         for (uint32_t f : straddling[earlier]) add_face(f, lo, hi, s.data(), gradient.data());
       for (uint32_t f = first_face[k]; f < first_face[k + 1]; ++f)
@@ -787,7 +816,7 @@ class Simplifier {
   size_t run_pass(size_t target) {
     const size_t m = source_.size();
     const bool all = slots_.size() != indices_.size();
-    if (all) slots_.assign(indices_.size(), Candidate{std::numeric_limits<float>::infinity(), kNone, kNone});
+    if (all) slots_.clear(), slots_.resize(indices_.size());  // every slot is written below
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 1024), [&](const auto& r) {
       for (uint32_t i = r.begin(); i < r.end(); ++i) {
         for (uint32_t s = offsets_[i]; s < offsets_[i + 1]; ++s) {  // faces are all alive (compact_faces)
@@ -853,55 +882,25 @@ class Simplifier {
 
   // The collapse loop over order_ (cost order, up to `limit`, until the target): independent collapses,
   // none touching a vertex an earlier one in this pass touched. Large passes (not recording collapses) run
-  // it first on many small regions at once (both cores, each region's data cache-resident: candidates come in
-  // cost order, random in space), each region taking its own candidates in order up to its share of the
-  // triangles still to remove (in proportion to its candidates); collapses whose faces cross a region's
-  // border, and what a region left, follow serially in order. Each region's outcome depends only on its own
-  // faces, so the result is the same on every run. Returns the number of collapses.
+  // it first on many small regions at once (collapse_regions: both cores, each region's data cache-resident,
+  // since candidates come in cost order, random in space), then again over what they left on the regions
+  // shifted by half a region, where most collapses that crossed a first-round border lie inside one region
+  // (elephant_1m 10 %: 43,638 -> 25,890 collapses left to the serial part, of 640,282); what crosses a border
+  // in both rounds, and what the regions' quotas left, follows serially in cost order. Each region's outcome
+  // depends only on its own faces and the previous round's, so the result is the same on every run, with
+  // any number of threads. Returns the number of collapses.
   size_t collapse_in_order(float limit, size_t target) {
     size_t collapsed = 0;
     constexpr size_t kParallelMin = 1024;
     const bool parallel = !record_ && order_.size() >= kParallelMin && alive_triangles_ > target + 8;
     if (parallel) {
-      group_by_region();
-      const size_t n = order_.size(), removable = alive_triangles_ - target;
-      const uint32_t regions = uint32_t(region_start_.size() - 1);
-      tbb::enumerable_thread_specific<Scratch> scratch;
-      std::atomic<size_t> count{0};
-      tbb::parallel_for(tbb::blocked_range<uint32_t>(0, regions, 1), [&](const auto& range) {
-        Scratch& s = scratch.local();
-        size_t here = 0;
-        for (uint32_t r = range.begin(); r < range.end(); ++r) {
-          const uint32_t begin = region_start_[r], end = region_start_[r + 1];
-          const size_t quota = size_t(double(removable) * (end - begin) / double(n));
-          const size_t removed_before = s.removed_triangles;
-          s.region = r;
-          for (uint32_t k = begin; k < end; ++k) {
-            if (s.removed_triangles - removed_before + 2 > quota) break;
-            prefetch(k, end);
-            const uint32_t i = sorted_[k].slot;
-            pending_[i] = 0;
-            const Candidate& c = slots_[order_[i].slot];
-            Plan p;
-            if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
-            p.slot = order_[i].slot;
-            if (p.a2 != kNone && (touched_[p.a2] || touched_[p.b2])) continue;
-            switch (try_collapse(p, s)) {
-              case Outcome::kCollapsed:
-                ++here;
-                break;
-              case Outcome::kOutsideRegion:
-                pending_[i] = 1;
-                break;
-              case Outcome::kRejected:
-                break;
-            }
-          }
-        }
-        count += here;
-      });
-      collapsed = count;
-      for (Scratch& s : scratch) gather(s);
+      size_regions();
+      pending_.assign(order_.size(), 1);
+      for (uint32_t half : {0u, region_vertices_ / 2}) {
+        round_shift_ = (region_shift_ + half) % region_vertices_;
+        group_by_region();
+        collapsed += collapse_regions(target);
+      }
     }
     // The serial part: every candidate, or what the regions left pending, in cost order, listed in sorted_
     // (the regions are done with it) so that prefetch can look ahead along it (on large meshes: on a small
@@ -928,20 +927,72 @@ class Simplifier {
     return collapsed;
   }
 
-  uint32_t region_of(uint32_t v) const { return (v + region_shift_) / region_vertices_; }
+  // One round of the regions' collapse loops (collapse_in_order) over the candidates group_by_region listed:
+  // each region takes its own in cost order up to its share of the triangles still to remove (in proportion
+  // to its share of the pending candidates), on every core; a collapse whose faces leave the region stays
+  // pending. Returns the number of collapses.
+  size_t collapse_regions(size_t target) {
+    const size_t removable = alive_triangles_ > target ? alive_triangles_ - target : 0;
+    const double n = double(std::max<size_t>(pending_count_, 1));
+    const uint32_t regions = uint32_t(region_start_.size() - 1);
+    tbb::enumerable_thread_specific<Scratch> scratch;
+    std::atomic<size_t> count{0};
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, regions, 1), [&](const auto& range) {
+      Scratch& s = scratch.local();
+      size_t here = 0;
+      for (uint32_t r = range.begin(); r < range.end(); ++r) {
+        const uint32_t begin = region_start_[r], end = region_start_[r + 1];
+        const size_t quota = size_t(double(removable) * (end - begin) / n);
+        const size_t removed_before = s.removed_triangles;
+        s.region = r;
+        for (uint32_t k = begin; k < end; ++k) {
+          if (s.removed_triangles - removed_before + 2 > quota) break;
+          prefetch(k, end);
+          const uint32_t i = sorted_[k].slot;
+          pending_[i] = 0;
+          const Candidate& c = slots_[order_[i].slot];
+          Plan p;
+          if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
+          p.slot = order_[i].slot;
+          if (p.a2 != kNone && (touched_[p.a2] || touched_[p.b2])) continue;
+          switch (try_collapse(p, s)) {
+            case Outcome::kCollapsed:
+              ++here;
+              break;
+            case Outcome::kOutsideRegion:
+              pending_[i] = 1;
+              break;
+            case Outcome::kRejected:
+              break;
+          }
+        }
+      }
+      count += here;
+    });
+    for (Scratch& s : scratch) gather(s);
+    return count;
+  }
 
-  // Groups the pass's candidates by region into sorted_ as (cost, order_ index), in cost order within each
-  // region (a counting_sort on both cores; candidates whose ends lie in two regions are left out) and sets
-  // region_start_; pending_ = 1 (for the serial part) for every candidate until a region takes it. Turns
-  // region_shift_.
-  void group_by_region() {
+  uint32_t region_of(uint32_t v) const { return (v + round_shift_) / region_vertices_; }
+
+  // Sizes the pass's regions (region_vertices_) and turns region_shift_.
+  void size_regions() {
     const size_t shrink = welded_triangles_ / std::max<size_t>(alive_triangles_, 1);
     const size_t first = std::clamp<size_t>(source_.size() / kMinRegions, 1, kRegionVertices);
     region_vertices_ = uint32_t(first * std::clamp<size_t>(shrink, 1, 1024));
     region_shift_ = (region_shift_ + region_vertices_ / 3 + 1) % region_vertices_;
+  }
+
+  // Groups the pending candidates by region (round_shift_) into sorted_ as (cost, order_ index), in cost
+  // order within each region (a counting_sort on both cores; candidates whose ends lie in two regions are
+  // left out), sets region_start_ and counts the pending candidates (pending_count_).
+  void group_by_region() {
     const uint32_t regions = region_of(uint32_t(source_.size())) + 1;
     sorted_.resize(order_.size());
+    pending_count_ = 0;
+    for (uint8_t p : pending_) pending_count_ += p;
     auto region = [&](size_t i) {
+      if (!pending_[i]) return kAnyRegion;
       const Candidate& c = slots_[order_[i].slot];
       const uint32_t ra = region_of(c.a);
       return ra == region_of(c.b) ? ra : kAnyRegion;
@@ -952,7 +1003,6 @@ class Simplifier {
           sorted_[position] = {order_[i].cost, uint32_t(i)};
         },
         &region_start_);
-    pending_.assign(order_.size(), 1);
   }
 
   // Candidates come in cost order, random in their region, so each try starts with cache misses on a chain of
