@@ -206,17 +206,15 @@ class Simplifier {
   UninitializedVector<Candidate> slots_;
   std::vector<Ranked> order_, sorted_;
   std::vector<float> bucket_;  // goal_cost's candidate costs in one histogram bucket
-  // Regions of the collapse loop's parallel rounds (region_of): runs of region_vertices_ vertex numbers in
+  // Regions of the collapse loop's parallel part (region_of): runs of region_vertices_ vertex numbers in
   // Morton order (about kRegionVertices alive vertices, at least kMinRegions regions on a smaller mesh; the
-  // run grows as the mesh shrinks), shifted by round_shift_: region_shift_ in a pass's first round (it turns
-  // each pass so that no band of the mesh is always left to the serial part), half a region more in its
-  // second.
+  // run grows as the mesh shrinks), shifted by region_shift_, which turns each pass so that no band of the
+  // mesh is always left to the serial part.
   // region_start_: where each region's candidates begin in sorted_ (grouped by region after the cost sort, as
   // (cost, order_ index); then the serial part's list); pending_: per order_ entry, whether the serial part
-  // is to try it (pending_count_ of them when a round begins).
+  // is to try it.
   static constexpr uint32_t kRegionVertices = 16384, kMinRegions = 2;
-  uint32_t region_vertices_ = kRegionVertices, region_shift_ = 0, round_shift_ = 0;
-  size_t pending_count_ = 0;
+  uint32_t region_vertices_ = kRegionVertices, region_shift_ = 0;
   std::vector<uint32_t> region_start_;
   std::vector<uint8_t> pending_;
   Scratch serial_;
@@ -882,25 +880,55 @@ class Simplifier {
 
   // The collapse loop over order_ (cost order, up to `limit`, until the target): independent collapses,
   // none touching a vertex an earlier one in this pass touched. Large passes (not recording collapses) run
-  // it first on many small regions at once (collapse_regions: both cores, each region's data cache-resident,
-  // since candidates come in cost order, random in space), then again over what they left on the regions
-  // shifted by half a region, where most collapses that crossed a first-round border lie inside one region
-  // (elephant_1m 10 %: 43,638 -> 25,890 collapses left to the serial part, of 640,282); what crosses a border
-  // in both rounds, and what the regions' quotas left, follows serially in cost order. Each region's outcome
-  // depends only on its own faces and the previous round's, so the result is the same on every run, with
-  // any number of threads. Returns the number of collapses.
+  // it first on many small regions at once (both cores, each region's data cache-resident: candidates come in
+  // cost order, random in space), each region taking its own candidates in order up to its share of the
+  // triangles still to remove (in proportion to its candidates); collapses whose faces cross a region's
+  // border, and what a region left, follow serially in order. Each region's outcome depends only on its own
+  // faces, so the result is the same on every run. Returns the number of collapses.
   size_t collapse_in_order(float limit, size_t target) {
     size_t collapsed = 0;
     constexpr size_t kParallelMin = 1024;
     const bool parallel = !record_ && order_.size() >= kParallelMin && alive_triangles_ > target + 8;
     if (parallel) {
-      size_regions();
-      pending_.assign(order_.size(), 1);
-      for (uint32_t half : {0u, region_vertices_ / 2}) {
-        round_shift_ = (region_shift_ + half) % region_vertices_;
-        group_by_region();
-        collapsed += collapse_regions(target);
-      }
+      group_by_region();
+      const size_t n = order_.size(), removable = alive_triangles_ - target;
+      const uint32_t regions = uint32_t(region_start_.size() - 1);
+      tbb::enumerable_thread_specific<Scratch> scratch;
+      std::atomic<size_t> count{0};
+      tbb::parallel_for(tbb::blocked_range<uint32_t>(0, regions, 1), [&](const auto& range) {
+        Scratch& s = scratch.local();
+        size_t here = 0;
+        for (uint32_t r = range.begin(); r < range.end(); ++r) {
+          const uint32_t begin = region_start_[r], end = region_start_[r + 1];
+          const size_t quota = size_t(double(removable) * (end - begin) / double(n));
+          const size_t removed_before = s.removed_triangles;
+          s.region = r;
+          for (uint32_t k = begin; k < end; ++k) {
+            if (s.removed_triangles - removed_before + 2 > quota) break;
+            prefetch(k, end);
+            const uint32_t i = sorted_[k].slot;
+            pending_[i] = 0;
+            const Candidate& c = slots_[order_[i].slot];
+            Plan p;
+            if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
+            p.slot = order_[i].slot;
+            if (p.a2 != kNone && (touched_[p.a2] || touched_[p.b2])) continue;
+            switch (try_collapse(p, s)) {
+              case Outcome::kCollapsed:
+                ++here;
+                break;
+              case Outcome::kOutsideRegion:
+                pending_[i] = 1;
+                break;
+              case Outcome::kRejected:
+                break;
+            }
+          }
+        }
+        count += here;
+      });
+      collapsed = count;
+      for (Scratch& s : scratch) gather(s);
     }
     // The serial part: every candidate, or what the regions left pending, in cost order, listed in sorted_
     // (the regions are done with it) so that prefetch can look ahead along it (on large meshes: on a small
@@ -927,72 +955,20 @@ class Simplifier {
     return collapsed;
   }
 
-  // One round of the regions' collapse loops (collapse_in_order) over the candidates group_by_region listed:
-  // each region takes its own in cost order up to its share of the triangles still to remove (in proportion
-  // to its share of the pending candidates), on every core; a collapse whose faces leave the region stays
-  // pending. Returns the number of collapses.
-  size_t collapse_regions(size_t target) {
-    const size_t removable = alive_triangles_ > target ? alive_triangles_ - target : 0;
-    const double n = double(std::max<size_t>(pending_count_, 1));
-    const uint32_t regions = uint32_t(region_start_.size() - 1);
-    tbb::enumerable_thread_specific<Scratch> scratch;
-    std::atomic<size_t> count{0};
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, regions, 1), [&](const auto& range) {
-      Scratch& s = scratch.local();
-      size_t here = 0;
-      for (uint32_t r = range.begin(); r < range.end(); ++r) {
-        const uint32_t begin = region_start_[r], end = region_start_[r + 1];
-        const size_t quota = size_t(double(removable) * (end - begin) / n);
-        const size_t removed_before = s.removed_triangles;
-        s.region = r;
-        for (uint32_t k = begin; k < end; ++k) {
-          if (s.removed_triangles - removed_before + 2 > quota) break;
-          prefetch(k, end);
-          const uint32_t i = sorted_[k].slot;
-          pending_[i] = 0;
-          const Candidate& c = slots_[order_[i].slot];
-          Plan p;
-          if (touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
-          p.slot = order_[i].slot;
-          if (p.a2 != kNone && (touched_[p.a2] || touched_[p.b2])) continue;
-          switch (try_collapse(p, s)) {
-            case Outcome::kCollapsed:
-              ++here;
-              break;
-            case Outcome::kOutsideRegion:
-              pending_[i] = 1;
-              break;
-            case Outcome::kRejected:
-              break;
-          }
-        }
-      }
-      count += here;
-    });
-    for (Scratch& s : scratch) gather(s);
-    return count;
-  }
+  uint32_t region_of(uint32_t v) const { return (v + region_shift_) / region_vertices_; }
 
-  uint32_t region_of(uint32_t v) const { return (v + round_shift_) / region_vertices_; }
-
-  // Sizes the pass's regions (region_vertices_) and turns region_shift_.
-  void size_regions() {
+  // Groups the pass's candidates by region into sorted_ as (cost, order_ index), in cost order within each
+  // region (a counting_sort on both cores; candidates whose ends lie in two regions are left out) and sets
+  // region_start_; pending_ = 1 (for the serial part) for every candidate until a region takes it. Turns
+  // region_shift_.
+  void group_by_region() {
     const size_t shrink = welded_triangles_ / std::max<size_t>(alive_triangles_, 1);
     const size_t first = std::clamp<size_t>(source_.size() / kMinRegions, 1, kRegionVertices);
     region_vertices_ = uint32_t(first * std::clamp<size_t>(shrink, 1, 1024));
     region_shift_ = (region_shift_ + region_vertices_ / 3 + 1) % region_vertices_;
-  }
-
-  // Groups the pending candidates by region (round_shift_) into sorted_ as (cost, order_ index), in cost
-  // order within each region (a counting_sort on both cores; candidates whose ends lie in two regions are
-  // left out), sets region_start_ and counts the pending candidates (pending_count_).
-  void group_by_region() {
     const uint32_t regions = region_of(uint32_t(source_.size())) + 1;
     sorted_.resize(order_.size());
-    pending_count_ = 0;
-    for (uint8_t p : pending_) pending_count_ += p;
     auto region = [&](size_t i) {
-      if (!pending_[i]) return kAnyRegion;
       const Candidate& c = slots_[order_[i].slot];
       const uint32_t ra = region_of(c.a);
       return ra == region_of(c.b) ? ra : kAnyRegion;
@@ -1003,6 +979,7 @@ class Simplifier {
           sorted_[position] = {order_[i].cost, uint32_t(i)};
         },
         &region_start_);
+    pending_.assign(order_.size(), 1);
   }
 
   // Candidates come in cost order, random in their region, so each try starts with cache misses on a chain of

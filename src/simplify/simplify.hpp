@@ -15,9 +15,8 @@
 // the cost of the collapse that would reach the target, which keeps the order close to greedy. A collapse
 // that fails the validity checks is not tried again until an end is touched (or a pass finds nothing). The
 // collapse loop of a large pass runs on many small regions (runs of about 16384 alive vertices in Morton
-// order, at least 2 runs, shifted each pass) on both cores, then over what they left on the regions shifted
-// by half a region, and the collapses that cross a border in both rounds after them, serially; the result
-// does not depend on thread timing.
+// order, at least 2 runs, shifted each pass) on both cores, the collapses that cross a region's border after
+// them, serially; the result does not depend on thread timing.
 //
 // Vertices are classified once (meshoptimizer's vertex kinds, extended): Manifold (interior), Border (one
 // open edge in and out), Seam (two vertices share the position and their open edges pair up: a UV, normal
