@@ -18,6 +18,7 @@
 #include "simplify/counting_sort.hpp"
 #include "simplify/quadric.hpp"
 #include "simplify/simplify.hpp"
+#include "simplify/uninitialized.hpp"
 
 namespace lodstream::simplify {
 namespace {
@@ -174,15 +175,17 @@ class Simplifier {
 
   // Welded vertices (input vertex -> welded) and their working data (normalized positions).
   std::vector<uint32_t> weld_remap_, source_;  // source_: welded vertex -> first input vertex
-  std::vector<glm::vec3> pos_;
-  std::vector<glm::vec3> nrm_;
-  std::vector<glm::vec2> uv_;
-  std::vector<glm::vec4> col_;
-  std::vector<uint32_t> wedge_, pid_;  // wedge ring (same position) and its representative
+  // The UninitializedVector members are first written by parallel loops (weld, renumber_spatially,
+  // build_quadrics, run_pass), so that their pages are first touched on every core.
+  UninitializedVector<glm::vec3> pos_;
+  UninitializedVector<glm::vec3> nrm_;
+  UninitializedVector<glm::vec2> uv_;
+  UninitializedVector<glm::vec4> col_;
+  UninitializedVector<uint32_t> wedge_, pid_;  // wedge ring (same position) and its representative
   std::vector<uint8_t> kind_, touched_, moved_;
   std::vector<float> radius_;  // bound radius r_v (simplify.hpp), normalized units
-  std::vector<Quadric> quadric_;
-  std::vector<AttributeTerm> attr_;  // channels_ per vertex
+  UninitializedVector<Quadric> quadric_;
+  UninitializedVector<AttributeTerm> attr_;  // channels_ per vertex
   // Weighted attribute channels in the cost: one component of the normal, UV or colour, with its weight.
   struct Channel {
     int attribute;  // 0 normal, 1 uv, 2 colour
@@ -200,7 +203,7 @@ class Simplifier {
   std::vector<uint32_t> indices_;  // alive faces; dead ones have indices_[3f] == kNone during a pass
   size_t alive_triangles_ = 0, welded_triangles_ = 0;  // welded_: before the first collapse
   std::vector<uint32_t> offsets_, faces_;              // vertex -> faces (CSR), rebuilt each pass
-  std::vector<Candidate> slots_;
+  UninitializedVector<Candidate> slots_;
   std::vector<Ranked> order_, sorted_;
   std::vector<float> bucket_;  // goal_cost's candidate costs in one histogram bucket
   // Regions of the collapse loop's parallel part (region_of): runs of region_vertices_ vertex numbers in
@@ -240,7 +243,7 @@ class Simplifier {
       return (!hn || in_.normals[i] == in_.normals[j]) && (!hu || in_.uvs[i] == in_.uvs[j]) &&
              (!hc || in_.colors[i] == in_.colors[j]);
     };
-    std::vector<std::pair<uint32_t, uint32_t>> sorted(n);  // (position hash, input vertex)
+    UninitializedVector<std::pair<uint32_t, uint32_t>> sorted(n);  // (position hash, input vertex)
     for_each(size_t(0), n, [&](size_t v) { sorted[v] = {hash_bits(&in_.positions[v].x, 3), uint32_t(v)}; });
     tbb::parallel_sort(sorted.begin(), sorted.end());
     std::vector<uint32_t> run(n);  // where the run of sorted[i]'s hash begins
@@ -249,7 +252,7 @@ class Simplifier {
     // Per input vertex: the first input vertex at its position, and the first with its position and
     // attributes (its welded vertex's source). Positions compare with == (NaN never equal, as in a hash-table
     // weld).
-    std::vector<uint32_t> first_at(n), source(n);
+    UninitializedVector<uint32_t> first_at(n), source(n);
     for_each(size_t(0), n, [&](size_t i) {
       const uint32_t v = sorted[i].second;
       uint32_t at = v, same = v;
@@ -324,18 +327,38 @@ class Simplifier {
     sort_faces();
   }
 
-  // Orders the faces by their smallest vertex (a counting sort; vertices are in Morton order), so that the
-  // faces around a vertex lie in a few cache lines of indices_ and slots_: each collapse walks them in cost
-  // order, random in space, and in input order the first read of every face was a cache miss (about a third
-  // of try_collapse's samples on elephant_1m). O(T + V).
+  // Orders the faces by their smallest vertex, stably (vertices are in Morton order), so that the faces
+  // around a vertex lie in a few cache lines of indices_ and slots_: each collapse walks them in cost order,
+  // random in space, and in input order the first read of every face was a cache miss (about a third of
+  // try_collapse's samples on elephant_1m). Two stable counting sorts, on every core: by runs of `span`
+  // vertices (counting_sort), then each run's faces by their vertex. O(T + V).
   void sort_faces() {
-    std::vector<uint32_t> start(source_.size() + 1, 0);
-    auto key = [&](size_t f) { return std::min({indices_[f], indices_[f + 1], indices_[f + 2]}); };
-    for (size_t f = 0; f < indices_.size(); f += 3) ++start[key(f) + 1];
-    for (size_t v = 1; v < start.size(); ++v) start[v] += start[v - 1];
+    constexpr uint32_t kRuns = 4096;
+    const size_t faces = indices_.size() / 3;
+    const uint32_t span = uint32_t(source_.size() / kRuns + 1);
+    auto key = [&](size_t f) {
+      return std::min({indices_[3 * f], indices_[3 * f + 1], indices_[3 * f + 2]});
+    };
+    UninitializedVector<uint32_t> by_run(faces);
+    std::vector<uint32_t> run_start;
+    counting_sort(
+        faces, kRuns, [&](size_t f) { return key(f) / span; },
+        [&](size_t f, uint32_t position) { by_run[position] = uint32_t(f); }, &run_start);
     std::vector<uint32_t> sorted(indices_.size());
-    for (size_t f = 0; f < indices_.size(); f += 3)
-      std::copy_n(&indices_[f], 3, &sorted[3 * size_t(start[key(f)]++)]);
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, kRuns, 64), [&](const auto& runs) {
+      std::vector<uint32_t> start(span + 1);
+      for (uint32_t r = runs.begin(); r < runs.end(); ++r) {
+        const uint32_t first = r * span, begin = run_start[r], end = run_start[r + 1];
+        std::fill(start.begin(), start.end(), 0);
+        for (uint32_t i = begin; i < end; ++i) ++start[key(by_run[i]) - first + 1];
+        start[0] = begin;
+        for (uint32_t v = 1; v <= span; ++v) start[v] += start[v - 1];
+        for (uint32_t i = begin; i < end; ++i) {
+          const uint32_t f = by_run[i];
+          std::copy_n(&indices_[3 * size_t(f)], 3, &sorted[3 * size_t(start[key(f) - first]++)]);
+        }
+      }
+    });
     indices_.swap(sorted);
   }
 
@@ -353,22 +376,23 @@ class Simplifier {
       x = (x | x << 8) & 0x100f00f00f00f00full, x = (x | x << 4) & 0x10c30c30c30c30c3ull;
       return (x | x << 2) & 0x1249249249249249ull;
     };
-    std::vector<std::pair<uint64_t, uint32_t>> code(m);
+    UninitializedVector<std::pair<uint64_t, uint32_t>> code(m);
     for_each(uint32_t(0), uint32_t(m), [&](uint32_t v) {
       const glm::vec3 q = glm::clamp(pos_[v], 0.0f, 1.0f) * 2097151.0f;  // pos_ is in [0, 1]^3
       code[v] = {spread(uint64_t(q.x)) | spread(uint64_t(q.y)) << 1 | spread(uint64_t(q.z)) << 2, v};
     });
     tbb::parallel_sort(code.begin(), code.end());  // ties (wedges share a position) by old number
-    std::vector<uint32_t> renumbered(m);
+    UninitializedVector<uint32_t> renumbered(m);
     for_each(uint32_t(0), uint32_t(m), [&](uint32_t i) { renumbered[code[i].second] = i; });
     auto permute = [&](auto& values) {
       if (values.size() != m) return;
-      auto old = values;
+      UninitializedVector<typename std::decay_t<decltype(values)>::value_type> old(m);
+      for_each(uint32_t(0), uint32_t(m), [&](uint32_t i) { old[i] = values[i]; });
       for_each(uint32_t(0), uint32_t(m), [&](uint32_t i) { values[i] = old[code[i].second]; });
     };
     permute(source_), permute(pos_), permute(nrm_), permute(uv_), permute(col_), permute(wedge_),
         permute(pid_);
-    auto rename = [&](std::vector<uint32_t>& vertices) {
+    auto rename = [&](auto& vertices) {
       for_each(size_t(0), vertices.size(), [&](size_t i) { vertices[i] = renumbered[vertices[i]]; });
     };
     rename(wedge_), rename(pid_), rename(weld_remap_);
@@ -553,8 +577,8 @@ class Simplifier {
   void build_quadrics() {
     const size_t m = source_.size();
     choose_channels();
-    quadric_.assign(m, Quadric{});
-    attr_.assign(m * size_t(channels_), AttributeTerm{});
+    quadric_.clear(), attr_.clear();
+    quadric_.resize(m), attr_.resize(m * size_t(channels_));  // zeroed per chunk below
     // Vertex ranges, one per chunk of faces (faces are sorted by their smallest vertex, sort_faces): a
     // chunk's faces add to their corners in its range; a face with a corner in a later range is also listed
     // for that range, which adds it before its own faces. Every vertex then sums its faces in face order, as
@@ -587,6 +611,9 @@ class Simplifier {
       std::vector<float> s(3 * size_t(channels_));
       std::vector<AttributeTerm> gradient(channels_);
       const uint32_t lo = first_vertex[k], hi = first_vertex[k + 1];
+      std::fill(quadric_.data() + lo, quadric_.data() + hi, Quadric{});
+      std::fill(attr_.data() + lo * size_t(channels_), attr_.data() + hi * size_t(channels_),
+                AttributeTerm{});
       for (uint32_t earlier = 0; earlier < k; ++earlier)
         for (uint32_t f : straddling[earlier]) add_face(f, lo, hi, s.data(), gradient.data());
       for (uint32_t f = first_face[k]; f < first_face[k + 1]; ++f)
@@ -787,7 +814,7 @@ class Simplifier {
   size_t run_pass(size_t target) {
     const size_t m = source_.size();
     const bool all = slots_.size() != indices_.size();
-    if (all) slots_.assign(indices_.size(), Candidate{std::numeric_limits<float>::infinity(), kNone, kNone});
+    if (all) slots_.clear(), slots_.resize(indices_.size());  // every slot is written below
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 1024), [&](const auto& r) {
       for (uint32_t i = r.begin(); i < r.end(); ++i) {
         for (uint32_t s = offsets_[i]; s < offsets_[i + 1]; ++s) {  // faces are all alive (compact_faces)
