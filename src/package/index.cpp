@@ -1,6 +1,7 @@
 #include "package/index.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 
@@ -18,16 +19,6 @@ namespace {
 // those of the previous record's bytes (bit 5).
 constexpr size_t kMinNodeRecordBytes = 9;
 
-void write_sphere(ByteWriter& w, const Sphere& s) {
-  w.f32(s.center.x), w.f32(s.center.y), w.f32(s.center.z), w.f32(s.radius);
-}
-Sphere read_sphere(ByteReader& r) {
-  Sphere s;
-  for (int a = 0; a < 3; ++a) s.center[a] = r.finite_f32("sphere centre");
-  s.radius = r.finite_f32("sphere radius");
-  if (s.radius < 0.0f) r.fail("negative sphere radius");
-  return s;
-}
 // An error bound: non-negative, +infinity allowed (nothing replaces the node), NaN rejected.
 float read_error(ByteReader& r) {
   float e = r.f32();
@@ -93,12 +84,73 @@ ErrorPair parent_pair(const NodeRecord& n) {
   return {n.parent_error, n.parent_sphere};
 }
 
-// What a run of node records (the root index's, or one index page's) is coded against: its records so far
-// and the distinct pairs they stored, in order of first appearance. Cost: O(distinct pairs) per pair coded.
+// The fields of a run of records, each coded into a stream of its own (index.hpp): zstd then sees each
+// field's repetitions and statistics apart from the others'.
+enum Field : size_t {
+  kHead,          // head byte
+  kDeltas,        // representation, material, level
+  kLocation,      // page, offset
+  kSize,          // size, cluster
+  kTriangles,     // triangle count
+  kVertices,      // vertex count
+  kChildren,      // children list
+  kParents,       // parents list
+  kObjects,       // objects list
+  kPairCode,      // pair codes
+  kPairError,     // pair errors
+  kPairExponent,  // compact pairs' exponents
+  kPairCentre,    // sphere centres
+  kPairRadius,    // sphere radii
+  kFields
+};
+constexpr const char* kFieldNames[kFields] = {
+    "record heads",  "record deltas",  "record locations", "record sizes", "triangle counts",
+    "vertex counts", "children",       "parents",          "objects",      "pair codes",
+    "pair errors",   "pair exponents", "sphere centres",   "sphere radii"};
+using FieldWriters = std::array<ByteWriter, kFields>;
+
+// A run's field streams as read: one reader per field over its bytes.
+struct FieldReaders {
+  std::vector<std::string> contexts;
+  std::vector<ByteReader> f;
+  ByteReader& operator[](Field field) { return f[field]; }
+};
+
+// A compact pair (index.hpp): the error's top 24 bits (its low 8 bits zero), then the sphere as integers
+// times 2^E: svarint E minus the previous compact pair's E, the centre's three integers as svarint deltas
+// from floor(previous compact centre / 2^E), varint radius integer. Limits keep every integer exact in a
+// double.
+constexpr int kMinPairExponent = -160, kMaxPairExponent = 128;
+constexpr int64_t kMaxPairInteger = int64_t(1) << 40;
+
+// floor(v / 2^exponent), clamped to +-2^62: the reference of a compact centre (exact in double: |v| < 2^128
+// and |exponent| <= 160).
+int64_t grid_reference(float v, int exponent) {
+  const double k = std::floor(std::ldexp(double(v), -exponent));
+  return int64_t(std::clamp(k, -0x1p62, 0x1p62));
+}
+// The largest E with every value an integer multiple of 2^E (0 when all are zero).
+int common_exponent(std::span<const float> values) {
+  int e = std::numeric_limits<int>::max();
+  for (float v : values) {
+    if (v == 0.0f) continue;
+    int ex = 0;
+    const double m = std::frexp(double(v), &ex);  // v = m 2^ex, 0.5 <= |m| < 1, m has at most 24 bits
+    const uint64_t bits = uint64_t(std::abs(std::ldexp(m, 53)));
+    e = std::min(e, ex - 53 + std::countr_zero(bits));
+  }
+  return e == std::numeric_limits<int>::max() ? 0 : e;
+}
+
+// What a run of node records (the root index's, or one index page's) is coded against: its records so far,
+// the distinct pairs they stored, in order of first appearance, and the last compact pair's exponent and
+// centre. Cost: O(distinct pairs) per pair coded.
 struct RecordRun {
   uint32_t first_id = 0;
   std::span<const NodeRecord> done;  // records first_id .. first_id + done.size() - 1
   std::vector<ErrorPair> pairs;
+  int exponent = 0;
+  glm::vec3 center{0.0f};
 
   const NodeRecord& previous() const {
     static const NodeRecord none;  // every field 0
@@ -110,27 +162,93 @@ struct RecordRun {
       return nullptr;
     return &done[n.parents[0] - first_id];
   }
-  // Pair code: 0 = a literal (error f32, sphere 4 f32) that joins the table, k >= 1 = the k-th latest pair of
-  // the table; `skip` codes below it are taken by the caller.
-  void write_pair(ByteWriter& w, const ErrorPair& p, uint64_t skip) {
+  // Writes `p` compactly and returns true when it decodes back bit for bit.
+  bool write_compact(FieldWriters& w, const ErrorPair& p) {
+    const uint32_t error_bits = std::bit_cast<uint32_t>(p.error);
+    if ((error_bits & 0xFFu) != 0 || !std::isfinite(p.sphere.radius) || !std::isfinite(p.sphere.center.x) ||
+        !std::isfinite(p.sphere.center.y) || !std::isfinite(p.sphere.center.z))
+      return false;
+    const std::array<float, 4> values = {p.sphere.center.x, p.sphere.center.y, p.sphere.center.z,
+                                         p.sphere.radius};
+    const int e = common_exponent(values);
+    if (e < kMinPairExponent || e > kMaxPairExponent) return false;
+    std::array<int64_t, 4> k;
+    for (int a = 0; a < 4; ++a) {
+      const double v = std::ldexp(double(values[a]), -e);
+      if (!(std::abs(v) <= double(kMaxPairInteger)) || (a == 3 && v < 0.0)) return false;
+      k[a] = int64_t(v);
+      if (std::bit_cast<uint32_t>(float(std::ldexp(double(k[a]), e))) != std::bit_cast<uint32_t>(values[a]))
+        return false;  // -0, or a negative radius
+    }
+    ByteWriter& error = w[kPairError];
+    error.u8(uint8_t(error_bits >> 8)), error.u8(uint8_t(error_bits >> 16)),
+        error.u8(uint8_t(error_bits >> 24));
+    w[kPairExponent].svarint(e - exponent);
+    for (int a = 0; a < 3; ++a) w[kPairCentre].svarint(k[a] - grid_reference(center[a], e));
+    w[kPairRadius].varint(uint64_t(k[3]));
+    exponent = e, center = p.sphere.center;
+    return true;
+  }
+  ErrorPair read_compact(FieldReaders& r) {
+    ErrorPair p;
+    ByteReader& error = r[kPairError];
+    uint32_t error_bits = uint32_t(error.u8()) << 8;
+    error_bits |= uint32_t(error.u8()) << 16;
+    error_bits |= uint32_t(error.u8()) << 24;
+    p.error = std::bit_cast<float>(error_bits);
+    if (std::isnan(p.error) || p.error < 0.0f) error.fail("invalid error bound");
+    const int64_t de = r[kPairExponent].svarint();
+    if (de < kMinPairExponent - exponent || de > kMaxPairExponent - exponent)
+      r[kPairExponent].fail("sphere exponent out of range");
+    const int e = exponent + int(de);
+    for (int a = 0; a < 3; ++a) {
+      const int64_t delta = r[kPairCentre].svarint(), base = grid_reference(center[a], e);
+      if (delta < -kMaxPairInteger - base || delta > kMaxPairInteger - base)
+        r[kPairCentre].fail("sphere centre out of range");
+      p.sphere.center[a] = float(std::ldexp(double(base + delta), e));
+    }
+    const uint64_t radius = r[kPairRadius].varint();
+    if (radius > uint64_t(kMaxPairInteger)) r[kPairRadius].fail("sphere radius out of range");
+    p.sphere.radius = float(std::ldexp(double(radius), e));
+    if (!std::isfinite(p.sphere.radius) || !std::isfinite(p.sphere.center.x) ||
+        !std::isfinite(p.sphere.center.y) || !std::isfinite(p.sphere.center.z))
+      r[kPairCentre].fail("sphere out of the float range");
+    exponent = e, center = p.sphere.center;
+    return p;
+  }
+  // Pair code: `skip` = a literal (error f32, sphere 4 f32), skip + 1 = a compact pair, both joining the
+  // table; skip + 1 + k (k >= 1) = the k-th latest pair of the table; codes below `skip` are taken by the
+  // caller.
+  void write_pair(FieldWriters& w, const ErrorPair& p, uint64_t skip) {
     const auto it = std::find(pairs.rbegin(), pairs.rend(), p);
     if (it != pairs.rend()) {
-      w.varint(skip + 1 + uint64_t(it - pairs.rbegin()));
+      w[kPairCode].varint(skip + 2 + uint64_t(it - pairs.rbegin()));
       return;
     }
-    w.varint(skip);
-    w.f32(p.error);
-    write_sphere(w, p.sphere);
+    if (write_compact(w, p)) {  // writes nothing when it returns false
+      w[kPairCode].varint(skip + 1);
+    } else {
+      w[kPairCode].varint(skip);
+      w[kPairError].f32(p.error);
+      for (int a = 0; a < 3; ++a) w[kPairCentre].f32(p.sphere.center[a]);
+      w[kPairRadius].f32(p.sphere.radius);
+    }
     pairs.push_back(p);
   }
-  ErrorPair read_pair(ByteReader& r, uint64_t code) {
-    if (code > 0) {
-      if (code > pairs.size()) r.fail("error pair reference out of range");
-      return pairs[pairs.size() - code];
+  ErrorPair read_pair(FieldReaders& r, uint64_t code) {
+    if (code > 1) {
+      if (code - 1 > pairs.size()) r[kPairCode].fail("error pair reference out of range");
+      return pairs[pairs.size() - (code - 1)];
     }
     ErrorPair p;
-    p.error = read_error(r);
-    p.sphere = read_sphere(r);
+    if (code == 1) {
+      p = read_compact(r);
+    } else {
+      p.error = read_error(r[kPairError]);
+      for (int a = 0; a < 3; ++a) p.sphere.center[a] = r[kPairCentre].finite_f32("sphere centre");
+      p.sphere.radius = r[kPairRadius].finite_f32("sphere radius");
+      if (p.sphere.radius < 0.0f) r[kPairRadius].fail("negative sphere radius");
+    }
     pairs.push_back(p);
     return p;
   }
@@ -138,79 +256,82 @@ struct RecordRun {
 
 enum : uint8_t { kSameChildren = 8, kSameParents = 16, kSameRecord = 32 };
 
-void write_node(ByteWriter& w, const NodeRecord& n, uint32_t id, RecordRun& run) {
+void write_node(FieldWriters& w, const NodeRecord& n, uint32_t id, RecordRun& run) {
   const NodeRecord& prev = run.previous();
   const bool same_children = !run.done.empty() && n.children == prev.children;
   const bool same_parents = !run.done.empty() && n.parents == prev.parents;
   const bool same_record = !run.done.empty() && n.page == prev.page && n.offset == prev.offset &&
                            n.size == prev.size && n.cluster == prev.cluster + 1;
-  w.u8(static_cast<uint8_t>(uint8_t(n.kind) | uint8_t(n.encoding) << 2 | (same_children ? kSameChildren : 0) |
-                            (same_parents ? kSameParents : 0) | (same_record ? kSameRecord : 0)));
-  w.svarint(int64_t(n.representation) - prev.representation);
-  w.svarint(int64_t(n.material) - prev.material);
-  w.svarint(int64_t(n.level) - prev.level);
+  w[kHead].u8(static_cast<uint8_t>(uint8_t(n.kind) | uint8_t(n.encoding) << 2 |
+                                   (same_children ? kSameChildren : 0) | (same_parents ? kSameParents : 0) |
+                                   (same_record ? kSameRecord : 0)));
+  w[kDeltas].svarint(int64_t(n.representation) - prev.representation);
+  w[kDeltas].svarint(int64_t(n.material) - prev.material);
+  w[kDeltas].svarint(int64_t(n.level) - prev.level);
   if (!same_record) {
-    w.svarint(int64_t(n.page) - prev.page);
-    w.svarint(int64_t(n.offset) - (n.page == prev.page ? int64_t(prev.offset) + prev.size : 0));
-    w.varint(n.size);
-    w.varint(n.cluster);
+    w[kLocation].svarint(int64_t(n.page) - prev.page);
+    w[kLocation].svarint(int64_t(n.offset) - (n.page == prev.page ? int64_t(prev.offset) + prev.size : 0));
+    w[kSize].varint(n.size);
+    w[kSize].varint(n.cluster);
   }
-  w.varint(n.triangles), w.varint(n.vertices);
-  if (!same_children) write_ids(w, n.children, id);
-  if (!same_parents) write_ids(w, n.parents, id);
-  write_ids(w, n.objects, 0);
+  w[kTriangles].varint(n.triangles), w[kVertices].varint(n.vertices);
+  if (!same_children) write_ids(w[kChildren], n.children, id);
+  if (!same_parents) write_ids(w[kParents], n.parents, id);
+  write_ids(w[kObjects], n.objects, 0);
   run.write_pair(w, own_pair(n), 0);
   const NodeRecord* parent = run.first_parent(n);
   if (parent && own_pair(*parent) == parent_pair(n)) {
-    w.varint(0);
+    w[kPairCode].varint(0);
   } else {
     run.write_pair(w, parent_pair(n), 1);
   }
 }
 
-NodeRecord read_node(ByteReader& r, const RootIndex& root, uint32_t id, RecordRun& run) {
+NodeRecord read_node(FieldReaders& r, const RootIndex& root, uint32_t id, RecordRun& run) {
   const NodeRecord& prev = run.previous();
   NodeRecord n;
-  const uint8_t head = r.u8();
+  const uint8_t head = r[kHead].u8();
   if (head & ~uint8_t(3 | 4 | kSameChildren | kSameParents | kSameRecord))
-    r.fail("node " + std::to_string(id) + ": unknown record flags");
+    r[kHead].fail("node " + std::to_string(id) + ": unknown record flags");
   n.kind = NodeKind(head & 3), n.encoding = NodeEncoding((head >> 2) & 1);
   if ((head & (kSameChildren | kSameParents | kSameRecord)) && run.done.empty())
-    r.fail("node " + std::to_string(id) + ": refers to a previous record that this run does not have");
-  n.representation = read_delta(r, prev.representation, root.scene.representations.size(), "representation");
-  n.material = read_delta(r, prev.material, root.scene.materials.size(), "material");
-  n.level = read_delta(r, prev.level, 1u << 16, "level");
+    r[kHead].fail("node " + std::to_string(id) + ": refers to a previous record that this run does not have");
+  n.representation =
+      read_delta(r[kDeltas], prev.representation, root.scene.representations.size(), "representation");
+  n.material = read_delta(r[kDeltas], prev.material, root.scene.materials.size(), "material");
+  n.level = read_delta(r[kDeltas], prev.level, 1u << 16, "level");
   if (head & kSameRecord) {
     n.page = prev.page, n.offset = prev.offset, n.size = prev.size, n.cluster = prev.cluster + 1;
   } else {
-    n.page = read_delta(r, prev.page, root.pages.size(), "page");
+    n.page = read_delta(r[kLocation], prev.page, root.pages.size(), "page");
     const int64_t base = n.page == prev.page ? int64_t(prev.offset) + prev.size : 0;
-    const int64_t delta = r.svarint();  // checked before adding so that nothing overflows
+    const int64_t delta = r[kLocation].svarint();  // checked before adding so that nothing overflows
     const int64_t offset = delta < -base || delta > int64_t(UINT32_MAX) ? -1 : base + delta;
-    const uint64_t size = r.varint();
+    const uint64_t size = r[kSize].varint();
     if (offset < 0 || uint64_t(offset) > root.pages[n.page].raw_size ||
         size > root.pages[n.page].raw_size - uint64_t(offset)) {
-      r.fail("node " + std::to_string(id) + ": bytes [" + std::to_string(offset) + ", +" +
-             std::to_string(size) + ") outside page " + std::to_string(n.page));
+      r[kSize].fail("node " + std::to_string(id) + ": bytes [" + std::to_string(offset) + ", +" +
+                    std::to_string(size) + ") outside page " + std::to_string(n.page));
     }
     n.offset = uint32_t(offset), n.size = uint32_t(size);
-    const uint64_t cluster = r.varint();
+    const uint64_t cluster = r[kSize].varint();
     n.cluster = uint32_t(std::min<uint64_t>(cluster, kMaxRecordClusters));
   }
   if (n.cluster >= kMaxRecordClusters)
-    r.fail("node " + std::to_string(id) + ": cluster index of its record out of range");
-  n.triangles = r.index(uint64_t(UINT32_MAX) + 1, "triangle count");
-  n.vertices = r.index(uint64_t(UINT32_MAX) + 1, "vertex count");
-  n.children = head & kSameChildren ? prev.children : read_ids(r, id, root.node_count, "child");
-  n.parents = head & kSameParents ? prev.parents : read_ids(r, id, root.node_count, "parent");
-  n.objects = read_ids(r, 0, root.scene.objects.size(), "object");
-  const ErrorPair own = run.read_pair(r, r.varint());
+    r[kSize].fail("node " + std::to_string(id) + ": cluster index of its record out of range");
+  n.triangles = r[kTriangles].index(uint64_t(UINT32_MAX) + 1, "triangle count");
+  n.vertices = r[kVertices].index(uint64_t(UINT32_MAX) + 1, "vertex count");
+  n.children = head & kSameChildren ? prev.children : read_ids(r[kChildren], id, root.node_count, "child");
+  n.parents = head & kSameParents ? prev.parents : read_ids(r[kParents], id, root.node_count, "parent");
+  n.objects = read_ids(r[kObjects], 0, root.scene.objects.size(), "object");
+  const ErrorPair own = run.read_pair(r, r[kPairCode].varint());
   n.error = own.error, n.sphere = own.sphere;
-  const uint64_t code = r.varint();
+  const uint64_t code = r[kPairCode].varint();
   ErrorPair parents;
   if (code == 0) {
     const NodeRecord* parent = run.first_parent(n);
-    if (!parent) r.fail("node " + std::to_string(id) + ": parents' pair refers to a record outside this run");
+    if (!parent)
+      r[kPairCode].fail("node " + std::to_string(id) + ": parents' pair refers to a record outside this run");
     parents = own_pair(*parent);
   } else {
     parents = run.read_pair(r, code - 1);
@@ -219,23 +340,37 @@ NodeRecord read_node(ByteReader& r, const RootIndex& root, uint32_t id, RecordRu
   return n;
 }
 
-// The records of ids first_id.., coded as one run.
+// The records of ids first_id.., coded as one run: for each field, varint byte count then its stream.
 void write_nodes(ByteWriter& w, std::span<const NodeRecord> nodes, uint32_t first_id) {
+  FieldWriters fields;
   RecordRun run;
   run.first_id = first_id;
   for (size_t i = 0; i < nodes.size(); ++i) {
     run.done = nodes.first(i);
-    write_node(w, nodes[i], first_id + uint32_t(i), run);
+    write_node(fields, nodes[i], first_id + uint32_t(i), run);
   }
+  for (const ByteWriter& f : fields) w.varint(f.bytes.size());
+  for (const ByteWriter& f : fields) w.raw(f.bytes);
 }
-std::vector<NodeRecord> read_nodes(ByteReader& r, const RootIndex& root, uint32_t first_id, size_t count) {
+std::vector<NodeRecord> read_nodes(ByteReader& r, const RootIndex& root, uint32_t first_id, size_t count,
+                                   std::string_view context) {
+  FieldReaders fields;
+  std::array<uint64_t, kFields> sizes;
+  for (uint64_t& size : sizes) size = r.varint();
+  fields.contexts.reserve(kFields);  // the readers keep views of these
+  for (size_t f = 0; f < kFields; ++f) {
+    if (sizes[f] > r.remaining()) r.fail(std::string(kFieldNames[f]) + " stream longer than the run");
+    fields.contexts.push_back(std::string(context) + ": " + kFieldNames[f]);
+    fields.f.emplace_back(r.bytes(size_t(sizes[f]), kFieldNames[f]), fields.contexts.back());
+  }
   std::vector<NodeRecord> nodes;  // grown as records parse (no reserve: a hostile count allocates nothing)
   RecordRun run;
   run.first_id = first_id;
   for (uint32_t i = 0; i < count; ++i) {
     run.done = nodes;
-    nodes.push_back(read_node(r, root, first_id + i, run));
+    nodes.push_back(read_node(fields, root, first_id + i, run));
   }
+  for (ByteReader& f : fields.f) f.expect_end();
   return nodes;
 }
 
@@ -354,7 +489,7 @@ RootIndex parse_root(std::span<const uint8_t> raw, const std::string& context) {
     throw Error(context + ": index pages cover " + std::to_string(next) + " nodes, the index declares " +
                 std::to_string(root.node_count));
   }
-  root.root_nodes = read_nodes(r, root, 0, root_nodes);
+  root.root_nodes = read_nodes(r, root, 0, root_nodes, context);
   r.expect_end();
   return root;
 }
@@ -369,7 +504,7 @@ std::vector<NodeRecord> parse_nodes(std::span<const uint8_t> raw, const RootInde
                                     uint32_t count, const std::string& context) {
   ByteReader r(raw, context);
   if (count > raw.size() / kMinNodeRecordBytes) r.fail("more node records than the page can hold");
-  std::vector<NodeRecord> nodes = read_nodes(r, root, first_id, count);
+  std::vector<NodeRecord> nodes = read_nodes(r, root, first_id, count, context);
   r.expect_end();
   return nodes;
 }

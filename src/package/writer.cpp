@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "package/meshopt_codec.hpp"
 #include "package/page_parts.hpp"
+#include "package/pair_rounding.hpp"
 #include "package/quantized_node.hpp"
 
 namespace lodstream::package {
@@ -148,6 +149,7 @@ WrittenPackage PackageWriter::finish(PackageScene scene, std::vector<NodeRecord>
     nodes[id].size = locations_[id].size;
     nodes[id].cluster = locations_[id].cluster;
   }
+  round_pairs(nodes);  // every invariant kept (pair_rounding.hpp); the index stores rounded pairs compactly
 
   RootIndex root;
   root.codec = node_codec(options_.codec).id();

@@ -74,8 +74,10 @@ class PackageWriter {
   uint32_t add_blob(std::span<const uint8_t> bytes);
 
   // `nodes[i]` is node i; each must have been added (its page, offset and size are filled in here). Node ids
-  // [0, root_nodes) go into the root index: number the coarse nodes a first frame needs first. The index is
-  // validated by the reader's own parser before the file is renamed into place. Throws lodstream::Error.
+  // [0, root_nodes) go into the root index: number the coarse nodes a first frame needs first. Their
+  // (error, sphere) pairs are stored rounded up (round_pairs, pair_rounding.hpp): a reader gets errors and
+  // spheres at least as large, with every invariant of inspect --verify kept. The index is validated by the
+  // reader's own parser before the file is renamed into place. Throws lodstream::Error.
   WrittenPackage finish(PackageScene scene, std::vector<NodeRecord> nodes, uint32_t root_nodes);
 
  private:

@@ -1,13 +1,16 @@
 // Node records of the index (index.hpp, "Node records"): a run round-trips exactly, shared (error, sphere)
-// pairs are stored once per run, and hostile references (to pairs or records the run does not have) are
-// one-line errors.
+// pairs are stored once per run, compact pairs are smaller and come back bit for bit, and hostile references
+// (to pairs or records the run does not have) and compact values are one-line errors.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <bit>
 #include <cmath>
 
 #include "core/error.hpp"
 #include "package/bytes.hpp"
 #include "package/index.hpp"
+#include "package/pair_rounding.hpp"
 #include "package/quantized_node.hpp"
 
 namespace lodstream::test {
@@ -140,44 +143,69 @@ TEST(IndexRecords, TheClustersOfARecordShareItsBytesAndStoreThemOnce) {
   expect_same(parse_nodes(raw, tables(), 0, 12, "run"), in);
 }
 
-// The hand-written run: one record with the given head, list and pair codes (and cluster, unless head bit 5
-// says it is the previous record's next cluster).
-std::vector<uint8_t> one_record(uint8_t head, uint64_t own_code, uint64_t parent_code, bool with_parent,
-                                uint64_t cluster = 0) {
+// A hand-written run's field streams, in the order of index.hpp ("Node records").
+enum Field : size_t {
+  kHead,
+  kDeltas,
+  kLocation,
+  kSize,
+  kTriangles,
+  kVertices,
+  kChildren,
+  kParents,
+  kObjects,
+  kPairCode,
+  kPairError,
+  kPairExponent,
+  kPairCentre,
+  kPairRadius,
+  kFields
+};
+using Fields = std::array<ByteWriter, kFields>;
+std::vector<uint8_t> run_bytes(const Fields& fields) {
   ByteWriter w;
-  w.u8(head);
-  for (int field = 0; field < 3; ++field) w.svarint(0);  // representation, material, level
-  if (!(head & 32)) w.svarint(0), w.svarint(0), w.varint(10), w.varint(cluster);  // page, offset, size
-  w.varint(1), w.varint(3);                                                       // triangles, vertices
-  if (!(head & 8)) w.varint(0);                                                   // no children
-  if (!(head & 16)) {
-    w.varint(with_parent ? 1 : 0);
-    if (with_parent) w.svarint(-1);  // parent id 4: the record before the run
-  }
-  w.varint(0);  // no objects
-  w.varint(own_code);
-  if (own_code == 0) w.f32(1.0f), w.f32(0.0f), w.f32(0.0f), w.f32(0.0f), w.f32(1.0f);
-  w.varint(parent_code);
-  if (parent_code == 1) w.f32(INFINITY), w.f32(0.0f), w.f32(0.0f), w.f32(0.0f), w.f32(0.0f);
+  for (const ByteWriter& f : fields) w.varint(f.bytes.size());
+  for (const ByteWriter& f : fields) w.raw(f.bytes);
   return std::move(w.bytes);
 }
+// A literal pair (f32 error, centre, radius).
+void literal(Fields& f, float error, float radius) {
+  f[kPairError].f32(error);
+  for (int a = 0; a < 3; ++a) f[kPairCentre].f32(0.0f);
+  f[kPairRadius].f32(radius);
+}
+// One record's fields but the pairs: the given head, no links, and cluster (unless head bit 5 says it is the
+// previous record's next cluster).
+Fields record_fields(uint8_t head, bool with_parent, uint64_t cluster = 0) {
+  Fields f;
+  f[kHead].u8(head);
+  for (int field = 0; field < 3; ++field) f[kDeltas].svarint(0);  // representation, material, level
+  if (!(head & 32))
+    f[kLocation].svarint(0), f[kLocation].svarint(0), f[kSize].varint(10), f[kSize].varint(cluster);
+  f[kTriangles].varint(1), f[kVertices].varint(3);
+  if (!(head & 8)) f[kChildren].varint(0);  // no children
+  if (!(head & 16)) {
+    f[kParents].varint(with_parent ? 1 : 0);
+    if (with_parent) f[kParents].svarint(-1);  // parent id 4: the record before the run
+  }
+  f[kObjects].varint(0);  // no objects
+  return f;
+}
 
-TEST(IndexRecords, HostileReferencesAreErrors) {
-  const RootIndex root = tables();
-  // The hand-written record itself parses.
-  EXPECT_NO_THROW(parse_nodes(one_record(0, 0, 1, false), root, 5, 1, "run"));
-  const std::vector<std::pair<const char*, std::vector<uint8_t>>> cases = {
-      {"own pair refers past the table", one_record(0, 1, 1, false)},
-      {"parents' pair refers past the table", one_record(0, 0, 3, false)},
-      {"parents' pair from a parent before the run", one_record(0, 0, 0, true)},
-      {"parents' pair from a node without parents", one_record(0, 0, 0, false)},
-      {"same children as a record the run does not have", one_record(8, 0, 1, false)},
-      {"same parents as a record the run does not have", one_record(16, 0, 1, false)},
-      {"the next cluster of a record the run does not have", one_record(32, 0, 1, false)},
-      {"cluster index past the most a record holds", one_record(0, 0, 1, false, kMaxRecordClusters)},
-      {"huge cluster index", one_record(0, 0, 1, false, uint64_t(1) << 40)},
-      {"unknown record flag", one_record(64, 0, 1, false)},
-  };
+// The hand-written run: one record with the given head, list and pair codes.
+std::vector<uint8_t> one_record(uint8_t head, uint64_t own_code, uint64_t parent_code, bool with_parent,
+                                uint64_t cluster = 0) {
+  Fields f = record_fields(head, with_parent, cluster);
+  f[kPairCode].varint(own_code);
+  if (own_code == 0) literal(f, 1.0f, 1.0f);
+  f[kPairCode].varint(parent_code);
+  if (parent_code == 1) literal(f, INFINITY, 0.0f);
+  return run_bytes(f);
+}
+
+// Each hand-written run (one record, id 5) fails to parse with a one-line error naming the file.
+void expect_one_line_errors(const std::vector<std::pair<const char*, std::vector<uint8_t>>>& cases,
+                            const RootIndex& root) {
   for (const auto& [name, raw] : cases) {
     try {
       parse_nodes(raw, root, 5, 1, "hostile.lods: index page");
@@ -188,6 +216,130 @@ TEST(IndexRecords, HostileReferencesAreErrors) {
       EXPECT_EQ(what.find('\n'), std::string::npos) << name;
     }
   }
+}
+
+TEST(IndexRecords, HostileReferencesAreErrors) {
+  const RootIndex root = tables();
+  // The hand-written record itself parses.
+  EXPECT_NO_THROW(parse_nodes(one_record(0, 0, 1, false), root, 5, 1, "run"));
+  const std::vector<std::pair<const char*, std::vector<uint8_t>>> cases = {
+      {"own pair refers past the table", one_record(0, 2, 1, false)},
+      {"parents' pair refers past the table", one_record(0, 0, 4, false)},
+      {"parents' pair from a parent before the run", one_record(0, 0, 0, true)},
+      {"parents' pair from a node without parents", one_record(0, 0, 0, false)},
+      {"same children as a record the run does not have", one_record(8, 0, 1, false)},
+      {"same parents as a record the run does not have", one_record(16, 0, 1, false)},
+      {"the next cluster of a record the run does not have", one_record(32, 0, 1, false)},
+      {"cluster index past the most a record holds", one_record(0, 0, 1, false, kMaxRecordClusters)},
+      {"huge cluster index", one_record(0, 0, 1, false, uint64_t(1) << 40)},
+      {"unknown record flag", one_record(64, 0, 1, false)},
+  };
+  expect_one_line_errors(cases, root);
+}
+
+// Records 0..n-1 whose pairs are all distinct, with centres and radii of full float precision.
+std::vector<NodeRecord> distinct_pairs(uint32_t n) {
+  std::vector<NodeRecord> out = records(0, n);
+  for (uint32_t i = 0; i < n; ++i) {
+    NodeRecord& r = out[i];
+    const float f = float(i) * 0.7071067f;
+    r.error = 0.01f * (1.0f + std::sqrt(f));
+    r.sphere = {{std::sin(f) * 13.1f, std::cos(f) * 7.3f, 2.9f + f}, 0.37f + f * 0.013f};
+    if (!r.parents.empty())
+      r.parent_error = 10.0f + std::sqrt(f), r.parent_sphere = {r.sphere.center, 33.3f + f};
+  }
+  return out;
+}
+
+TEST(IndexRecords, RoundedPairsAreCompactAndComeBackBitForBit) {
+  const std::vector<NodeRecord> exact = distinct_pairs(48);
+  std::vector<NodeRecord> rounded = exact;
+  round_pairs(rounded);
+  const RootIndex root = tables();
+  const std::vector<uint8_t> exact_raw = serialize_nodes(exact, 0), rounded_raw = serialize_nodes(rounded, 0);
+  expect_same(parse_nodes(exact_raw, root, 0, 48, "run"), exact);
+  expect_same(parse_nodes(rounded_raw, root, 0, 48, "run"), rounded);
+  // 96 distinct pairs: 20 bytes each as literals, at most 12 compact (3 error, 1 exponent, 3 x 2 centre, 2
+  // radius), so at least 8 x 96 bytes fewer.
+  EXPECT_LE(rounded_raw.size() + 8 * 96, exact_raw.size());
+}
+
+TEST(IndexRecords, EveryKindOfFloatComesBackBitForBit) {
+  // Values the compact form holds (zeros, powers of two, subnormals, far apart exponents) and values it does
+  // not (-0, an error with low bits set, a negative radius's sign), in one run: each pair back bit for bit.
+  const float values[] = {0.0f,   -0.0f, 1.0f, -3.5f,           1e-40f, 0x1p-126f, 0x1p100f,
+                          -1e30f, 7.25f, 1.1f, 0x1.fffffep127f, 3e-39f, 65536.0f,  0.1f};
+  const size_t n = std::size(values);
+  std::vector<NodeRecord> in = records(0, uint32_t(n));
+  for (size_t i = 0; i < n; ++i) {
+    in[i].error = std::abs(values[(i + 3) % n]);
+    in[i].sphere = {{values[i], values[(i + 1) % n], values[(i + 5) % n]}, std::abs(values[(i + 2) % n])};
+    if (i == 4) in[i].error = -0.0f;
+    if (!in[i].parents.empty()) in[i].parent_error = INFINITY;
+  }
+  const std::vector<NodeRecord> out = parse_nodes(serialize_nodes(in, 0), tables(), 0, uint32_t(n), "run");
+  ASSERT_EQ(out.size(), n);
+  for (size_t i = 0; i < n; ++i) {
+    SCOPED_TRACE("record " + std::to_string(i));
+    EXPECT_EQ(std::bit_cast<uint32_t>(out[i].error), std::bit_cast<uint32_t>(in[i].error));
+    for (int a = 0; a < 3; ++a)
+      EXPECT_EQ(std::bit_cast<uint32_t>(out[i].sphere.center[a]),
+                std::bit_cast<uint32_t>(in[i].sphere.center[a]));
+    EXPECT_EQ(std::bit_cast<uint32_t>(out[i].sphere.radius), std::bit_cast<uint32_t>(in[i].sphere.radius));
+  }
+}
+
+// A compact pair: error bits (top 24), exponent delta, centre deltas, radius integer.
+struct Compact {
+  uint32_t error_top;
+  int64_t exponent;
+  std::array<int64_t, 3> centre;
+  uint64_t radius;
+};
+// One record without parents whose own pair is compact pair `c`, its parents' pair a literal (+infinity).
+std::vector<uint8_t> compact_record(const Compact& c) {
+  Fields f = record_fields(0, false);
+  f[kPairCode].varint(1);
+  f[kPairError].u8(uint8_t(c.error_top)), f[kPairError].u8(uint8_t(c.error_top >> 8));
+  f[kPairError].u8(uint8_t(c.error_top >> 16));
+  f[kPairExponent].svarint(c.exponent);
+  for (int64_t k : c.centre) f[kPairCentre].svarint(k);
+  f[kPairRadius].varint(c.radius);
+  f[kPairCode].varint(1);
+  literal(f, INFINITY, 0.0f);
+  return run_bytes(f);
+}
+
+TEST(IndexRecords, HostileCompactPairsAreErrors) {
+  const RootIndex root = tables();
+  // The hand-written compact pair parses: error 1.0 (0x3f800000), centre (1, -2, 3) x 2^-1, radius 5 x 2^-1.
+  const std::vector<NodeRecord> ok =
+      parse_nodes(compact_record(Compact{0x3f8000, -1, {1, -2, 3}, 5}), root, 5, 1, "run");
+  EXPECT_EQ(ok[0].error, 1.0f);
+  EXPECT_EQ(ok[0].sphere.center, glm::vec3(0.5f, -1.0f, 1.5f));
+  EXPECT_EQ(ok[0].sphere.radius, 2.5f);
+  std::vector<std::pair<const char*, std::vector<uint8_t>>> cases = {
+      {"NaN error", compact_record(Compact{0x7fc000, 0, {0, 0, 0}, 1})},
+      {"negative error", compact_record(Compact{0xbf8000, 0, {0, 0, 0}, 1})},
+      {"exponent far below the float range", compact_record(Compact{0x3f8000, -100000, {0, 0, 0}, 1})},
+      {"exponent far above the float range",
+       compact_record(Compact{0x3f8000, int64_t(1) << 40, {0, 0, 0}, 1})},
+      {"centre beyond the float range", compact_record(Compact{0x3f8000, 120, {int64_t(1) << 30, 0, 0}, 1})},
+      {"centre integer past the limit", compact_record(Compact{0x3f8000, 0, {0, INT64_MAX, 0}, 1})},
+      {"centre integer below the limit", compact_record(Compact{0x3f8000, 0, {0, 0, INT64_MIN}, 1})},
+      {"radius integer past the limit", compact_record(Compact{0x3f8000, 0, {0, 0, 0}, UINT64_MAX})},
+      {"radius beyond the float range", compact_record(Compact{0x3f8000, 127, {0, 0, 0}, 4})},
+  };
+  std::vector<uint8_t> truncated = compact_record(Compact{0x3f8000, -1, {1, -2, 3}, 5});
+  truncated.pop_back();  // the last stream (sphere radii) one byte short
+  cases.push_back({"truncated compact pair", truncated});
+  std::vector<uint8_t> long_stream = compact_record(Compact{0x3f8000, -1, {1, -2, 3}, 5});
+  long_stream[0] = 0x7f;  // the first stream claims more bytes than the run holds
+  cases.push_back({"field stream past the run", long_stream});
+  std::vector<uint8_t> trailing = compact_record(Compact{0x3f8000, -1, {1, -2, 3}, 5});
+  trailing[kPairRadius] += 1, trailing.push_back(0);  // a byte no record reads
+  cases.push_back({"trailing byte in a field stream", trailing});
+  expect_one_line_errors(cases, root);
 }
 
 }  // namespace

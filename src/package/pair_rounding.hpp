@@ -1,0 +1,42 @@
+// Conservative rounding of the (error, sphere) pairs of node records, so that the index stores them in few
+// bytes (index.hpp, "compact pair"): errors are rounded up to 16 significant bits, spheres to a grid of
+// 2^-kSphereGridBits of their radius (centre rounded to the grid, radius grown by the centre's move plus one
+// step, then rounded up to the grid), and every invariant inspect --verify checks still holds exactly:
+//   - errors stay monotonic (rounding up to 16 bits is a non-decreasing function of the error);
+//   - a rounded sphere contains the exact one (decoded vertices, HLOD objects' bounds stay inside);
+//   - a node's sphere stays inside its parents' sphere: a pair's rounded sphere is kept only when it lies
+//     inside the final sphere of every pair that is its parents' pair somewhere (tried on grids 8, 64 and
+//     512 times finer when it does not); else the exact sphere is kept, which the parents' final sphere
+//     contains (it contains their exact one, which contained it);
+//   - a node's parents' pair stays bit-for-bit its parents' own pair (rounding is per distinct pair).
+// Pairs of roots (a node without parents, and the +infinity parents' pair of a root) keep their exact
+// spheres: other representations' proxies (HLOD) are built to contain them.
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include "core/bounds.hpp"
+#include "package/index.hpp"
+
+namespace lodstream::package {
+
+inline constexpr int kSphereGridBits = 10;
+
+// e rounded up to a float whose low 8 mantissa bits are zero (16 significant bits): relative change below
+// 2^-15. 0, +infinity and values that would round to infinity are returned unchanged.
+float round_error_up(float e);
+
+// The smallest sphere on the grid of step 2^(floor(log2 radius) - grid_bits) that contains `s` with one step
+// of margin, or `s` when it has no such grid (zero or subnormal radius, or a centre more than 2^24 steps from
+// the origin). Relative growth of the radius: at most about 3 x 2^-grid_bits.
+Sphere round_sphere_out(const Sphere& s, int grid_bits = kSphereGridBits);
+
+// Whether `outer` contains `inner` with no tolerance, computed as inspect --verify does (double precision).
+bool contains_exactly(const Sphere& outer, const Sphere& inner);
+
+// Rounds the pairs of `nodes` (own and parents') as the header describes. Cost: O(nodes x parents' pairs per
+// pair) with a hash map of the distinct pairs.
+void round_pairs(std::span<NodeRecord> nodes);
+
+}  // namespace lodstream::package

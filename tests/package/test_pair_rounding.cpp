@@ -1,0 +1,111 @@
+// Conservative rounding of (error, sphere) pairs (pair_rounding.hpp): errors only grow and stay monotonic,
+// rounded spheres contain the exact ones, a node's sphere stays inside its parents' even when containment is
+// tight, parents' pairs stay their parents' own pairs bit for bit, and roots keep their exact spheres.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <random>
+
+#include "package/pair_rounding.hpp"
+
+namespace lodstream::test {
+namespace {
+
+using namespace package;
+
+TEST(PairRounding, ErrorsRoundUpMonotonicallyTo16Bits) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-30.0f, 30.0f);
+  std::vector<float> errors = {0.0f, INFINITY, 1.0f, 0x1.fffffep127f, 1e-45f};
+  for (int i = 0; i < 2000; ++i) errors.push_back(std::exp2(u(rng)));
+  std::sort(errors.begin(), errors.end());
+  float previous = 0.0f;
+  for (float e : errors) {
+    const float r = round_error_up(e);
+    EXPECT_GE(r, e);
+    EXPECT_GE(r, previous);  // monotonic: sorted errors stay sorted
+    if (std::isfinite(e) && e < 0x1p127f) EXPECT_EQ(std::bit_cast<uint32_t>(r) & 0xFFu, 0u) << e;
+    if (std::isnormal(e) && e < 0x1p127f) EXPECT_LE(double(r) - double(e), double(e) * 0x1p-15) << e;
+    previous = r;
+  }
+  EXPECT_EQ(round_error_up(0.0f), 0.0f);
+  EXPECT_EQ(round_error_up(INFINITY), INFINITY);
+  EXPECT_EQ(round_error_up(0x1.fffffep127f), 0x1.fffffep127f);  // would round to infinity: kept
+}
+
+TEST(PairRounding, RoundedSpheresContainTheExactOnesAndGrowLittle) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (int i = 0; i < 2000; ++i) {
+    const float scale = std::exp2(20.0f * u(rng));
+    const Sphere s{{u(rng) * 1000.0f, u(rng) * scale, u(rng)}, scale * (1.0f + u(rng) * 0.9f)};
+    const Sphere r = round_sphere_out(s);
+    EXPECT_TRUE(contains_exactly(r, s));
+    EXPECT_LE(r.radius, s.radius * (1.0f + 3.0f * std::exp2(-float(kSphereGridBits)) + 1e-6f));
+  }
+  // No grid: zero radius, infinite radius, a centre more than 2^24 steps out.
+  const Sphere point{{1.0f, 2.0f, 3.0f}, 0.0f};
+  EXPECT_EQ(round_sphere_out(point).radius, 0.0f);
+  const Sphere far{{1e9f, 0.0f, 0.0f}, 1.0f};
+  EXPECT_EQ(round_sphere_out(far).center.x, far.center.x);
+  EXPECT_EQ(round_sphere_out(far).radius, far.radius);
+}
+
+// A chain of nested spheres, each 1e-4 of its parent's radius from touching it from inside (tighter than the
+// coarsest grid's rounding), as a DAG's levels: node i's parents are node i - 1 (node 0 is the root), with
+// two siblings per level sharing a pair.
+std::vector<NodeRecord> nested(int levels) {
+  std::vector<NodeRecord> nodes;
+  Sphere parent{{0.3f, -0.7f, 1.1f}, 100.0f};
+  float parent_error = 50.0f;
+  for (int l = 0; l < levels; ++l) {
+    const Sphere own = l == 0 ? parent
+                              : Sphere{parent.center + glm::vec3(0.3699f, 0.0f, 0.0f) * parent.radius,
+                                       parent.radius * 0.63f};  // 1e-4 of the parent radius from its boundary
+    const float error = l == 0 ? parent_error : parent_error * 0.4f;
+    for (int sibling = 0; sibling < 2; ++sibling) {
+      NodeRecord n;
+      n.error = error, n.sphere = own;
+      if (l > 0) {
+        n.parents = {uint32_t(nodes.size() - 1 - sibling)};
+        n.parent_error = parent_error, n.parent_sphere = parent;
+      } else {
+        n.parent_sphere = own;  // a root: +infinity parents' error
+      }
+      nodes.push_back(n);
+    }
+    parent = own, parent_error = error;
+  }
+  return nodes;
+}
+
+TEST(PairRounding, TightlyNestedPairsKeepEveryInvariant) {
+  const std::vector<NodeRecord> exact = nested(12);
+  std::vector<NodeRecord> nodes = exact;
+  round_pairs(nodes);
+  size_t rounded = 0;
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    SCOPED_TRACE("node " + std::to_string(i));
+    const NodeRecord& n = nodes[i];
+    EXPECT_GE(n.error, exact[i].error);
+    EXPECT_TRUE(contains_exactly(n.sphere, exact[i].sphere));
+    rounded += std::bit_cast<uint32_t>(n.sphere.radius) != std::bit_cast<uint32_t>(exact[i].sphere.radius);
+    if (n.parents.empty()) {
+      EXPECT_EQ(n.sphere.radius, exact[i].sphere.radius);  // roots keep their spheres
+      EXPECT_EQ(n.sphere.center, exact[i].sphere.center);
+      continue;
+    }
+    const NodeRecord& p = nodes[n.parents[0]];
+    EXPECT_LE(n.error, n.parent_error);
+    EXPECT_TRUE(contains_exactly(n.parent_sphere, n.sphere));
+    EXPECT_EQ(std::bit_cast<uint32_t>(p.error), std::bit_cast<uint32_t>(n.parent_error));
+    EXPECT_EQ(std::bit_cast<uint32_t>(p.sphere.radius), std::bit_cast<uint32_t>(n.parent_sphere.radius));
+    EXPECT_EQ(p.sphere.center, n.parent_sphere.center);
+  }
+  // Every pair but the root's is rounded (on a finer grid where containment is tight).
+  EXPECT_EQ(rounded, nodes.size() - 2);
+}
+
+}  // namespace
+}  // namespace lodstream::test
