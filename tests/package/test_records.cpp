@@ -149,6 +149,7 @@ TEST(Records, InvalidClusterCountsAndOtherCodecsAreRefused) {
   counts[0] += 1;  // one more than the mesh holds
   EXPECT_THROW(TraversalCodec().encode(g, r.grid), Error);
   counts[0] -= 1, counts.push_back(0);  // an empty cluster
+  g.cluster_triangles = counts;         // push_back may have moved them
   EXPECT_THROW(TraversalCodec().encode(g, r.grid), Error);
   std::vector<uint32_t> many(kMaxRecordClusters + 1, 1);  // more clusters than a record may hold
   Mesh strip;
