@@ -29,14 +29,15 @@
 // floor(log2(e / (16 * step))) clamped to [0, 16], so that the rounding adds at most q(e) = sqrt(3)/2 * 2^k *
 // step <= e / 16 * sqrt(3)/2; the stored error and sphere radius are raised by q(e). q is a non-decreasing
 // function of e, so stored errors stay monotonic and spheres containing. Why 16 (measured with divisors 2, 4,
-// 8, 16 and shift 0; bake, render at 1 px, bench stream gen:fly at 10 Mbit/s 80 ms): a larger shift saves
-// bits on free vertices but costs 3k raw bits per locked vertex and raises stored errors, so clients refine
-// deeper; against 4, divisor 16 gives elephant_1m a 0.6 % smaller package, 5-15 % fewer triangles at 1 px and
-// PSNR at 1 / 2 / 5 s of 55.9 / 57.2 / 51.0 dB instead of 50.5 / 52.4 / 49.3 (push), refined_elephant +1.6 %
-// bytes with PSNR 52.0 / 51.8 / 48.4 instead of 51.4 / 50.3 / 48.2. Vertices on the border of the group that
-// made or consumes a cluster are flagged locked and decode exactly, so cuts stay crack-free (free vertices
-// are shared only by clusters of one page group, stored at one shift: page_group_precision). HLOD proxies are
-// stored on a 2^-14 grid of the scene's world bounds, shift 0; the rounding is part of their errors.
+// 8, 16 and shift 0, at group ratio 0.5; bake, render at 1 px, bench stream gen:fly at 10 Mbit/s 80 ms): a
+// larger shift saves bits on free vertices but costs 3k raw bits per locked vertex and raises stored errors,
+// so clients refine deeper; against 4, divisor 16 gives elephant_1m a 0.6 % smaller package, 5-15 % fewer
+// triangles at 1 px and PSNR at 1 / 2 / 5 s of 55.9 / 57.2 / 51.0 dB instead of 50.5 / 52.4 / 49.3 (push),
+// refined_elephant +1.6 % bytes with PSNR 52.0 / 51.8 / 48.4 instead of 51.4 / 50.3 / 48.2. Vertices on the
+// border of the group that made or consumes a cluster are flagged locked and decode exactly, so cuts stay
+// crack-free (free vertices are shared only by clusters of one page group, stored at one shift:
+// page_group_precision). HLOD proxies are stored on a 2^-14 grid of the scene's world bounds, shift 0; the
+// rounding is part of their errors.
 #include <tbb/parallel_for.h>
 
 #include <atomic>
@@ -73,12 +74,13 @@ using namespace package;
 
 // Meshes of at most this many triangles become progressive meshes (hierarchy/progressive_steps.hpp), larger
 // ones cluster DAGs. Why 2048: as a DAG such a mesh is 16 clusters, 3-4 levels and about 2 x 2048 stored
-// triangles, ~20 KB encoded: less than one 48 KB page, so the DAG's per-cluster selection buys nothing (a
-// page is what travels), while a progressive mesh stores each triangle once and streams it in about 3 steps
-// (base, then doubling). Measured (bench stream gen:fly, 10 Mbit/s 80 ms, push time to benefit 0.95):
-// motorBike 2.10 s all-DAG, 2.03 s at 2048, 2.20 s at 8192; city 2.20 s all-DAG, 2.30 s at 2048, 2.37 s
-// at 8192 (sse-pull 4.37 -> 3.97 s at both); larger N loses view-dependent refinement on objects that fill
-// the screen, and steps that double overshoot tau by up to 2x triangles.
+// triangles (1.8 x since the group ratio is 0.45; the figures below were measured at 0.5), ~20 KB encoded:
+// less than one 48 KB page, so the DAG's per-cluster selection buys nothing (a page is what travels), while a
+// progressive mesh stores each triangle once and streams it in about 3 steps (base, then doubling). Measured
+// (bench stream gen:fly, 10 Mbit/s 80 ms, push time to benefit 0.95): motorBike 2.10 s all-DAG, 2.03 s at
+// 2048, 2.20 s at 8192; city 2.20 s all-DAG, 2.30 s at 2048, 2.37 s at 8192 (sse-pull 4.37 -> 3.97 s at
+// both); larger N loses view-dependent refinement on objects that fill the screen, and steps that double
+// overshoot tau by up to 2x triangles.
 constexpr uint32_t kDefaultPmMaxTriangles = 2048;
 // A step's vertices must fit one codec node (65536); a mesh of T triangles has at most 3T vertices.
 constexpr uint32_t kMaxPmTriangles = 21845;
