@@ -52,7 +52,7 @@ std::string check_records(const std::vector<NodeRecord>& nodes) {
     if (!(n.parent_error >= n.error)) return where + "parents' error is below its own (not monotonic)";
     if (n.parents.empty() != std::isinf(n.parent_error))
       return where + "parents' error must be infinite exactly when it has no parents";
-    if (!n.parents.empty() && !hierarchy::sphere_contains(n.parent_sphere, n.sphere))
+    if (!n.parents.empty() && !sphere_contains(n.parent_sphere, n.sphere))
       return where + "parents' sphere does not contain its own";
     for (uint32_t p : n.parents)
       if (nodes[p].error != n.parent_error || !same_sphere(nodes[p].sphere, n.parent_sphere))
@@ -101,7 +101,7 @@ std::string check_hlod(const PackageScene& scene, const std::vector<NodeRecord>&
         const ObjectRecord& object = scene.objects[o];
         const double scale = schedule::max_scale(object.transform);
         const schedule::WorldSphere os = schedule::object_sphere(scene, o);
-        if (!hierarchy::sphere_contains(n.sphere, Sphere{glm::vec3(os.center), float(os.radius)}))
+        if (!sphere_contains(n.sphere, Sphere{glm::vec3(os.center), float(os.radius)}))
           return where + "its sphere does not contain object " + std::to_string(o) + "'s bounds";
         for (uint32_t root : scene.representations[object.representation].roots) {
           const NodeRecord& rr = nodes[root];
@@ -109,7 +109,7 @@ std::string check_hlod(const PackageScene& scene, const std::vector<NodeRecord>&
           if (double(n.error) < double(rr.error) * scale)
             return where + "its error is below object " + std::to_string(o) + "'s root " +
                    std::to_string(root);
-          if (!hierarchy::sphere_contains(n.sphere, Sphere{glm::vec3(ws.center), float(ws.radius)}))
+          if (!sphere_contains(n.sphere, Sphere{glm::vec3(ws.center), float(ws.radius)}))
             return where + "its sphere does not contain object " + std::to_string(o) + "'s root " +
                    std::to_string(root);
         }

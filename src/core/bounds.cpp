@@ -12,4 +12,9 @@ Bounds transform_bounds(const Bounds& b, const glm::mat4& m) {
   return out;
 }
 
+bool sphere_contains(const Sphere& outer, const Sphere& inner, double tolerance) {
+  const double d = glm::length(glm::dvec3(inner.center) - glm::dvec3(outer.center));
+  return d + double(inner.radius) <= double(outer.radius) * (1.0 + tolerance) + 1e-30;
+}
+
 }  // namespace lodstream

@@ -38,6 +38,10 @@ struct Sphere {
   float radius = 0.0f;
 };
 
+// Whether `outer` contains `inner` (centre distance plus inner radius, in double precision), allowing
+// `tolerance` x outer's radius of slack; tolerance 0 is exact containment (up to 1e-30 absolute).
+bool sphere_contains(const Sphere& outer, const Sphere& inner, double tolerance = 1e-6);
+
 // Bounds of a box under an affine transform (the box of the eight transformed corners).
 Bounds transform_bounds(const Bounds& b, const glm::mat4& m);
 

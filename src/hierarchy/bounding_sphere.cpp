@@ -60,9 +60,4 @@ Sphere sphere_of_spheres(std::span<const Sphere> spheres, std::span<const glm::v
   return to_float(c, r);
 }
 
-bool sphere_contains(const Sphere& outer, const Sphere& inner, double tolerance) {
-  const double d = glm::length(glm::dvec3(inner.center) - glm::dvec3(outer.center));
-  return d + double(inner.radius) <= double(outer.radius) * (1.0 + tolerance) + 1e-30;
-}
-
 }  // namespace lodstream::hierarchy

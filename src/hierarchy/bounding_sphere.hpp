@@ -18,7 +18,4 @@ Sphere sphere_of_points(std::span<const glm::vec3> points);
 // later distance computations. Cost: O(n + m).
 Sphere sphere_of_spheres(std::span<const Sphere> spheres, std::span<const glm::vec3> points = {});
 
-// Whether `outer` contains `inner`, allowing `tolerance` x outer's radius of slack.
-bool sphere_contains(const Sphere& outer, const Sphere& inner, double tolerance = 1e-6);
-
 }  // namespace lodstream::hierarchy

@@ -19,20 +19,20 @@ namespace {
 // Build state: the DAG plus, per cluster, the position id of each vertex (ids equal <=> positions equal).
 struct Builder {
   const DagOptions& options;
-  ClusterDag dag;
-  std::vector<std::vector<uint32_t>> position_ids;  // by cluster
-  std::vector<uint8_t> open_boundary;               // by position id (ids of the input mesh)
+  ClusterDag dag{};
+  std::vector<std::vector<uint32_t>> position_ids{};  // by cluster
+  std::vector<uint8_t> open_boundary{};               // by position id (ids of the input mesh)
   uint32_t next_position_id = 0;
   // The input and its level-0 clusters' vertices until their vertex data is copied (beside level 1's
   // grouping, which needs only the clusters' indices, position ids and spheres).
-  Mesh input;
-  std::vector<ClusterPart> input_parts;
+  Mesh input{};
+  std::vector<ClusterPart> input_parts{};
   // Per level, reused (fresh pages cost 4 s/GB to touch): the active clusters' boundary edges, and by
   // position id the group holding it (UINT32_MAX) and whether clusters of two groups hold it (0), both
   // reset to those values after each level.
-  std::vector<ClusterEdge> edges;
-  std::vector<uint32_t> owner;
-  std::vector<uint8_t> border;
+  std::vector<ClusterEdge> edges{};
+  std::vector<uint32_t> owner{};
+  std::vector<uint8_t> border{};
 };
 
 // Positions a group simplification creates get ids kNewId | k while groups run in parallel; the ids are made
@@ -319,7 +319,7 @@ void finish_groups(Builder& b, const std::vector<uint32_t>& groups, std::vector<
 }  // namespace
 
 ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
-  Builder b{options, {}, {}, {}, {}};
+  Builder b{options};
   build_level0(b, std::move(mesh));
   ClusterDag& dag = b.dag;
   if (dag.clusters.empty()) return std::move(dag);

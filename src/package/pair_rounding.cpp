@@ -3,6 +3,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <vector>
 
@@ -28,12 +29,7 @@ Sphere round_sphere_out(const Sphere& s, int grid_bits) {
   // r' >= r + |c' - c| + step, a multiple of the step (exact in float: r' / step < 2^(grid_bits + 2)).
   const double moved = glm::length(glm::dvec3(out.center) - glm::dvec3(s.center));
   out.radius = float(std::ceil((double(s.radius) + moved) / step + 1.0) * step);
-  return contains_exactly(out, s) ? out : s;
-}
-
-bool contains_exactly(const Sphere& outer, const Sphere& inner) {
-  const double d = glm::length(glm::dvec3(inner.center) - glm::dvec3(outer.center));
-  return d + double(inner.radius) <= double(outer.radius);
+  return sphere_contains(out, s, 0.0) ? out : s;
 }
 
 namespace {
@@ -68,7 +64,7 @@ struct PairGraph {
       const Sphere s = round_sphere_out(exact[p], bits);
       bool inside = true;
       for (uint32_t q : parents[p])
-        inside = inside && (q == p || (state[q] == 2 && contains_exactly(final[q], s)));
+        inside = inside && (q == p || (state[q] == 2 && sphere_contains(final[q], s, 0.0)));
       if (inside) {
         final[p] = s;
         break;

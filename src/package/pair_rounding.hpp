@@ -32,11 +32,8 @@ float round_error_up(float e);
 // the origin). Relative growth of the radius: at most about 3 x 2^-grid_bits.
 Sphere round_sphere_out(const Sphere& s, int grid_bits = kSphereGridBits);
 
-// Whether `outer` contains `inner` with no tolerance, computed as inspect --verify does (double precision).
-bool contains_exactly(const Sphere& outer, const Sphere& inner);
-
 // Rounds the pairs of `nodes` (own and parents') as the header describes. Cost: O(nodes x parents' pairs per
-// pair) with a hash map of the distinct pairs.
+// pair) with an ordered map of the distinct pairs.
 void round_pairs(std::span<NodeRecord> nodes);
 
 }  // namespace lodstream::package

@@ -225,6 +225,7 @@ void add_hlod_exchange(const package::PackageScene& scene, const NodeSource& rec
 // 0.92 for 0.7 s). Cost: O(|G|).
 double member_gain(const package::PackageScene& scene, const NodeSource& records, uint32_t object,
                    const std::vector<uint32_t>& g, const View& view, double p_error_px, double tau) {
+  if (g.empty()) return 0.0;
   const glm::mat4& transform = scene.objects[object].transform;
   const double scale = max_scale(transform);
   double weighted = 0.0, weight = 0.0, plain = 0.0;
@@ -235,7 +236,6 @@ double member_gain(const package::PackageScene& scene, const NodeSource& records
     const double a = projected_area(to_world(r.sphere, transform, scale), view);
     weighted += a * gain, weight += a, plain += gain;
   }
-  if (g.empty()) return 0.0;
   return weight > 0.0 ? weighted / weight : plain / double(g.size());
 }
 

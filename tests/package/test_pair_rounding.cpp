@@ -25,8 +25,12 @@ TEST(PairRounding, ErrorsRoundUpMonotonicallyTo16Bits) {
     const float r = round_error_up(e);
     EXPECT_GE(r, e);
     EXPECT_GE(r, previous);  // monotonic: sorted errors stay sorted
-    if (std::isfinite(e) && e < 0x1p127f) EXPECT_EQ(std::bit_cast<uint32_t>(r) & 0xFFu, 0u) << e;
-    if (std::isnormal(e) && e < 0x1p127f) EXPECT_LE(double(r) - double(e), double(e) * 0x1p-15) << e;
+    if (std::isfinite(e) && e < 0x1p127f) {
+      EXPECT_EQ(std::bit_cast<uint32_t>(r) & 0xFFu, 0u) << e;
+    }
+    if (std::isnormal(e) && e < 0x1p127f) {
+      EXPECT_LE(double(r) - double(e), double(e) * 0x1p-15) << e;
+    }
     previous = r;
   }
   EXPECT_EQ(round_error_up(0.0f), 0.0f);
@@ -41,7 +45,7 @@ TEST(PairRounding, RoundedSpheresContainTheExactOnesAndGrowLittle) {
     const float scale = std::exp2(20.0f * u(rng));
     const Sphere s{{u(rng) * 1000.0f, u(rng) * scale, u(rng)}, scale * (1.0f + u(rng) * 0.9f)};
     const Sphere r = round_sphere_out(s);
-    EXPECT_TRUE(contains_exactly(r, s));
+    EXPECT_TRUE(sphere_contains(r, s, 0.0));
     EXPECT_LE(r.radius, s.radius * (1.0f + 3.0f * std::exp2(-float(kSphereGridBits)) + 1e-6f));
   }
   // No grid: zero radius, infinite radius, a centre more than 2^24 steps out.
@@ -89,7 +93,7 @@ TEST(PairRounding, TightlyNestedPairsKeepEveryInvariant) {
     SCOPED_TRACE("node " + std::to_string(i));
     const NodeRecord& n = nodes[i];
     EXPECT_GE(n.error, exact[i].error);
-    EXPECT_TRUE(contains_exactly(n.sphere, exact[i].sphere));
+    EXPECT_TRUE(sphere_contains(n.sphere, exact[i].sphere, 0.0));
     rounded += std::bit_cast<uint32_t>(n.sphere.radius) != std::bit_cast<uint32_t>(exact[i].sphere.radius);
     if (n.parents.empty()) {
       EXPECT_EQ(n.sphere.radius, exact[i].sphere.radius);  // roots keep their spheres
@@ -98,7 +102,7 @@ TEST(PairRounding, TightlyNestedPairsKeepEveryInvariant) {
     }
     const NodeRecord& p = nodes[n.parents[0]];
     EXPECT_LE(n.error, n.parent_error);
-    EXPECT_TRUE(contains_exactly(n.parent_sphere, n.sphere));
+    EXPECT_TRUE(sphere_contains(n.parent_sphere, n.sphere, 0.0));
     EXPECT_EQ(std::bit_cast<uint32_t>(p.error), std::bit_cast<uint32_t>(n.parent_error));
     EXPECT_EQ(std::bit_cast<uint32_t>(p.sphere.radius), std::bit_cast<uint32_t>(n.parent_sphere.radius));
     EXPECT_EQ(p.sphere.center, n.parent_sphere.center);

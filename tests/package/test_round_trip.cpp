@@ -135,7 +135,7 @@ TEST_P(RoundTrip, RecordsLoadOnDemand) {
     EXPECT_EQ(n.parent_sphere.center, e.parent_sphere.center);
     EXPECT_EQ(n.parent_sphere.radius, e.parent_sphere.radius);
     EXPECT_GE(n.error, t.records[id].error);
-    EXPECT_TRUE(contains_exactly(n.sphere, t.records[id].sphere));
+    EXPECT_TRUE(sphere_contains(n.sphere, t.records[id].sphere, 0.0));
     EXPECT_EQ(n.children, e.children);
     EXPECT_EQ(n.parents, e.parents);
     EXPECT_EQ(n.objects, e.objects);
