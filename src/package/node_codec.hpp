@@ -28,17 +28,20 @@ struct PositionGrid {
   float step = 1.0f;
 
   // The grid with origin at the box minimum and step = diagonal * 2^-bits (bits = 14 gives the ≤ 2^-14 of the
-  // diagonal that DESIGN.md requires of the finest level; the error per axis is at most step / 2).
-  static PositionGrid for_bounds(const Bounds& bounds, int bits = 14);
+  // diagonal that DESIGN.md requires of the finest level; the error per axis is at most step / 2). Bits need
+  // not be whole: the step is any float.
+  static PositionGrid for_bounds(const Bounds& bounds, double bits = 14);
 
-  // The grid for_bounds(mesh.bounds(), b) with the fewest bits b in [min_bits, max_bits] on which the mesh's
-  // distinct positions stay distinct (no two of them round to one grid point), or max_bits when none is.
+  // The grid for_bounds(mesh.bounds(), b) with the fewest bits b in [min_bits, max_bits], to 1/8 of a bit
+  // above min_bits, on which the mesh's distinct positions stay distinct (no two of them round to one grid
+  // point), or max_bits when none is.
   // Used with snap(): e.g. buildings.obj tessellates footprints with vertices 0.013 apart, under the 2^-14
   // step (0.017) of its 279-unit diagonal, and also holds near-duplicate vertices 1e-5 apart (float noise,
   // which no grid separates): it gets max_bits, and the 92 near-duplicates that still collide there are
   // welded by snap(). Only the finest level pays for the extra bits: coarser nodes drop low bits in
   // proportion to their error (the bake's position_shift). Requires max_bits <= 20. Cost: O(V) per bit count
-  // tried, on every core; 32 bytes per vertex of scratch.
+  // tried (whole bits up to the first that separates, then three halvings), on every core; 32 bytes per
+  // vertex of scratch.
   static PositionGrid separating(const Mesh& mesh, int min_bits = 14, int max_bits = 20);
   // Moves every position to the grid point the codec decodes it to and drops the triangles this makes
   // degenerate (two corners on one grid point). A hierarchy built on the snapped mesh has a finest level
