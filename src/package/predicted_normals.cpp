@@ -1,6 +1,7 @@
 #include "package/predicted_normals.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cstring>
 #include <limits>
 #include <type_traits>
@@ -63,7 +64,7 @@ void transpose(const NormalSum* s, Float4& x, Float4& y, Float4& z) {
 // and an add (AVX2 does not include FMA), so both compute the same bits.
 __attribute__((target_clones("avx2", "default"))) void predicted_normals(
     std::span<const uint32_t> indices, uint32_t first_vertex, uint32_t index_end, const glm::vec3* positions,
-    uint32_t V, std::vector<NormalSum>& sum) {
+    uint32_t V, bool smooth, std::vector<NormalSum>& sum) {
   // Lanes 0-2 of a 16-byte load at positions[v] are its x y z; lane 3 (the next vertex's x) is never read.
   auto p = [positions](uint32_t v) {
     NormalSum r;
@@ -84,10 +85,27 @@ __attribute__((target_clones("avx2", "default"))) void predicted_normals(
       sum[a] += n, sum[b] += n, sum[c] += n;
     }
   };
-  if (first_vertex == 0 && index_end == V)
+  // s'[v] = 2 s[v] + sum over v's triangles of the other two corners' s: with t = s[a] + s[b] + s[c], corner
+  // a gains t - s[a].
+  thread_local std::vector<NormalSum> plain;
+  auto smoothen = [&](auto all_inside) {
+    plain = sum;
+    for (NormalSum& s : sum) s += s;
+    for (size_t i = 0; i + 2 < indices.size(); i += 3) {
+      const uint32_t a = indices[i] - first_vertex, b = indices[i + 1] - first_vertex,
+                     c = indices[i + 2] - first_vertex;
+      if (!all_inside && (a >= V || b >= V || c >= V)) continue;
+      const NormalSum t = plain[a] + plain[b] + plain[c];
+      sum[a] += t - plain[a], sum[b] += t - plain[b], sum[c] += t - plain[c];
+    }
+  };
+  if (first_vertex == 0 && index_end == V) {
     accumulate(std::true_type{});
-  else
+    if (smooth) smoothen(std::true_type{});
+  } else {
     accumulate(std::false_type{});
+    if (smooth) smoothen(std::false_type{});
+  }
 }
 
 std::vector<uint64_t> normal_residuals(std::span<const glm::vec3> normals, std::span<const uint32_t> order,
@@ -114,6 +132,24 @@ std::vector<uint64_t> normal_residuals(std::span<const glm::vec3> normals, std::
   }
   width = bytes_for(largest);
   return residuals;
+}
+
+NormalCodes code_normals(std::span<const glm::vec3> normals, std::span<const uint32_t> order,
+                         std::span<const uint32_t> indices, uint32_t first_vertex, uint32_t index_end,
+                         const glm::vec3* positions, uint32_t bits) {
+  const uint32_t V = uint32_t(order.size());
+  std::vector<NormalSum> sum;
+  NormalCodes best;
+  uint64_t fewest = UINT64_MAX;
+  for (bool smooth : {false, true}) {
+    predicted_normals(indices, first_vertex, index_end, positions, V, smooth, sum);
+    NormalCodes c;
+    c.codes = normal_residuals(normals, order, sum, bits, c.width), c.smooth = smooth;
+    uint64_t bits_taken = 0;
+    for (uint64_t code : c.codes) bits_taken += std::bit_width(code);
+    if (bits_taken < fewest) fewest = bits_taken, best = std::move(c);
+  }
+  return best;
 }
 
 // An AVX2 build besides the baseline one, as predicted_normals.
