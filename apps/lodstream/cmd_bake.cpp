@@ -171,7 +171,8 @@ Sphere stored_sphere(const Sphere& s, float error, const PositionGrid& grid) {
 // 0.02 dB; 9 keeps a margin for close-up views and specular shading, which these renders do not test.
 // (Recomputing the normals from the snapped positions, which the codec predicts exactly, saved 5.4 % but cost
 // 0.2 dB near and 3.3 dB far: quantized positions tilt face normals by more than 8-bit octahedral rounding
-// does.)
+// does.) These figures are of format 5's global octahedral code; format 6 codes a normal in the frame of its
+// prediction at the same RMS angular error for the same bits (predicted_normals.hpp).
 uint32_t cluster_normal_bits(float error, const BakeArgs& args) {
   return error > 0.0f ? std::min(args.normal_bits, args.coarse_normal_bits) : args.normal_bits;
 }

@@ -18,10 +18,10 @@ inline float sign_not_zero(float v) {
 }
 
 // n need not be unit length; a zero (or non-finite) vector encodes as +z. Returns components in
-// [-(2^(bits-1)-1), 2^(bits-1)-1].
-inline glm::ivec2 oct_encode(glm::vec3 n, int bits) {
+// [-scale, scale], rounded; oct_decode with inv_scale = 1 / scale inverts it.
+inline glm::ivec2 oct_encode(glm::vec3 n, float scale) {
   // Selects only (no branch, no short-circuit, the division unconditional), so that a loop of encodes
-  // vectorizes: the predictive codecs encode a predicted normal per vertex when decoding.
+  // vectorizes.
   const float l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
   const bool usable = (l1 > 0.0f) & (l1 <= std::numeric_limits<float>::max());  // not zero, NaN or infinite
   const float px = usable ? n.x / l1 : 0.0f, py = usable ? n.y / l1 : 0.0f;     // as before: same codes
@@ -29,10 +29,14 @@ inline glm::ivec2 oct_encode(glm::vec3 n, int bits) {
   const float fx = lower ? (1.0f - std::abs(py)) * sign_not_zero(px) : px;
   const float fy = lower ? (1.0f - std::abs(px)) * sign_not_zero(py) : py;
   // Round half away from zero without a libm call.
-  const float scale = static_cast<float>((1 << (bits - 1)) - 1);
   const float x = std::min(std::max(fx, -1.0f), 1.0f) * scale,
               y = std::min(std::max(fy, -1.0f), 1.0f) * scale;
   return {static_cast<int>(x + std::copysign(0.5f, x)), static_cast<int>(y + std::copysign(0.5f, y))};
+}
+
+// The b-bit code: components in [-(2^(bits-1)-1), 2^(bits-1)-1].
+inline glm::ivec2 oct_encode(glm::vec3 n, int bits) {
+  return oct_encode(n, static_cast<float>((1 << (bits - 1)) - 1));
 }
 
 // Inverse of oct_encode for any integer pair (garbage in gives some unit vector, never NaN). The fold of the
@@ -48,9 +52,8 @@ inline glm::vec3 oct_decode(int x, int y, float inv_scale) {
   return {fx * inv_length, fy * inv_length, fz * inv_length};
 }
 
-// Four lanes (GCC / Clang vector extensions, one SSE register). The 4-lane forms below compute in each lane
-// exactly what the scalar functions above compute (the same operations in the same order), so that a decoder
-// may predict with them what an encoder predicted with the scalar ones.
+// Four lanes (GCC / Clang vector extensions, one SSE register). The 4-lane oct_decode below computes in each
+// lane exactly what the scalar one computes (the same operations in the same order).
 using Float4 = float __attribute__((vector_size(16)));
 using Int4 = int32_t __attribute__((vector_size(16)));
 
@@ -83,22 +86,6 @@ inline Float4 sqrt(Float4 v) {
 #else
   return Float4{std::sqrt(v[0]), std::sqrt(v[1]), std::sqrt(v[2]), std::sqrt(v[3])};
 #endif
-}
-
-// oct_encode of 4 vectors (x[i], y[i], z[i]) into (ox[i], oy[i]).
-inline void oct_encode(Float4 x, Float4 y, Float4 z, int bits, Int4& ox, Int4& oy) {
-  const Float4 zero = splat(0.0f), one = splat(1.0f);
-  const Float4 l1 = abs(x) + abs(y) + abs(z);
-  const Int4 usable = (l1 > zero) & (l1 <= splat(std::numeric_limits<float>::max()));
-  const Float4 px = select(usable, x / l1, zero), py = select(usable, y / l1, zero);
-  const Int4 lower = usable & (z < zero);
-  const Float4 fx = select(lower, (one - abs(py)) * select(px >= zero, one, -one), px);
-  const Float4 fy = select(lower, (one - abs(px)) * select(py >= zero, one, -one), py);
-  const Float4 scale = splat(static_cast<float>((1 << (bits - 1)) - 1));
-  const Float4 cx = clamp(fx, -one, one) * scale, cy = clamp(fy, -one, one) * scale;
-  const Int4 sign = Int4(splat(-0.0f)), half = Int4(splat(0.5f));
-  ox = __builtin_convertvector(cx + Float4((Int4(cx) & sign) | half), Int4);
-  oy = __builtin_convertvector(cy + Float4((Int4(cy) & sign) | half), Int4);
 }
 
 // oct_decode of 4 codes (x[i], y[i]) into (nx[i], ny[i], nz[i]).

@@ -61,9 +61,10 @@ PredictiveNode read_layout(ByteReader& r, size_t node_size, uint8_t format, uint
   PredictiveNode p;
   static_cast<NodeHeader&>(p) = NodeHeader::read(r, format, known_flags, node_size);
   const uint8_t widths = r.u8();
-  p.position_bytes = widths & 15, p.normal_bytes = (widths >> 4) & 3, p.damping = 4 - (widths >> 6);
+  p.position_bytes = widths & 7, p.smooth_normals = (widths >> 3) & 1;
+  p.normal_bytes = (widths >> 4) & 3, p.damping = 4 - (widths >> 6);
   if (p.position_bytes < 1 || p.position_bytes > kMaxPositionBytes || p.damping < 2 ||
-      (p.normal_bytes == 0) != !(p.flags & kHasNormals))
+      (p.normal_bytes == 0) != !(p.flags & kHasNormals) || (p.smooth_normals && p.normal_bytes == 0))
     r.fail("invalid residual widths");
   const uint64_t attribute_size = r.varint(), locked_size = r.varint(), connectivity_size = r.varint();
   p.header_size = r.position();
@@ -138,11 +139,11 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
   }
   if (g.mesh->has_normals()) {
     std::vector<glm::vec3> decoded(V + 1);  // predicted_normals reads one past the last
-    std::vector<NormalSum> sum;
     decode_positions(n.c, LockedStream::parse(locked_stream, V, g.position_shift, "node codec"), grid,
                      decoded.data());
-    predicted_normals(indices, g.first_vertex, n.index_end, decoded.data(), uint32_t(V), sum);
-    r.normals = normal_residuals(g.mesh->normals, n.order, sum, g.normal_bits, r.normal_bytes);
+    NormalCodes codes = code_normals(g.mesh->normals, n.order, indices, g.first_vertex, n.index_end,
+                                     decoded.data(), g.normal_bits);
+    r.normals = std::move(codes.codes), r.normal_bytes = codes.width, r.smooth_normals = codes.smooth;
   }
   return r;
 }
@@ -154,7 +155,8 @@ std::vector<uint8_t> write_predictive_node(const NodeHeader& header, const Predi
                                            std::span<const uint8_t> tail) {
   ByteWriter w;
   header.write(w);
-  w.u8(static_cast<uint8_t>(r.position_bytes | r.normal_bytes << 4 | (4 - r.damping) << 6));
+  w.u8(static_cast<uint8_t>(r.position_bytes | r.smooth_normals << 3 | r.normal_bytes << 4 |
+                            (4 - r.damping) << 6));
   w.varint(attribute_stream.size());
   w.varint(locked_stream.size());
   w.varint(connectivity.size());
@@ -196,7 +198,7 @@ void decode_predicted_vertices(const PredictiveNode& p, std::span<const uint32_t
 
   if (p.flags & kHasNormals) {
     thread_local std::vector<NormalSum> sum;
-    predicted_normals(m.indices, p.first_vertex, p.index_end, positions.data(), V, sum);
+    predicted_normals(m.indices, p.first_vertex, p.index_end, positions.data(), V, p.smooth_normals, sum);
     decode_predicted_normals(sum, V, p.normal_planes.data(), p.normal_bytes, p.normal_bits, m.normals);
   }
   decode_attribute_stream(p.attribute_stream, p.flags, V, p.uv_min, p.uv_extent, out, where);

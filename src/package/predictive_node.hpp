@@ -2,7 +2,8 @@
 // layout of a node's bytes, the parallelogram-predicted positions and the normals predicted from them.
 //
 // Bytes of a node:
-//   the common header (node_header.hpp); u8 widths (bits 0-3: bytes per position residual wp, 1..5; bits 4-5:
+//   the common header (node_header.hpp); u8 widths (bits 0-2: bytes per position residual wp, 1..5; bit 3:
+//   the normals' prediction is smoothed (predicted_normals.hpp); bits 4-5:
 //   bytes per normal residual wn, 0..3, 0 exactly without normals; bits 6-7: the damping j below, 4 - value);
 //   varint sizes of the attribute, locked and connectivity streams; then the position planes (3 wp V bytes),
 //   the normal planes (2 wn V bytes), the attribute stream (vertex_attributes.hpp), the locked stream
@@ -16,7 +17,7 @@
 //   position bits). Predictors o1, o2, o lie below v; the codec derives them from the connectivity; a single
 //   predictor x is (x, x, x) (P = x for every j), and index V stands for cmin (no predictor). The residuals
 //   are zigzag-mapped, byte b of axis a at plane 3b + a (byte_planes.hpp).
-// Normals: predicted from the decoded positions (predicted_normals.hpp).
+// Normals: predicted from the decoded positions, plain or smoothed (predicted_normals.hpp).
 #pragma once
 
 #include <cstdint>
@@ -32,6 +33,7 @@ namespace lodstream::package {
 struct PredictiveNode : NodeHeader {
   uint32_t position_bytes = 0, normal_bytes = 0;
   uint32_t damping = 4;  // j of the position prediction
+  bool smooth_normals = false;
   size_t header_size = 0;
   std::span<const uint8_t> position_planes, normal_planes, attribute_stream, locked_stream, connectivity,
       tail;
@@ -54,6 +56,7 @@ struct PredictiveResiduals {
   std::vector<uint64_t> positions, normals;
   uint32_t position_bytes = 0, normal_bytes = 0;
   uint32_t damping = 4;  // j
+  bool smooth_normals = false;
 };
 PredictiveResiduals predictive_residuals(const NodeGeometry& geometry, const QuantizedNode& node,
                                          std::span<const uint32_t> predictors,

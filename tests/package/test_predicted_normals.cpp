@@ -1,0 +1,150 @@
+// Normals coded in the frame of their prediction (predicted_normals.hpp): what the decoder rebuilds from the
+// codes, in any frame (degenerate and seam predictions included), and the encoder's choice of the plain or
+// the smoothed prediction.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <numeric>
+#include <random>
+
+#include "core/mesh.hpp"
+#include "package/byte_planes.hpp"
+#include "package/predicted_normals.hpp"
+#include "support/shapes.hpp"
+
+namespace lodstream::test {
+namespace {
+
+using namespace package;
+
+double angle(glm::vec3 a, glm::vec3 b) {
+  const glm::dvec3 x(a), y(b);
+  return std::atan2(glm::length(glm::cross(x, y)), glm::dot(x, y));
+}
+
+// The decoder's normals from the encoder's codes against `sum`.
+std::vector<glm::vec3> round_trip(std::span<const glm::vec3> normals, std::span<const NormalSum> sum,
+                                  uint32_t bits) {
+  std::vector<uint32_t> order(normals.size());
+  std::iota(order.begin(), order.end(), 0u);
+  uint32_t width = 0;
+  const std::vector<uint64_t> codes = normal_residuals(normals, order, sum, bits, width);
+  std::vector<uint8_t> planes;
+  put_planes(planes, codes, 2, width);
+  std::vector<glm::vec3> decoded;
+  decode_predicted_normals(sum, uint32_t(normals.size()), planes.data(), width, bits, decoded);
+  return decoded;
+}
+
+TEST(PredictedNormals, EveryNormalComesBackInAnyFrame) {
+  // Random normals against random predictions (so the codes cover the whole sphere), and predictions at the
+  // frame's seam (z = +-0), at its poles, zero, tiny, huge, infinite and NaN sums (the +z frame).
+  std::mt19937 rng(3);
+  std::normal_distribution<float> g;
+  const NormalSum special[] = {{0, 0, 0, 0},   {1, 0, 0, 0},        {0, 1, -0.0f, 0},     {0, 0, -1, 0},
+                               {0, 0, 1, 0},   {1e-30f, 0, 0, 0},   {3e38f, 3e38f, 1, 0}, {INFINITY, 0, 0},
+                               {NAN, 0, 1, 0}, {-1, -1, -1e-30f, 0}};
+  for (uint32_t bits : {8u, 9u, 12u, 16u}) {
+    const size_t V = 4003;  // not a multiple of 4
+    std::vector<glm::vec3> normals(V);
+    std::vector<NormalSum> sum((V + 3) & ~size_t(3), NormalSum{0, 0, 0, 0});
+    for (size_t v = 0; v < V; ++v) {
+      normals[v] = glm::normalize(glm::vec3(g(rng), g(rng), g(rng)));
+      sum[v] = v % 5 == 0 ? special[(v / 5) % std::size(special)] : NormalSum{g(rng), g(rng), g(rng), 0};
+    }
+    const std::vector<glm::vec3> decoded = round_trip(normals, sum, bits);
+    ASSERT_EQ(decoded.size(), V);
+    double worst = 0.0;
+    for (size_t v = 0; v < V; ++v) {
+      EXPECT_NEAR(glm::length(decoded[v]), 1.0f, 1e-5f) << v;
+      worst = std::max(worst, angle(decoded[v], normals[v]));
+    }
+    // The frame's codes are 1 / 0.52 times as wide as the global b-bit code's, whose rounding errs by less
+    // than 5 * 2^-bits radians (test_codec's Octahedral test).
+    EXPECT_LT(worst, std::ldexp(5.0 / 0.52, -int(bits))) << bits << " bits";
+    EXPECT_GT(worst, std::ldexp(0.5, -int(bits))) << bits << " bits";  // and the precision is really that
+  }
+}
+
+TEST(PredictedNormals, AWellPredictedNormalStoresZeros) {
+  // Normals equal to their (unnormalized) predictions code as (0, 0) in their frames, whatever their length.
+  std::mt19937 rng(5);
+  std::normal_distribution<float> g;
+  std::vector<NormalSum> sum(64);
+  std::vector<glm::vec3> normals(64);
+  std::vector<uint32_t> order(64);
+  std::iota(order.begin(), order.end(), 0u);
+  for (size_t v = 0; v < 64; ++v) {
+    sum[v] = NormalSum{g(rng), g(rng), g(rng), 0} * float(v + 1);
+    normals[v] = glm::normalize(glm::vec3(sum[v][0], sum[v][1], sum[v][2]));
+  }
+  uint32_t width = 0;
+  const std::vector<uint64_t> codes = normal_residuals(normals, order, sum, 9, width);
+  EXPECT_EQ(width, 1u);
+  for (uint64_t c : codes) EXPECT_EQ(c, 0u);
+}
+
+// code_normals on a mesh whose triangles the decoder sees as `m.indices`, over `positions`.
+NormalCodes codes_of(const Mesh& m, const std::vector<glm::vec3>& positions, uint32_t bits) {
+  std::vector<uint32_t> order(m.vertex_count());
+  std::iota(order.begin(), order.end(), 0u);
+  std::vector<glm::vec3> padded(positions);
+  padded.push_back(glm::vec3(0.0f));  // predicted_normals reads one past the last
+  return code_normals(m.normals, order, m.indices, 0, uint32_t(m.vertex_count()), padded.data(), bits);
+}
+
+uint64_t bits_of(const NormalCodes& c) {
+  uint64_t b = 0;
+  for (uint64_t code : c.codes) b += std::bit_width(code);
+  return b;
+}
+
+TEST(PredictedNormals, TheEncoderSmoothsWhereQuantizedPositionsTiltTheFacesButNotAcrossACrease) {
+  // A finely tessellated sphere with exact normals, its positions snapped to a coarse grid: each face is
+  // tilted, the one-ring average much less.
+  Mesh ball = sphere(1.0f, 96, 192);
+  std::vector<glm::vec3> snapped = ball.positions;
+  for (glm::vec3& p : snapped) p = glm::round(p * 256.0f) / 256.0f;
+  const NormalCodes smooth_ball = codes_of(ball, snapped, 9);
+  EXPECT_TRUE(smooth_ball.smooth);
+
+  // A folded sheet (z = |x - 1/2|) whose normals are the plain prediction over its exact positions: the plain
+  // prediction stores zeros, the smoothed one bends the normals along the crease.
+  Mesh sheet = grid(16);
+  for (glm::vec3& p : sheet.positions) p.z = std::abs(p.x - 0.5f);
+  compute_smooth_normals(sheet);
+  const NormalCodes plain_sheet = codes_of(sheet, sheet.positions, 9);
+  EXPECT_FALSE(plain_sheet.smooth);
+  EXPECT_EQ(bits_of(plain_sheet), 0u);
+  std::vector<glm::vec3> padded(sheet.positions);
+  padded.push_back(glm::vec3(0.0f));
+  std::vector<NormalSum> smoothed;
+  const uint32_t sheet_vertices = uint32_t(sheet.vertex_count());
+  predicted_normals(sheet.indices, 0, sheet_vertices, padded.data(), sheet_vertices, true, smoothed);
+  std::vector<uint32_t> order(sheet_vertices);
+  std::iota(order.begin(), order.end(), 0u);
+  uint32_t width = 0;
+  const std::vector<uint64_t> bent = normal_residuals(sheet.normals, order, smoothed, 9, width);
+  EXPECT_GT(std::count_if(bent.begin(), bent.end(), [](uint64_t c) { return c != 0; }), 16);
+
+  // Both choices round-trip: the decoder rebuilds the prediction the node's flag names.
+  for (const auto& [m, positions, codes] :
+       {std::tuple(&ball, &snapped, &smooth_ball), std::tuple(&sheet, &sheet.positions, &plain_sheet)}) {
+    std::vector<glm::vec3> padded(*positions);
+    padded.push_back(glm::vec3(0.0f));
+    std::vector<NormalSum> sum;
+    const uint32_t V = uint32_t(m->vertex_count());
+    predicted_normals(m->indices, 0, V, padded.data(), V, codes->smooth, sum);
+    std::vector<uint8_t> planes;
+    put_planes(planes, codes->codes, 2, codes->width);
+    std::vector<glm::vec3> decoded;
+    decode_predicted_normals(sum, V, planes.data(), codes->width, 9, decoded);
+    for (uint32_t v = 0; v < V; ++v)
+      EXPECT_LT(angle(decoded[v], glm::normalize(m->normals[v])), std::ldexp(5.0 / 0.52, -9)) << v;
+  }
+}
+
+}  // namespace
+}  // namespace lodstream::test
