@@ -13,6 +13,8 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <numeric>
+#include <utility>
 
 #include "simplify/cluster.hpp"
 #include "simplify/counting_sort.hpp"
@@ -414,14 +416,40 @@ class Simplifier {
     if (cached) slots_.resize(w);
   }
 
+  // Vertex -> faces (offsets_, faces_), each vertex's faces in increasing order, as one loop over the
+  // corners would list them. On every core: the corners are grouped by runs of 2^kAdjacencyRunBits vertices
+  // (counting_sort, stable, their ids parked in faces_), then each run lists its vertices' faces from its
+  // own corners. A mesh of one run skips the grouping. O(T + V).
+  static constexpr uint32_t kAdjacencyRunBits = 13;
   void build_adjacency() {
-    const size_t m = source_.size();
-    offsets_.assign(m + 1, 0);
-    for (uint32_t v : indices_) ++offsets_[v + 1];
-    for (size_t v = 0; v < m; ++v) offsets_[v + 1] += offsets_[v];
-    faces_.resize(indices_.size());
-    std::vector<uint32_t> fill(offsets_.begin(), offsets_.end() - 1);
-    for (size_t c = 0; c < indices_.size(); ++c) faces_[fill[indices_[c]]++] = uint32_t(c / 3);
+    const size_t m = source_.size(), corners = indices_.size();
+    const uint32_t runs = uint32_t((m >> kAdjacencyRunBits) + 1);
+    offsets_.resize(m + 1);
+    faces_.resize(corners);
+    std::vector<uint32_t> run_start{0, uint32_t(corners)};
+    if (runs > 1)
+      counting_sort(
+          corners, runs, [&](size_t c) { return indices_[c] >> kAdjacencyRunBits; },
+          [&](size_t c, uint32_t position) { faces_[position] = uint32_t(c); }, &run_start);
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, runs, 1), [&](const auto& range) {
+      std::vector<uint32_t> parked, next;
+      for (uint32_t r = range.begin(); r < range.end(); ++r) {
+        const uint32_t lo = r << kAdjacencyRunBits;
+        const uint32_t hi = uint32_t(std::min<size_t>(m, size_t(r + 1) << kAdjacencyRunBits));
+        if (runs > 1)
+          parked.assign(faces_.begin() + run_start[r], faces_.begin() + run_start[r + 1]);
+        else
+          parked.resize(corners), std::iota(parked.begin(), parked.end(), 0u);
+        next.assign(hi - lo, 0);  // degrees, then where each vertex's next face goes
+        for (uint32_t c : parked) ++next[indices_[c] - lo];
+        for (uint32_t v = lo, at = run_start[r]; v < hi; ++v) {
+          offsets_[v] = at;
+          at += std::exchange(next[v - lo], at);
+        }
+        for (uint32_t c : parked) faces_[next[indices_[c] - lo]++] = c / 3;
+      }
+    });
+    offsets_[m] = uint32_t(corners);
   }
 
   // Out- and in-neighbours of v over its alive faces: face (v, out, in) in counter-clockwise order.
