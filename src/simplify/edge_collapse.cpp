@@ -457,23 +457,21 @@ class Simplifier {
       counting_sort(
           corners, runs, [&](size_t c) { return indices_[c] >> kAdjacencyRunBits; },
           [&](size_t c, uint32_t position) { faces_[position] = uint32_t(c); }, &run_start);
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, runs, 1), [&](const auto& range) {
-      std::vector<uint32_t> parked, next;
-      for (uint32_t r = range.begin(); r < range.end(); ++r) {
-        const uint32_t lo = r << kAdjacencyRunBits;
-        const uint32_t hi = uint32_t(std::min<size_t>(m, size_t(r + 1) << kAdjacencyRunBits));
-        if (runs > 1)
-          parked.assign(faces_.begin() + run_start[r], faces_.begin() + run_start[r + 1]);
-        else
-          parked.resize(corners), std::iota(parked.begin(), parked.end(), 0u);
-        next.assign(hi - lo, 0);  // degrees, then where each vertex's next face goes
-        for (uint32_t c : parked) ++next[indices_[c] - lo];
-        for (uint32_t v = lo, at = run_start[r]; v < hi; ++v) {
-          offsets_[v] = at;
-          at += std::exchange(next[v - lo], at);
-        }
-        for (uint32_t c : parked) faces_[next[indices_[c] - lo]++] = c / 3;
+    for_each(uint32_t(0), runs, [&](uint32_t r) {
+      const uint32_t lo = r << kAdjacencyRunBits;
+      const uint32_t hi = uint32_t(std::min<size_t>(m, size_t(r + 1) << kAdjacencyRunBits));
+      std::vector<uint32_t> parked(run_start[r + 1] - run_start[r]);
+      if (runs > 1)
+        std::copy(faces_.begin() + run_start[r], faces_.begin() + run_start[r + 1], parked.begin());
+      else
+        std::iota(parked.begin(), parked.end(), 0u);
+      std::vector<uint32_t> next(hi - lo, 0);  // degrees, then where each vertex's next face goes
+      for (uint32_t c : parked) ++next[indices_[c] - lo];
+      for (uint32_t v = lo, at = run_start[r]; v < hi; ++v) {
+        offsets_[v] = at;
+        at += std::exchange(next[v - lo], at);
       }
+      for (uint32_t c : parked) faces_[next[indices_[c] - lo]++] = c / 3;
     });
     offsets_[m] = uint32_t(corners);
   }
