@@ -971,11 +971,8 @@ class Simplifier {
             prefetch(k, end);
             const uint32_t i = sorted_[k].slot;
             pending_[i] = 0;
-            const Candidate c = listed(order_[i].slot);
             Plan p;
-            if (c.a == kNone || touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
-            p.slot = order_[i].slot;
-            if (p.a2 != kNone && (touched_[p.a2] || touched_[p.b2])) continue;
+            if (!plan_listed(i, p)) continue;
             switch (try_collapse(p, s)) {
               case Outcome::kCollapsed:
                 ++here;
@@ -1007,15 +1004,20 @@ class Simplifier {
       const uint32_t i = sorted_[k].slot;
       if (order_[i].cost > limit || alive_triangles_ - s.removed_triangles <= target) break;
       if (!small_) prefetch(k, end);
-      const Candidate c = listed(order_[i].slot);
       Plan p;
-      if (c.a == kNone || touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) continue;
-      p.slot = order_[i].slot;
-      if (p.a2 != kNone && (touched_[p.a2] || touched_[p.b2])) continue;
-      if (try_collapse(p, s) == Outcome::kCollapsed) ++collapsed;
+      if (plan_listed(i, p) && try_collapse(p, s) == Outcome::kCollapsed) ++collapsed;
     }
     gather(s);
     return collapsed;
+  }
+
+  // The plan of order_ entry i for the collapse loop; false when it is skipped: its face died, an end (or a
+  // seam twin's) was touched by an earlier collapse of the pass, or the kind rules forbid it.
+  bool plan_listed(uint32_t i, Plan& p) const {
+    const Candidate c = listed(order_[i].slot);
+    if (c.a == kNone || touched_[c.a] || touched_[c.b] || !can_remove(c.a, c.b, p)) return false;
+    p.slot = order_[i].slot;
+    return p.a2 == kNone || (!touched_[p.a2] && !touched_[p.b2]);
   }
 
   uint32_t region_of(uint32_t v) const { return (v + region_shift_) / region_vertices_; }
