@@ -90,8 +90,8 @@ struct Result {
 };
 
 // Simplifies `mesh`. Cost: O(T log T) time over a few passes, using every core for the set-up (weld,
-// quadrics, classification, sorts), cost evaluation and the collapse loop; memory about 150 bytes per input
-// triangle (elephant_1m: 191 B/tri peak for the whole `lodstream simplify`, import and export included).
+// quadrics, classification, sorts), cost evaluation and the collapse loop; memory about 130 bytes per input
+// triangle (elephant_1m: 169 B/tri peak for the whole `lodstream simplify`, import and export included).
 // Never throws on odd input (non-manifold, degenerate, empty).
 Result simplify_mesh(const Mesh& mesh, const Options& options);
 
