@@ -47,17 +47,14 @@ class ResidualDecoder {
   void finish() const;
 
  private:
-  uint32_t next_symbol();
-  uint64_t raw_bits(uint32_t n);
-
   const std::string& where_;
-  std::vector<uint8_t> symbol_;  // per slot of 2^12
-  std::vector<uint16_t> frequency_, start_;
+  // Per slot of 2^12: bits 0-12 its symbol's frequency, 13-24 the slot minus the symbol's start, 25-31 the
+  // symbol.
+  std::vector<uint32_t> slot_;
   std::span<const uint8_t> rans_, raw_;
   size_t rans_at_ = 0, raw_at_ = 0;
-  uint32_t state_[2] = {0, 0};
-  uint64_t values_ = 0;  // decoded so far (which state is next)
-  uint64_t bits_ = 0;    // raw bits buffered, LSB first
+  uint32_t state_[2] = {0, 0};  // the next value's state first
+  uint64_t bits_ = 0;           // raw bits buffered, LSB first
   uint32_t bit_count_ = 0;
 };
 
