@@ -47,7 +47,7 @@ class ResidualDecoder {
   void finish() const;
 
  private:
-  const std::string& where_;
+  std::string where_;
   // Per slot of 2^12: bits 0-12 its symbol's frequency, 13-24 the slot minus the symbol's start, 25-31 the
   // symbol.
   std::vector<uint32_t> slot_;
