@@ -15,9 +15,8 @@
 // residual_coder.hpp (an entropy coder of our own, order 0, rANS), which zstd then stores as it is (a block
 // of its own, incompressible). The writer keeps the smaller as zstd stores it (a second compression of the
 // part alone): on scans the coded form (sub-bit codes for the many tiny residuals), on regular synthetic
-// meshes the planes (zstd's matches find repeated residual runs that an order-0 coder cannot). Measured
-// (bake, codec 3, default options), format 4 -> 5: see residual_coder.hpp and the helper's report
-// (session of 2026-12-01, "ctxcode").
+// meshes the planes (zstd's matches find repeated residual runs that an order-0 coder cannot: a page of a
+// UV sphere took 6,786 B coded against 5,081 B whole). Measured format 4 -> 5 in residual_coder.hpp.
 //
 // The regrouped bytes (the zstd frame's content): six varints, the sizes of the six part streams; then the
 // streams. The header stream holds, per node in page order, varint node size then the node's header; the
