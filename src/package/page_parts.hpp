@@ -9,14 +9,14 @@
 // 539,775 (-5.2 %) -> 530,950 (-0.9 %), motorBike (10-bit normals) 2,607,957 -> 2,528,943 (-3.0 %), then -1.4
 // %; decode (bench_package, codec 3, checksum + zstd + codec) 33.4 -> 31.4 M triangles/s per core (load 5.5).
 //
-// Format 5: six parts (header, positions, normals, attributes, locked, connectivity), and for the byte-plane
+// Format 6: six parts (header, positions, normals, attributes, locked, connectivity), and for the byte-plane
 // codecs (2, 3) a residual part (positions, normals) is, when not empty, a form byte then either (0) the
 // nodes' planes, as format 4 stored them, or (1) the residuals of all the page's nodes as one stream of
 // residual_coder.hpp (an entropy coder of our own, order 0, rANS), which zstd then stores as it is (a block
 // of its own, incompressible). The writer keeps the smaller as zstd stores it (a second compression of the
 // part alone): on scans the coded form (sub-bit codes for the many tiny residuals), on regular synthetic
 // meshes the planes (zstd's matches find repeated residual runs that an order-0 coder cannot: a page of a
-// UV sphere took 6,786 B coded against 5,081 B whole). Measured format 4 -> 5 in residual_coder.hpp.
+// UV sphere took 6,786 B coded against 5,081 B whole). Measured format 5 -> 6 in residual_coder.hpp.
 //
 // The regrouped bytes (the zstd frame's content): six varints, the sizes of the six part streams; then the
 // streams. The header stream holds, per node in page order, varint node size then the node's header; the

@@ -77,7 +77,8 @@ TEST(ResidualCoder, DecodesToThePlanesOfTheResiduals) {
 TEST(ResidualCoder, OneSymbolAloneAndNoResiduals) {
   const std::vector<uint64_t> zeros(1000, 0);
   const std::vector<uint8_t> stream = encode_residuals(zeros);
-  EXPECT_LT(stream.size(), 16u);  // one symbol of probability 1 costs nothing
+  EXPECT_LE(stream.size(), 21u);  // one symbol of probability 1 costs nothing: D, A, its frequency, the
+                                  // size and the four states
   std::vector<uint8_t> planes(3000, 7);
   ResidualDecoder decoder(stream, "s");
   decoder.planes(500, 2, 3, planes.data());
@@ -120,11 +121,16 @@ TEST(ResidualCoder, CorruptedStreamsAreErrorsNeverOutOfBounds) {
   std::vector<uint8_t> bad = good;
   bad.push_back(0);
   expect_error(bad, "a byte too many");
+  for (uint8_t D : {0, 8, 255}) {
+    bad = good;
+    bad[0] = D;  // direct bits outside 1..7
+    expect_error(bad, "direct bits");
+  }
   bad = good;
-  bad[0] = 81;  // more symbols than 40-bit residuals have
+  bad[1] = uint8_t((1u << good[0]) + 2 * (40 - good[0]) + 1);  // more symbols than 40-bit residuals have
   expect_error(bad, "table size");
   bad = good;
-  bad[1] ^= 1;  // the first frequency: the table no longer adds up to 2^12
+  bad[2] ^= 1;  // the first frequency: the table no longer adds up to 2^12
   expect_error(bad, "table sum");
   // A residual of 9 bits in a node of 1-byte planes.
   const std::vector<uint64_t> wide = {0, 300, 1};
