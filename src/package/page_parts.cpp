@@ -42,6 +42,8 @@ void put_varint(std::vector<uint8_t>& out, uint64_t v) {
 
 // The residual part's forms (page_parts.hpp).
 constexpr uint8_t kPlanesForm = 0, kCodedForm = 1;
+// The bits a residual the coded form must save over the zstd'd planes (page_parts.hpp).
+constexpr double kMinSavedBits = 0.2;
 
 // The regrouped bytes (page_parts.hpp), as the size varints and the six streams, each residual part in the
 // smaller form (measured as zstd at `level` / `min_match` stores it); nullopt when a node's bytes do not
@@ -87,7 +89,11 @@ std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<co
       std::vector<uint8_t> form = {kCodedForm};
       const std::vector<uint8_t> stream = encode_residuals(residuals[p]);
       form.insert(form.end(), stream.begin(), stream.end());
-      if (form.size() >= zstd_compress(out[1 + p], level, min_match).size()) {  // repeats zstd finds
+      // Coded only when it saves kMinSavedBits a residual (page_parts.hpp): not where zstd finds repeats,
+      // nor where it saves too little to pay for its decode.
+      const double saved_bits =
+          8 * (double(zstd_compress(out[1 + p], level, min_match).size()) - form.size());
+      if (saved_bits < kMinSavedBits * double(residuals[p].size())) {
         form.assign(1, kPlanesForm);
         form.insert(form.end(), out[1 + p].begin(), out[1 + p].end());
       }

@@ -16,7 +16,12 @@
 // of its own, incompressible). The writer keeps the smaller as zstd stores it (a second compression of the
 // part alone): on scans the coded form (sub-bit codes for the many tiny residuals), on regular synthetic
 // meshes the planes (zstd's matches find repeated residual runs that an order-0 coder cannot: a page of a
-// UV sphere took 6,786 B coded against 5,081 B whole). Measured format 5 -> 6 in residual_coder.hpp.
+// UV sphere took 6,786 B coded against 5,081 B whole). The coded form must also pay for its decode, about 25
+// instructions a residual against about 3 for zstd's Huffman stage over the planes: it is kept only when
+// it saves at least 0.2 bit a residual. Measured (whole pages, coded against zstd'd planes): on the pages
+// of bench_package (refined_elephant) the positions save 0.12 bit a residual, the normals 0.34; elephant_1m
+// 0.26 and 0.30. With both coded BM_Decode/4 took ~440 instructions a triangle (callgrind, decode_node +
+// unpack_page; 382 all planes), with the rule 404. Sizes in residual_coder.hpp and the helper's report.
 //
 // The regrouped bytes (the zstd frame's content): six varints, the sizes of the six part streams; then the
 // streams. The header stream holds, per node in page order, varint node size then the node's header; the

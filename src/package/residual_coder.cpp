@@ -39,7 +39,8 @@ inline uint32_t symbols_for(uint32_t D) {
 }
 
 // Frequencies adding up to kScale, every symbol that occurs at least 1, about proportional to `counts`.
-std::array<uint32_t, kMaxSymbols> normalized(const std::array<uint32_t, kMaxSymbols>& counts, uint64_t total) {
+std::array<uint32_t, kMaxSymbols> normalized(const std::array<uint32_t, kMaxSymbols>& counts,
+                                             uint64_t total) {
   std::array<uint32_t, kMaxSymbols> f{};
   uint64_t sum = 0;
   for (uint32_t s = 0; s < kMaxSymbols; ++s) {
@@ -63,7 +64,8 @@ std::array<uint32_t, kMaxSymbols> normalized(const std::array<uint32_t, kMaxSymb
 // The symbols' counts with D direct bits, from the counts of the values below 2^kMaxDirect (`low`) and of
 // the bit lengths k > kMaxDirect of the others (`lengths`, at k).
 std::array<uint32_t, kMaxSymbols> symbol_counts(const std::array<uint32_t, 1u << kMaxDirect>& low,
-                                                const std::array<uint32_t, kMaxBits + 1>& lengths, uint32_t D) {
+                                                const std::array<uint32_t, kMaxBits + 1>& lengths,
+                                                uint32_t D) {
   std::array<uint32_t, kMaxSymbols> counts{};
   for (uint32_t z = 0; z < (1u << kMaxDirect); ++z) counts[symbol_of(z, D)] += low[z];
   for (uint32_t k = kMaxDirect + 1; k <= kMaxBits; ++k) counts[(1u << D) + k - D - 1] += lengths[k];
@@ -87,9 +89,9 @@ double estimated_bits(const std::array<uint32_t, 1u << kMaxDirect>& low,
   return bits;
 }
 
-// x < kLow: x = x << 16 | next and at += 2, else neither; with conditional moves, not a branch (GCC 12
-// compiles every C form of it, hints included, to a branch, which mispredicts on every read: about one
-// step in ten on these residuals, a third of the decode time).
+// x < kLow: x = x << 16 | next and at += 2, else neither; with conditional moves, not a branch (a read
+// comes about every 16 bits of code, every few steps: a branch mispredicts on most, and GCC 12 compiles
+// every C form of the selection, hints included, to a branch).
 inline __attribute__((always_inline)) void renormalize(uint32_t& x, size_t& at, uint16_t next) {
   const uint32_t read = x << 16 | next;
 #if defined(__x86_64__)
@@ -121,7 +123,8 @@ std::vector<uint8_t> encode_residuals(std::span<const uint64_t> values) {
   }
   // D: the largest whose estimate is within kDirectTolerance of the smallest (residual_coder.hpp).
   std::array<double, kMaxDirect + 1> bits{};
-  for (uint32_t d = kMinDirect; d <= kMaxDirect; ++d) bits[d] = estimated_bits(low, lengths, d, values.size());
+  for (uint32_t d = kMinDirect; d <= kMaxDirect; ++d)
+    bits[d] = estimated_bits(low, lengths, d, values.size());
   const double fewest = *std::min_element(bits.begin() + kMinDirect, bits.end());
   uint32_t D = kMaxDirect;
   while (bits[D] > fewest * (1 + kDirectTolerance)) --D;
@@ -197,8 +200,8 @@ ResidualDecoder::ResidualDecoder(std::span<const uint8_t> stream, const std::str
   std::memcpy(bytes_.data(), rest.data(), rest.size());
   rans_end_ = size, raw_bit_at_ = 8 * size, raw_bit_end_ = 8 * uint64_t(rest.size());
   for (uint32_t k = 0; k < kStates; ++k) {
-    uint32_t x = 0;
-    for (uint32_t b = 0; b < 4; ++b) x |= uint32_t(bytes_[4 * k + b]) << (8 * b);
+    uint32_t x;
+    std::memcpy(&x, bytes_.data() + 4 * k, 4);
     if (x < kLow) fail("invalid residual rANS state");
     state_[k] = x;
   }
@@ -209,8 +212,12 @@ void ResidualDecoder::fail(const char* what) const {
   throw Error(where_ + ": " + what);
 }
 
-template <uint32_t W>
-void ResidualDecoder::decode(size_t count, uint32_t width, size_t plane, uint8_t* out) {
+void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, uint8_t* planes) {
+  if (count == 0) return;
+  if (slot_.empty()) fail("residuals past the residual stream's end");
+  const size_t values = components * count;
+  // The higher planes are zero but for values of raw bits, which write their higher bytes themselves.
+  std::memset(planes + values, 0, (width - 1) * values);
   // The decoder's state in locals (registers) for the loop, written back after it; x0 decodes next.
   const uint32_t* slots = slot_.data();
   const uint8_t* bytes = bytes_.data();
@@ -220,44 +227,37 @@ void ResidualDecoder::decode(size_t count, uint32_t width, size_t plane, uint8_t
   const size_t rans_end = rans_end_;
   const uint32_t D = direct_bits_, direct = 1u << D;
   uint32_t x0 = state_[0], x1 = state_[1], x2 = state_[2], x3 = state_[3];
-  const uint32_t w = W ? W : width;
-  const uint64_t largest = w >= 8 ? ~uint64_t(0) : (uint64_t(1) << (8 * w)) - 1;
+  const uint64_t largest = width >= 8 ? ~uint64_t(0) : (uint64_t(1) << (8 * width)) - 1;
   // One step (rANS, Duda 2013, eq. 9: D(x) = (s, f_s floor(x / 2^12) + x mod 2^12 - start_s), s the
-  // symbol of slot x mod 2^12), then x read back up to kLow from the next 2 rANS bytes (loaded whether
-  // needed or not, so no branch: bytes_' padding keeps the load inside the buffer); a value's raw bits,
-  // rare (residual_coder.hpp), take a branch.
-  const auto step = [&](uint32_t& x, size_t i) __attribute__((always_inline)) {
+  // symbol of slot x mod 2^12), then x read back up to kLow from the next 2 rANS bytes; a value's raw
+  // bits, rare (residual_coder.hpp), take a branch too.
+  const auto step = [&](uint32_t & x, size_t i) __attribute__((always_inline)) {
     const uint32_t e = slots[x & (kScale - 1)], s = e >> 25;
     x = (e & 0x1fff) * (x >> kScaleBits) + ((e >> 13) & 0xfff);
     uint16_t next;
     std::memcpy(&next, bytes + at, 2);
     renormalize(x, at, next);
-    uint64_t z = s;
+    planes[i] = uint8_t(s);
     if (s >= direct) [[unlikely]] {
       const uint32_t n = s - direct + D;  // k - 1 raw bits below the leading one
       if (raw_end - raw_at < n) fail("residual raw bits end early");
       uint64_t word;  // 8 bytes from the one holding the next bit: at least 57 bits, n <= 39 needed
       std::memcpy(&word, bytes + (raw_at >> 3), 8);
-      z = uint64_t(1) << n | ((word >> (raw_at & 7)) & ((uint64_t(1) << n) - 1));
+      const uint64_t z = uint64_t(1) << n | ((word >> (raw_at & 7)) & ((uint64_t(1) << n) - 1));
       raw_at += n;
       if (z > largest) fail("residual wider than its node's planes");
-    }
-    out[i] = uint8_t(z);
-    if constexpr (W == 2) {
-      out[plane + i] = uint8_t(z >> 8);
-    } else if constexpr (W == 0) {
-      for (uint32_t b = 1; b < w; ++b) out[b * plane + i] = uint8_t(z >> (8 * b));
+      for (uint32_t b = 0; b < width; ++b) planes[b * values + i] = uint8_t(z >> (8 * b));
     }
   };
-  // Blocks of kStates values, each reading at most 8 bytes: started only while at is within the rANS bytes,
-  // so that no read leaves the padding.
+  // Values in blocks of kStates, then one by one, rotating the states. A block reads at most 8 bytes:
+  // started only while at is within the rANS bytes, so that no read leaves the padding.
   size_t i = 0;
-  for (; count - i >= kStates; i += kStates) {
+  for (; values - i >= kStates; i += kStates) {
     if (at > rans_end) break;
     step(x0, i), step(x1, i + 1), step(x2, i + 2), step(x3, i + 3);
   }
   if (at <= rans_end)
-    for (; i < count; ++i) {
+    for (; i < values; ++i) {
       step(x0, i);
       const uint32_t t = x0;
       x0 = x1, x1 = x2, x2 = x3, x3 = t;
@@ -267,21 +267,6 @@ void ResidualDecoder::decode(size_t count, uint32_t width, size_t plane, uint8_t
   rans_at_ = at, raw_bit_at_ = raw_at;
 }
 
-void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, uint8_t* planes) {
-  if (count == 0) return;
-  if (slot_.empty()) fail("residuals past the residual stream's end");
-  const size_t plane = components * count;
-  for (uint32_t a = 0; a < components; ++a) {
-    uint8_t* out = planes + a * count;
-    if (width == 1)
-      decode<1>(count, width, plane, out);
-    else if (width == 2)
-      decode<2>(count, width, plane, out);
-    else
-      decode<0>(count, width, plane, out);
-  }
-}
-
 void ResidualDecoder::finish() const {
   if (slot_.empty()) return;
   bool states_back = true;
@@ -289,8 +274,7 @@ void ResidualDecoder::finish() const {
   // Raw bits: up to the last byte, and none set beyond the last one read.
   const bool bits_left = (raw_bit_at_ + 7) / 8 != raw_bit_end_ / 8 ||
                          (raw_bit_at_ % 8 && bytes_[raw_bit_at_ / 8] >> (raw_bit_at_ % 8));
-  if (rans_at_ != rans_end_ || !states_back || bits_left)
-    fail("residual stream holds bytes of no residual");
+  if (rans_at_ != rans_end_ || !states_back || bits_left) fail("residual stream holds bytes of no residual");
 }
 
 }  // namespace lodstream::package

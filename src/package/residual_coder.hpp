@@ -2,15 +2,14 @@
 // codecs 2 and 3), replacing zstd for those page parts (page_parts.hpp). zstd codes a byte plane's bytes with
 // a Huffman table, at least one bit per byte: most residuals are tiny (a normal residual is 0 at most
 // interior vertices), and their best code is well under a bit. Here each value z is a symbol: z itself when
-// z < 2^D (a direct value; D, 1..7, chosen per stream), else its magnitude class with the bit below the
-// leading one (2^D + 2 (k - D - 1) + bit k-2 of z, k > D the bit length of z) followed by its k - 2
-// remaining low bits, stored raw. The symbols are coded by rANS (Duda 2013, "Asymmetric numeral systems:
-// entropy coding combining speed of Huffman coding with compression rate of arithmetic coding",
-// arXiv:1311.2540; 32-bit states renormalized 16 bits at a time, so that a decode step reads at most once,
-// without a branch) with one static frequency table per stream, stored in front of it, and four interleaved
-// states (value i takes state i mod 4) so that the decoder's four dependency chains overlap. No Debian
-// library offers coding of our own symbol alphabet with tables of our own (zstd's and lzma's entropy stages
-// are internal to their formats), hence this file.
+// z < 2^D (a direct value; D, 1..6, chosen per stream), else its bit length k > D (symbol 2^D + k - D - 1)
+// followed by its k - 1 bits below the leading one, stored raw. The symbols are coded by rANS (Duda 2013,
+// "Asymmetric numeral systems: entropy coding combining speed of Huffman coding with compression rate of
+// arithmetic coding", arXiv:1311.2540; 32-bit states renormalized 16 bits at a time, so that a decode step
+// reads at most once, with conditional moves rather than a branch) with one static frequency table per
+// stream, stored in front of it, and four interleaved states (value i takes state i mod 4) so that the
+// decoder's four dependency chains overlap. No Debian library offers coding of our own symbol alphabet with
+// tables of our own (zstd's and lzma's entropy stages are internal to their formats), hence this file.
 //
 // Measured before building it (an offline estimate over every page of the baked packages, each page's model
 // alone, table costs included; bench sessions of 2026-12-01, helper "ctxcode"): order-0 coding of these
@@ -19,14 +18,18 @@
 // residuals, the gate edge's length, the other component's class, valence) gained at most 1-2 % more and
 // most lost to their tables, so the coder is order 0.
 //
-// Direct values: a decode step of a direct value (or of a class with no raw bits) is a table lookup, a
-// multiply and a conditional 16-bit read, with no branch; only classes with raw bits take the slower path.
-// The encoder picks D as the smallest estimated size over D = 1..7 (codes and table); larger D code the
-// low bits by their frequencies instead of raw, so they are never much larger and decode faster.
+// Direct values are for speed: a decode step of one is a table lookup, a multiply and a conditional 16-bit
+// read, with no branch; only values of raw bits take a (rarely taken) branch. The encoder estimates the size
+// for each D (codes, raw bits, table) and takes the largest D within 0.5 % of the smallest: on the pages of
+// bench_package (refined_elephant) that is D = 5-6 for positions and 3-5 for normals, leaving about 1 % of
+// the values with raw bits (a D of 1-3 would be up to 1 % smaller and leave 10-70 %, each a mispredicted
+// branch). The first form of this coder (every value a class and raw bits, two states, a renormalization
+// branch) cost 600 instructions a triangle in BM_Decode/4 against 382 with zstd'd planes; this one ~440
+// when both parts are coded (callgrind, decode_node + unpack_page).
 //
-// A stream (no bytes for no values): u8 D (1..7), u8 A (symbols in the table, 1..2^D + 2 (40 - D)), A varint
+// A stream (no bytes for no values): u8 D (1..6), u8 A (symbols in the table, 1..2^D + 40 - D), A varint
 // frequencies adding up to 2^12, varint size of the rANS bytes, the rANS bytes (the four final states
-// first), then the raw bits (LSB first, in value order).
+// first, u32 LE each; then u16 LE reads), then the raw bits (LSB first, in value order).
 #pragma once
 
 #include <cstdint>
@@ -36,7 +39,7 @@
 
 namespace lodstream::package {
 
-// The stream of `values` (zigzagged, each below 2^40). Cost: O(values.size()), two passes, and 7 estimates
+// The stream of `values` (zigzagged, each below 2^40). Cost: O(values.size()), two passes, and 6 estimates
 // over a histogram for D.
 std::vector<uint8_t> encode_residuals(std::span<const uint64_t> values);
 
@@ -45,21 +48,17 @@ std::vector<uint8_t> encode_residuals(std::span<const uint64_t> values);
 // reads outside its bytes or writes outside the planes asked for.
 class ResidualDecoder {
  public:
-  // Parses the table. Cost: O(2^12) (the decode table, 4 KB) and a copy of the stream.
+  // Parses the table. Cost: O(2^12) (the decode table, 16 KB) and a copy of the stream.
   ResidualDecoder(std::span<const uint8_t> stream, const std::string& where);
   // The next count * components values, component by component, as `width` byte planes (put_planes'
   // layout: byte b of component a of value i at planes[(b * components + a) * count + i]); a value needing
-  // more than 8 width bytes throws. Cost: O(count * components * width); about 20 instructions a direct
+  // more than 8 width bytes throws. Cost: O(count * components * width); about 25 instructions a direct
   // value.
   void planes(size_t count, uint32_t components, uint32_t width, uint8_t* planes);
   // Throws unless every byte and bit of the stream was used and the states are back to their start.
   void finish() const;
 
  private:
-  // Decodes count values into out[i] (their higher bytes at out[b * plane + i]), W their width (0: any,
-  // `width`).
-  template <uint32_t W>
-  void decode(size_t count, uint32_t width, size_t plane, uint8_t* out);
   [[noreturn]] void fail(const char* what) const;
 
   std::string where_;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <set>
 
 #include "core/error.hpp"
 #include "package/byte_planes.hpp"
@@ -92,6 +93,25 @@ TEST(ResidualCoder, OneSymbolAloneAndNoResiduals) {
   EXPECT_THROW(none.planes(1, 3, 1, planes.data()), Error);
 }
 
+TEST(ResidualCoder, EveryDirectWidthTheEncoderPicksDecodes) {
+  // Geometric residuals of growing scale, in short and longer streams: the encoder's D (the stream's first
+  // byte) follows the scale and the table's cost, every D occurs, and each stream decodes back, its values
+  // of raw bits included.
+  std::set<uint8_t> picked;
+  for (size_t count : {100, 1000})
+    for (uint32_t scale = 0; scale < 12; ++scale) {
+      std::mt19937_64 rng(scale);
+      std::geometric_distribution<uint64_t> geometric(1.0 / (1 + (uint64_t(1) << scale)));
+      Residuals r;
+      r.counts = {count}, r.widths = {5};
+      for (size_t i = 0; i < 3 * count; ++i) r.values.push_back(geometric(rng) & ((uint64_t(1) << 40) - 1));
+      const std::vector<uint8_t> stream = encode_residuals(r.values);
+      picked.insert(stream[0]);
+      EXPECT_EQ(decoded_planes(stream, r), expected_planes(r)) << "scale " << scale;
+    }
+  EXPECT_EQ(picked, (std::set<uint8_t>{1, 2, 3, 4, 5, 6}));
+}
+
 TEST(ResidualCoder, MostlyZeroResidualsTakeWellUnderABitEach) {
   std::mt19937 rng(1);
   std::vector<uint64_t> values(30000);
@@ -132,6 +152,18 @@ TEST(ResidualCoder, CorruptedStreamsAreErrorsNeverOutOfBounds) {
   bad = good;
   bad[2] ^= 1;  // the first frequency: the table no longer adds up to 2^12
   expect_error(bad, "table sum");
+  bad = good;
+  bad.insert(bad.begin() + 2, {0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0x7f});  // a huge frequency
+  expect_error(bad, "huge frequency");
+  // A huge rANS size, and a first state below the states' range, in a stream of one symbol.
+  const std::vector<uint8_t> zeros = encode_residuals(std::vector<uint64_t>(100, 0));
+  ASSERT_EQ(zeros.size(), 21u);  // D, A = 1, frequency 4096 (2 bytes), size 16, four states
+  bad = zeros;
+  bad[4] = 0xff, bad.insert(bad.begin() + 5, {0xff, 0xff, 0xff, 0x7f});
+  EXPECT_THROW(ResidualDecoder(bad, "s"), Error);
+  bad = zeros;
+  bad[5] = bad[6] = bad[7] = bad[8] = 0;
+  EXPECT_THROW(ResidualDecoder(bad, "s"), Error);
   // A residual of 9 bits in a node of 1-byte planes.
   const std::vector<uint64_t> wide = {0, 300, 1};
   std::vector<uint8_t> out(3);
