@@ -11,7 +11,7 @@
 //
 // Format 6: six parts (header, positions, normals, attributes, locked, connectivity), and for the byte-plane
 // codecs (2, 3) a residual part (positions, normals) is, when not empty, a form byte then either (0) the
-// nodes' planes, as format 4 stored them, or (1) the residuals of all the page's nodes as one stream of
+// nodes' planes as the nodes hold them, or (1) the residuals of all the page's nodes as one stream of
 // residual_coder.hpp (an entropy coder of our own, order 0, rANS), which zstd then stores as it is (a block
 // of its own, incompressible). The writer keeps the smaller as zstd stores it (a second compression of the
 // part alone): on scans the coded form (sub-bit codes for the many tiny residuals), on regular synthetic
@@ -21,7 +21,7 @@
 // it saves at least 0.2 bit a residual. Measured (whole pages, coded against zstd'd planes): on the pages
 // of bench_package (refined_elephant) the positions save 0.12 bit a residual, the normals 0.34; elephant_1m
 // 0.26 and 0.30. With both coded BM_Decode/4 took ~440 instructions a triangle (callgrind, decode_node +
-// unpack_page; 382 all planes), with the rule 404. Sizes in residual_coder.hpp and the helper's report.
+// unpack_page; 382 all planes), with the rule 404. Sizes in residual_coder.hpp.
 //
 // The regrouped bytes (the zstd frame's content): six varints, the sizes of the six part streams; then the
 // streams. The header stream holds, per node in page order, varint node size then the node's header; the
