@@ -26,7 +26,8 @@ inline constexpr std::array<uint8_t, 8> kMagic = {0x89, 'L', 'O', 'D', 'S', '\r'
 // 2: node records coded against their run (index.hpp); 3: data pages stored by part (page_parts.hpp); 4: a
 // node record names its cluster within a record of several clusters (index.hpp, NodeRecord::cluster); 5:
 // compact (error, sphere) pairs (index.hpp, pair_rounding.hpp); 6: normals coded in the frame of their
-// prediction (predicted_normals.hpp).
+// prediction (predicted_normals.hpp), pages of codecs 2 and 3 store their residuals entropy-coded
+// (page_parts.hpp, residual_coder.hpp).
 inline constexpr uint32_t kFormatVersion = 6;
 inline constexpr size_t kHeaderSize = 64;
 

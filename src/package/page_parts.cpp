@@ -4,26 +4,34 @@
 #include <cstring>
 
 #include "core/error.hpp"
+#include "package/byte_planes.hpp"
 #include "package/bytes.hpp"
 #include "package/format.hpp"
 #include "package/meshopt_codec.hpp"
+#include "package/residual_coder.hpp"
 
 namespace lodstream::package {
 
 namespace {
 
-// NodeSizeBreakdown's parts, in its order, the positions and normals cut into low and high byte planes.
-constexpr size_t kParts = 8;
+// NodeSizeBreakdown's parts, in its order.
+constexpr size_t kParts = 6;
+constexpr size_t kPositions = 1, kNormals = 2;
 
 std::array<size_t, kParts> part_sizes(const NodeSizeBreakdown& b) {
-  return {b.header,
-          b.position_low,
-          b.positions() - b.position_low,
-          b.normal_low,
-          b.normals - b.normal_low,
-          b.attributes,
-          b.locked,
-          b.indices};
+  return {b.header, b.positions(), b.normals, b.attributes, b.locked, b.indices};
+}
+
+// The byte planes of a node's positions (components 3) or normals (2): `low` bytes of low planes, `bytes` in
+// all (NodeSizeBreakdown); nullopt unless they are whole planes.
+struct Planes {
+  size_t count = 0;
+  uint32_t components = 0, width = 0;
+};
+std::optional<Planes> planes_of(size_t bytes, size_t low, uint32_t components) {
+  if (bytes == 0) return Planes{};
+  if (low == 0 || low % components != 0 || bytes % low != 0 || bytes / low > 5) return std::nullopt;
+  return Planes{low / components, components, uint32_t(bytes / low)};
 }
 
 void put_varint(std::vector<uint8_t>& out, uint64_t v) {
@@ -32,12 +40,22 @@ void put_varint(std::vector<uint8_t>& out, uint64_t v) {
   out.insert(out.end(), w.bytes.begin(), w.bytes.end());
 }
 
-// The regrouped bytes (page_parts.hpp), as the size varints and the eight streams; nullopt when a node's
-// bytes do not parse as the codec's.
+// The residual part's forms (page_parts.hpp).
+constexpr uint8_t kPlanesForm = 0, kCodedForm = 1;
+// The bits a residual the coded form must save over the zstd'd planes (page_parts.hpp).
+constexpr double kMinSavedBits = 0.2;
+
+// The regrouped bytes (page_parts.hpp), as the size varints and the six streams, each residual part in the
+// smaller form (measured as zstd at `level` / `min_match` stores it); nullopt when a node's bytes do not
+// parse as the codec's (or, for a byte-plane codec, hold no whole planes).
 std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<const uint8_t> page,
                                                                     std::span<const uint32_t> node_sizes,
-                                                                    const NodeCodec& codec) {
+                                                                    const NodeCodec& codec, int level,
+                                                                    int min_match) {
   std::array<std::vector<uint8_t>, kParts + 1> out;  // [0]: the stream sizes, [1 + p]: stream p
+  const bool coded = residuals_coded(codec);
+  std::vector<uint64_t> residuals[kParts];  // of kPositions and kNormals, coded
+  std::vector<int64_t> signed_residuals;
   size_t at = 0;
   for (uint32_t size : node_sizes) {
     const std::span<const uint8_t> node = page.subspan(at, size);
@@ -49,22 +67,51 @@ std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<co
     }
     put_varint(out[1], size);
     const std::array<size_t, kParts> n = part_sizes(b);
+    const std::optional<Planes> shape[kParts] = {
+        {}, planes_of(n[kPositions], b.position_low, 3), planes_of(n[kNormals], b.normal_low, 2)};
     size_t from = 0;
     for (size_t p = 0; p < kParts; ++p) {
+      if (coded && (p == kPositions || p == kNormals)) {
+        if (!shape[p]) return std::nullopt;
+        const Planes& s = *shape[p];
+        signed_residuals.resize(s.count * s.components);
+        if (s.count) read_planes(node.data() + from, s.count, s.components, s.width, signed_residuals.data());
+        for (int64_t r : signed_residuals) residuals[p].push_back(zigzag(r));
+      }
       out[1 + p].insert(out[1 + p].end(), node.begin() + from, node.begin() + from + n[p]);
       from += n[p];
     }
     at += size;
   }
+  if (coded)
+    for (size_t p : {kPositions, kNormals}) {
+      if (out[1 + p].empty()) continue;
+      std::vector<uint8_t> form = {kCodedForm};
+      const std::vector<uint8_t> stream = encode_residuals(residuals[p]);
+      form.insert(form.end(), stream.begin(), stream.end());
+      // Coded only when it saves kMinSavedBits a residual (page_parts.hpp): not where zstd finds repeats,
+      // nor where it saves too little to pay for its decode.
+      const double saved_bits =
+          8 * (double(zstd_compress(out[1 + p], level, min_match).size()) - form.size());
+      if (saved_bits < kMinSavedBits * double(residuals[p].size())) {
+        form.assign(1, kPlanesForm);
+        form.insert(form.end(), out[1 + p].begin(), out[1 + p].end());
+      }
+      out[1 + p] = std::move(form);
+    }
   for (size_t p = 0; p < kParts; ++p) put_varint(out[0], out[1 + p].size());
   return out;
 }
 
 }  // namespace
 
+bool residuals_coded(const NodeCodec& codec) {
+  return codec.id() != MeshoptCodec::kId;
+}
+
 std::vector<uint8_t> compress_page(std::span<const uint8_t> page, std::span<const uint32_t> node_sizes,
                                    const NodeCodec& codec, int level, int min_match) {
-  const auto streams = regroup(page, node_sizes, codec);
+  const auto streams = regroup(page, node_sizes, codec, level, min_match);
   if (!streams) return zstd_compress(page, level, min_match);
   std::array<std::span<const uint8_t>, kParts + 1> parts;
   for (size_t i = 0; i <= kParts; ++i) parts[i] = (*streams)[i];
@@ -94,6 +141,15 @@ std::vector<uint8_t> decompress_page(std::span<const uint8_t> stored, uint32_t r
   if (total != r.remaining()) r.fail("page part streams do not add up to the page");
   for (size_t p = 0; p < kParts; ++p) stream[p] = r.bytes(size[p], "page part stream");
 
+  std::array<bool, kParts> coded{};  // the residual parts in the coded form
+  if (residuals_coded(codec))
+    for (size_t p : {kPositions, kNormals}) {
+      if (stream[p].empty()) continue;
+      if (stream[p][0] != kPlanesForm && stream[p][0] != kCodedForm) r.fail("invalid residual part form");
+      coded[p] = stream[p][0] == kCodedForm, stream[p] = stream[p].subspan(1);
+    }
+  ResidualDecoder positions(coded[kPositions] ? stream[kPositions] : std::span<const uint8_t>(), where),
+      normals(coded[kNormals] ? stream[kNormals] : std::span<const uint8_t>(), where);
   std::vector<uint8_t> page(raw_size);
   std::array<size_t, kParts> used{};  // bytes of each stream consumed
   ByteReader headers(stream[0], where);
@@ -102,17 +158,26 @@ std::vector<uint8_t> decompress_page(std::span<const uint8_t> stored, uint32_t r
     const uint64_t node_size = headers.varint();
     if (node_size == 0 || node_size > raw_size - at) headers.fail("node size past the page's end");
     used[0] = headers.position();
-    const std::array<size_t, kParts> n =
-        part_sizes(codec.layout(stream[0].subspan(used[0]), node_size, where));
+    const NodeSizeBreakdown b = codec.layout(stream[0].subspan(used[0]), node_size, where);
+    const std::array<size_t, kParts> n = part_sizes(b);
     for (size_t p = 0; p < kParts; ++p) {
-      if (n[p] > stream[p].size() - used[p]) headers.fail("node part past its stream's end");
-      std::memcpy(page.data() + at, stream[p].data() + used[p], n[p]);
-      at += n[p], used[p] += n[p];
+      if (coded[p]) {
+        const std::optional<Planes> s =
+            p == kPositions ? planes_of(n[p], b.position_low, 3) : planes_of(n[p], b.normal_low, 2);
+        if (!s) headers.fail("node residuals not in byte planes");
+        (p == kPositions ? positions : normals).planes(s->count, s->components, s->width, page.data() + at);
+      } else {
+        if (n[p] > stream[p].size() - used[p]) headers.fail("node part past its stream's end");
+        std::memcpy(page.data() + at, stream[p].data() + used[p], n[p]);
+        used[p] += n[p];
+      }
+      at += n[p];
     }
     headers.bytes(n[0], "node header");
   }
+  positions.finish(), normals.finish();
   for (size_t p = 0; p < kParts; ++p)
-    if (used[p] != stream[p].size()) r.fail("page part streams hold bytes of no node");
+    if (used[p] != stream[p].size() && !coded[p]) r.fail("page part streams hold bytes of no node");
   if (at != raw_size) r.fail("page part streams hold fewer bytes than the page");
   return page;
 }

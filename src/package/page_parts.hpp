@@ -9,17 +9,33 @@
 // 539,775 (-5.2 %) -> 530,950 (-0.9 %), motorBike (10-bit normals) 2,607,957 -> 2,528,943 (-3.0 %), then -1.4
 // %; decode (bench_package, codec 3, checksum + zstd + codec) 33.4 -> 31.4 M triangles/s per core (load 5.5).
 //
-// The regrouped bytes (the zstd frame's content): eight varints, the sizes of the eight part streams; then
-// the streams. The header stream holds, per node in page order, varint node size then the node's header; the
-// other streams the node's part, in the same order. A reader walks the header stream: the codec's layout()
-// of each header gives the sizes of that node's parts (NodeCodec::layout), and copying them back in order
-// gives the page of whole nodes that the node records point into. A page whose frame holds exactly the
-// page's raw size is stored whole: a page whose bytes are not all codec nodes, or a codec-1 page that is
-// smaller whole. Pages of the byte-plane codecs (2, 3) are not also compressed whole: by part was smaller on
-// every page of elephant_1m, motorBike and refined_elephant with codecs 2 and 3 and of the city with codec 3
-// (2,378 pages; elephant_1m codec 3 6,320,159 vs 6,764,425 B), and the second compression cost about a tenth
-// of a bake's CPU. Codec 1's pages were smaller by part too on those meshes (400 pages), but not always: a
-// small page of a test sphere is 1 % larger by part, so codec 1 keeps whichever is smaller.
+// Format 6: six parts (header, positions, normals, attributes, locked, connectivity), and for the byte-plane
+// codecs (2, 3) a residual part (positions, normals) is, when not empty, a form byte then either (0) the
+// nodes' planes as the nodes hold them, or (1) the residuals of all the page's nodes as one stream of
+// residual_coder.hpp (an entropy coder of our own, order 0, rANS), which zstd then stores as it is (a block
+// of its own, incompressible). The writer keeps the smaller as zstd stores it (a second compression of the
+// part alone): on scans the coded form (sub-bit codes for the many tiny residuals), on regular synthetic
+// meshes the planes (zstd's matches find repeated residual runs that an order-0 coder cannot: a page of a
+// UV sphere took 6,786 B coded against 5,081 B whole). The coded form must also pay for its decode, about 25
+// instructions a residual against about 3 for zstd's Huffman stage over the planes: it is kept only when
+// it saves at least 0.2 bit a residual. Measured (whole pages, coded against zstd'd planes): on the pages
+// of bench_package (refined_elephant) the positions save 0.12 bit a residual, the normals 0.34; elephant_1m
+// 0.26 and 0.30. With both coded BM_Decode/4 took ~440 instructions a triangle (callgrind, decode_node +
+// unpack_page; 382 all planes), with the rule 404. Sizes in residual_coder.hpp.
+//
+// The regrouped bytes (the zstd frame's content): six varints, the sizes of the six part streams; then the
+// streams. The header stream holds, per node in page order, varint node size then the node's header; the
+// other streams the node's part, in the same order (the residual streams: the node's residuals, component
+// by component, in the order of its planes). A reader walks the header stream: the codec's layout() of each
+// header gives the sizes of that node's parts (NodeCodec::layout), and copying them back in order (decoding
+// the residuals back into their planes) gives the page of whole nodes that the node records point into. A
+// page whose frame holds exactly the page's raw size is stored whole: a page whose bytes are not all codec
+// nodes, or a codec-1 page that is smaller whole. Pages of the byte-plane codecs (2, 3) are not also
+// compressed whole: by part was smaller on every page of elephant_1m, motorBike and refined_elephant with
+// codecs 2 and 3 and of the city with codec 3 (2,378 pages; elephant_1m codec 3 6,320,159 vs 6,764,425 B,
+// format 3), and the second compression cost about a tenth of a bake's CPU. Codec 1's pages were smaller by
+// part too on those meshes (400 pages), but not always: a small page of a test sphere is 1 % larger by part,
+// so codec 1 keeps whichever is smaller.
 #pragma once
 
 #include <cstdint>
@@ -31,6 +47,9 @@
 #include "package/node_codec.hpp"
 
 namespace lodstream::package {
+
+// Whether pages of `codec` store their residuals coded (residual_coder.hpp): the byte-plane codecs 2 and 3.
+bool residuals_coded(const NodeCodec& codec);
 
 // The stored bytes of a page of whole nodes (`node_sizes`, in page order, add up to page.size()): one zstd
 // frame at `level` / `min_match` (format.hpp's zstd_compress), by part when `codec` parses every node (for

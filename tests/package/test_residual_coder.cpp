@@ -1,0 +1,185 @@
+// The residual coder (package/residual_coder.hpp): streams decode back to the planes put_planes writes,
+// mostly-zero residuals cost well under a bit each, and corrupted or hostile streams are errors, never reads
+// or writes out of bounds.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <set>
+
+#include "core/error.hpp"
+#include "package/byte_planes.hpp"
+#include "package/residual_coder.hpp"
+
+namespace lodstream::test {
+namespace {
+
+using namespace package;
+
+// Residuals of `nodes` nodes of `count` values of 3 components, zigzagged, each node's in the order of its
+// planes (component by component); residuals of node k below 2^(8 widths[k]).
+struct Residuals {
+  std::vector<size_t> counts;
+  std::vector<uint32_t> widths;
+  std::vector<uint64_t> values;  // all nodes, component-major within each
+};
+
+Residuals random_residuals(uint32_t seed, double zero_share) {
+  std::mt19937_64 rng(seed);
+  Residuals r;
+  for (uint32_t node = 0; node < 12; ++node) {
+    const size_t count = 1 + rng() % 300;
+    const uint32_t width = 1 + node % 5;
+    r.counts.push_back(count), r.widths.push_back(width);
+    for (size_t i = 0; i < 3 * count; ++i) {
+      const uint32_t bits = std::uniform_real_distribution<double>(0, 1)(rng) < zero_share
+                                ? 0
+                                : uint32_t(rng() % (8 * width + 1));
+      r.values.push_back(bits == 0 ? 0 : (rng() & ((uint64_t(1) << bits) - 1)) | uint64_t(1) << (bits - 1));
+    }
+  }
+  return r;
+}
+
+// The planes of every node, as put_planes writes them, one after the other.
+std::vector<uint8_t> expected_planes(const Residuals& r) {
+  std::vector<uint8_t> out;
+  size_t at = 0;
+  for (size_t node = 0; node < r.counts.size(); ++node) {
+    const size_t n = r.counts[node];
+    std::vector<uint64_t> records(3 * n);  // put_planes takes records of 3 components
+    for (uint32_t a = 0; a < 3; ++a)
+      for (size_t i = 0; i < n; ++i) records[3 * i + a] = r.values[at + a * n + i];
+    put_planes(out, records, 3, r.widths[node]);
+    at += 3 * n;
+  }
+  return out;
+}
+
+std::vector<uint8_t> decoded_planes(std::span<const uint8_t> stream, const Residuals& r) {
+  ResidualDecoder decoder(stream, "stream 3");
+  std::vector<uint8_t> out;
+  for (size_t node = 0; node < r.counts.size(); ++node) {
+    const size_t at = out.size();
+    out.resize(at + 3 * r.counts[node] * r.widths[node]);
+    decoder.planes(r.counts[node], 3, r.widths[node], out.data() + at);
+  }
+  decoder.finish();
+  return out;
+}
+
+TEST(ResidualCoder, DecodesToThePlanesOfTheResiduals) {
+  for (uint32_t seed = 0; seed < 6; ++seed) {
+    const Residuals r = random_residuals(seed, seed * 0.15);
+    const std::vector<uint8_t> stream = encode_residuals(r.values);
+    EXPECT_EQ(decoded_planes(stream, r), expected_planes(r)) << "seed " << seed;
+  }
+}
+
+TEST(ResidualCoder, OneSymbolAloneAndNoResiduals) {
+  const std::vector<uint64_t> zeros(1000, 0);
+  const std::vector<uint8_t> stream = encode_residuals(zeros);
+  EXPECT_LE(stream.size(), 21u);  // one symbol of probability 1 costs nothing: D, A, its frequency, the
+                                  // size and the four states
+  std::vector<uint8_t> planes(3000, 7);
+  ResidualDecoder decoder(stream, "s");
+  decoder.planes(500, 2, 3, planes.data());
+  decoder.finish();
+  EXPECT_EQ(planes, std::vector<uint8_t>(3000, 0));
+
+  EXPECT_TRUE(encode_residuals({}).empty());
+  ResidualDecoder none({}, "s");
+  none.planes(0, 3, 1, nullptr);
+  none.finish();
+  EXPECT_THROW(none.planes(1, 3, 1, planes.data()), Error);
+}
+
+TEST(ResidualCoder, EveryDirectWidthTheEncoderPicksDecodes) {
+  // Geometric residuals of growing scale, in short and longer streams: the encoder's D (the stream's first
+  // byte) follows the scale and the table's cost, every D occurs, and each stream decodes back, its values
+  // of raw bits included.
+  std::set<uint8_t> picked;
+  for (size_t count : {100, 1000})
+    for (uint32_t scale = 0; scale < 12; ++scale) {
+      std::mt19937_64 rng(scale);
+      std::geometric_distribution<uint64_t> geometric(1.0 / (1 + (uint64_t(1) << scale)));
+      Residuals r;
+      r.counts = {count}, r.widths = {5};
+      for (size_t i = 0; i < 3 * count; ++i) r.values.push_back(geometric(rng) & ((uint64_t(1) << 40) - 1));
+      const std::vector<uint8_t> stream = encode_residuals(r.values);
+      picked.insert(stream[0]);
+      EXPECT_EQ(decoded_planes(stream, r), expected_planes(r)) << "scale " << scale;
+    }
+  EXPECT_EQ(picked, (std::set<uint8_t>{1, 2, 3, 4, 5, 6}));
+}
+
+TEST(ResidualCoder, MostlyZeroResidualsTakeWellUnderABitEach) {
+  std::mt19937 rng(1);
+  std::vector<uint64_t> values(30000);
+  for (uint64_t& v : values) v = rng() % 20 == 0 ? 1 + rng() % 3 : 0;  // 5 % small, the rest 0
+  // H = 0.286 + 0.05 log2(3) bits per value (about 0.37): zstd's Huffman stage takes at least 1 bit a byte.
+  const size_t bytes = encode_residuals(values).size();
+  EXPECT_LT(bytes, values.size() * 0.40 / 8);
+  EXPECT_GT(bytes, values.size() * 0.33 / 8);
+}
+
+TEST(ResidualCoder, CorruptedStreamsAreErrorsNeverOutOfBounds) {
+  const Residuals r = random_residuals(9, 0.5);
+  const std::vector<uint8_t> good = encode_residuals(r.values);
+  const std::vector<uint8_t> planes = expected_planes(r);
+  auto expect_error = [&](const std::vector<uint8_t>& stream, const char* what) {
+    try {
+      decoded_planes(stream, r);
+      ADD_FAILURE() << what << ": no error";
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("stream 3", 0), 0u) << e.what();
+    }
+  };
+  // Every proper prefix and a byte too many: the symbols or bits run out, or the states do not end at
+  // their start.
+  for (size_t n = 0; n < good.size(); n += 1 + n / 64)
+    expect_error(std::vector<uint8_t>(good.begin(), good.begin() + n), "a prefix");
+  std::vector<uint8_t> bad = good;
+  bad.push_back(0);
+  expect_error(bad, "a byte too many");
+  for (uint8_t D : {0, 8, 255}) {
+    bad = good;
+    bad[0] = D;  // direct bits outside 1..7
+    expect_error(bad, "direct bits");
+  }
+  bad = good;
+  bad[1] = uint8_t((1u << good[0]) + 2 * (40 - good[0]) + 1);  // more symbols than 40-bit residuals have
+  expect_error(bad, "table size");
+  bad = good;
+  bad[2] ^= 1;  // the first frequency: the table no longer adds up to 2^12
+  expect_error(bad, "table sum");
+  bad = good;
+  bad.insert(bad.begin() + 2, {0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0x7f});  // a huge frequency
+  expect_error(bad, "huge frequency");
+  // A huge rANS size, and a first state below the states' range, in a stream of one symbol.
+  const std::vector<uint8_t> zeros = encode_residuals(std::vector<uint64_t>(100, 0));
+  ASSERT_EQ(zeros.size(), 21u);  // D, A = 1, frequency 4096 (2 bytes), size 16, four states
+  bad = zeros;
+  bad[4] = 0xff, bad.insert(bad.begin() + 5, {0xff, 0xff, 0xff, 0x7f});
+  EXPECT_THROW(ResidualDecoder(bad, "s"), Error);
+  bad = zeros;
+  bad[5] = bad[6] = bad[7] = bad[8] = 0;
+  EXPECT_THROW(ResidualDecoder(bad, "s"), Error);
+  // A residual of 9 bits in a node of 1-byte planes.
+  const std::vector<uint64_t> wide = {0, 300, 1};
+  std::vector<uint8_t> out(3);
+  ResidualDecoder decoder(encode_residuals(wide), "stream 3");
+  EXPECT_THROW(decoder.planes(1, 3, 1, out.data()), Error);
+
+  std::mt19937 rng(3);
+  for (int i = 0; i < 2000; ++i) {
+    bad = good;
+    for (int k = 0; k < 1 + i % 3; ++k) bad[rng() % bad.size()] = uint8_t(rng());
+    try {
+      EXPECT_EQ(decoded_planes(bad, r).size(), planes.size());  // wrong values, right size: possible
+    } catch (const Error&) {
+    }
+  }
+}
+
+}  // namespace
+}  // namespace lodstream::test
