@@ -90,7 +90,9 @@ TEST(PageParts, NoisyResidualsAreStoredCodedAndSmaller) {
     const Page page = sphere_page(codec, 0.01f);
     const std::vector<uint8_t> stored = compress_page(page.bytes, page.node_sizes, codec, 9, 6);
     EXPECT_EQ(decompress_page(stored, uint32_t(page.bytes.size()), codec, "page"), page.bytes);
-    EXPECT_EQ(residual_forms(content(stored)), std::make_pair(uint8_t(1), uint8_t(1))) << "codec " << id;
+    // Positions coded; the normals, coded in the frame of their prediction (predicted_normals.hpp), are
+    // spread so evenly here that the coded form saves under kMinSavedBits on them: either form.
+    EXPECT_EQ(residual_forms(content(stored)).first, 1u) << "codec " << id;
     EXPECT_LT(stored.size(), zstd_compress(page.bytes, 9, 6).size());
   }
 }
@@ -107,11 +109,11 @@ TEST(PageParts, PagesOfNonCodecBytesAreStoredWhole) {
 
 TEST(PageParts, HostileRegroupedBytesAreErrorsOrPagesOfTheRightSize) {
   const NodeCodec& codec = node_codec(TraversalCodec::kId);
-  const Page page = sphere_page(codec, 0.01f);  // residuals in the coded form
+  const Page page = sphere_page(codec, 0.01f);  // positions in the coded form
   const uint32_t raw_size = uint32_t(page.bytes.size());
   const std::vector<uint8_t> good = content(compress_page(page.bytes, page.node_sizes, codec, 9, 6));
   ASSERT_NE(good.size(), raw_size);
-  ASSERT_EQ(residual_forms(good), std::make_pair(uint8_t(1), uint8_t(1)));
+  ASSERT_EQ(residual_forms(good).first, 1u);
   auto unpack = [&](const std::vector<uint8_t>& regrouped) {
     return decompress_page(zstd_compress(regrouped, 1), raw_size, codec, "page 7");
   };
