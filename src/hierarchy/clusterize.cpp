@@ -1,10 +1,11 @@
 #include "hierarchy/clusterize.hpp"
 
-#include <meshoptimizer.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <span>
+
+#include "hierarchy/spatial_sort.hpp"
 
 namespace lodstream::hierarchy {
 
@@ -150,9 +151,7 @@ void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_
 std::vector<ClusterPart> clusterize(const Mesh& mesh, size_t max_vertices, size_t max_triangles) {
   std::vector<ClusterPart> parts;
   if (mesh.indices.empty()) return parts;
-  std::vector<uint32_t> sorted(mesh.indices.size());
-  meshopt_spatialSortTriangles(sorted.data(), mesh.indices.data(), mesh.indices.size(), &mesh.positions[0].x,
-                               mesh.positions.size(), sizeof(glm::vec3));
+  const std::vector<uint32_t> sorted = spatial_sort_triangles(mesh.positions, mesh.indices);
   const size_t chunk_indices = 3 * kChunkClusters * max_triangles;
   if (sorted.size() <= chunk_indices) {
     grow_clusters(mesh.positions, sorted, max_vertices, max_triangles, parts);

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <bit>
 
+#include "hierarchy/bucket_sort.hpp"
+
 namespace lodstream::hierarchy {
 namespace {
 
@@ -79,39 +81,17 @@ uint32_t PositionIndex::find(const glm::vec3& p) const {
 std::vector<uint32_t> weld_positions(std::span<const glm::vec3> positions, uint32_t& distinct) {
   const size_t n = positions.size();
   std::vector<uint32_t> ids(n);
-  // Buckets by the hash's top bits, about 1024 positions each; positions in chunks, each chunk's bucket
-  // counts apart, so that the counting sort runs on every core and keeps increasing positions per bucket.
+  // Buckets by the hash's top bits, about 1024 positions each, increasing positions in each
+  // (bucket_sort.hpp).
   const int bucket_bits = std::min(16, int(std::bit_width(n / 1024)));
   const size_t buckets = size_t(1) << bucket_bits;
   auto bucket_of = [bucket_bits](uint64_t h) {
     return bucket_bits == 0 ? size_t(0) : size_t(h >> (64 - bucket_bits));
   };
-  constexpr size_t kChunk = size_t(1) << 16;
-  const size_t chunks = (n + kChunk - 1) / kChunk;
-  std::vector<uint32_t> start(chunks * buckets, 0);  // chunk-major: start[c * buckets + b]
-  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-    uint32_t* count = &start[c * buckets];
-    for (size_t v = c * kChunk; v < std::min(n, (c + 1) * kChunk); ++v)
-      ++count[bucket_of(position_hash(positions[v]))];
-  });
-  std::vector<uint32_t> bucket_begin(buckets + 1, 0);
-  uint32_t running = 0;
-  for (size_t b = 0; b < buckets; ++b) {
-    bucket_begin[b] = running;
-    for (size_t c = 0; c < chunks; ++c) {
-      const uint32_t k = start[c * buckets + b];
-      start[c * buckets + b] = running;
-      running += k;
-    }
-  }
-  bucket_begin[buckets] = running;
-  std::vector<uint32_t> order(n);
-  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-    uint32_t* next = &start[c * buckets];
-    for (size_t v = c * kChunk; v < std::min(n, (c + 1) * kChunk); ++v)
-      order[next[bucket_of(position_hash(positions[v]))]++] = uint32_t(v);
-  });
-  start = {};
+  std::vector<uint32_t> order, bucket_begin;
+  bucket_sort(
+      n, buckets, [&](size_t v) { return bucket_of(position_hash(positions[v])); },
+      [](size_t v) { return uint32_t(v); }, order, bucket_begin);
   // Each bucket: every position's first equal position (its representative), through a table of (32 hash
   // bits, position) slots at load <= 0.5, reused by the thread.
   tbb::parallel_for(tbb::blocked_range<size_t>(0, buckets, 16), [&](const tbb::blocked_range<size_t>& r) {
