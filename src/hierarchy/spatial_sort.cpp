@@ -9,7 +9,7 @@
 #include <cfloat>
 
 #include "core/morton.hpp"
-#include "hierarchy/bucket_sort.hpp"
+#include "core/bucket_sort.hpp"
 
 namespace lodstream::hierarchy {
 

@@ -10,6 +10,8 @@
 #include <memory>
 #include <vector>
 
+#include "core/representatives.hpp"
+
 namespace lodstream {
 
 namespace {
@@ -63,45 +65,11 @@ struct VertexKey {
   }
 };
 
-// For every vertex, the first vertex equal to it under `key`. Open addressing with linear probing at load
-// <= 0.5; each slot keeps 32 bits of the hash next to the vertex, so a probe touches the vertex data only
-// when the hashes agree (one cache miss per vertex in the common case).
+// For every vertex, the first vertex equal to it under `key` (core/representatives.hpp, on every core).
 std::vector<uint32_t> representatives(const VertexKey& key, size_t n) {
-  size_t capacity = 16;
-  while (capacity < 2 * n) capacity *= 2;
-  constexpr uint64_t kEmpty = UINT64_MAX;
-  std::vector<uint64_t> table(capacity, kEmpty);
-  // Arrays that are written in full are left uninitialized (zero-filling them cost a tenth of an import).
-  auto hashes = std::make_unique_for_overwrite<uint64_t[]>(n);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t v = r.begin(); v < r.end(); ++v) hashes[v] = key.hash(uint32_t(v));
-  });
-  std::vector<uint32_t> rep;
-  rep.reserve(n);
-  const size_t mask = capacity - 1;
-  // The table is far larger than the caches: prefetching the slot of a vertex a few steps ahead keeps several
-  // misses in flight instead of waiting for each.
-  constexpr uint32_t kAhead = 16;
-  for (uint32_t v = 0; v < n; ++v) {
-    if (v + kAhead < n) __builtin_prefetch(&table[hashes[v + kAhead] & mask]);
-    const uint64_t h = hashes[v];
-    const uint64_t tag = h >> 32;
-    size_t slot = h & mask;
-    for (;;) {
-      const uint64_t e = table[slot];
-      if (e == kEmpty) {
-        table[slot] = (tag << 32) | v;
-        rep.push_back(v);
-        break;
-      }
-      if ((e >> 32) == tag && key.equal(static_cast<uint32_t>(e), v)) {
-        rep.push_back(static_cast<uint32_t>(e));
-        break;
-      }
-      slot = (slot + 1) & mask;
-    }
-  }
-  return rep;
+  return lodstream::representatives(
+      n, [&key](size_t v) { return key.hash(uint32_t(v)); },
+      [&key](uint32_t a, uint32_t b) { return key.equal(a, b); });
 }
 
 // Keeps the vertices listed in `keep` order; `remap[old]` gives each old vertex's new index. Gathers on

@@ -2,7 +2,7 @@
 // consecutive runs, each run keeping increasing i. The items are cut into chunks of 2^16, each chunk counts
 // its own buckets (in parallel), a prefix over (bucket, chunk) gives every chunk its place in every run, and
 // each chunk scatters its items there (in parallel). Used where a large array is split into pieces that are
-// then handled in cache (the bucketed weld, the spatial sort's runs).
+// then handled in cache (representatives.hpp, the spatial sort's runs).
 #pragma once
 
 #include <tbb/parallel_for.h>
@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace lodstream::hierarchy {
+namespace lodstream {
 
 // Fills `out` (n entries) with value(i) in the order above and `begin` (buckets + 1 entries) with where each
 // bucket's run starts (begin[buckets] = n); bucket_of(i) < buckets is called twice per item, value(i) once.
@@ -44,4 +44,4 @@ void bucket_sort(size_t n, size_t buckets, const BucketOf& bucket_of, const Valu
   });
 }
 
-}  // namespace lodstream::hierarchy
+}  // namespace lodstream
