@@ -16,8 +16,9 @@ namespace lodstream::hierarchy {
 
 // `indices` (three per triangle, over `positions`) with the triangles in the order above. Cost: O(T) on
 // every core (a counting sort by the code's top 10 bits, then each of the 1024 runs sorted in cache) for
-// meshes of at least kParallelSortTriangles triangles, else meshoptimizer's serial sort; 20 bytes per
-// triangle of scratch.
+// meshes of at least kParallelSortTriangles triangles, else one O(T log T) sort on the calling thread (on a
+// DAG group's few hundred triangles about 38 k instructions fewer per call than meshoptimizer's three radix
+// passes over 1024-entry histograms); 20 bytes per triangle of scratch.
 std::vector<uint32_t> spatial_sort_triangles(std::span<const glm::vec3> positions,
                                              std::span<const uint32_t> indices);
 
