@@ -19,19 +19,15 @@ namespace {
 // component used up) it continues from the next unused triangle of the spatial order, which is near.
 // `indices` are over `positions` (a run of the spatial order, compact vertex numbers); clusters are
 // appended to `parts`. Cost: O(T * frontier) with a frontier of a few dozen triangles; memory O(V + T).
-void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
-                   size_t max_vertices, size_t max_triangles, std::vector<ClusterPart>& parts) {
+template <bool kDegenerate>
+void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indices, size_t max_vertices,
+          size_t max_triangles, std::vector<ClusterPart>& parts) {
   const size_t triangles = indices.size() / 3, vertices = positions.size();
-  // Corner k of triangle t counts unless it repeats an earlier corner (degenerate input; the DAG drops such
-  // triangles first, so there every corner counts without the per-corner test).
-  bool degenerate = false;
-  for (size_t t = 0; t < triangles && !degenerate; ++t) {
-    const uint32_t* c = &indices[3 * t];
-    degenerate = c[0] == c[1] || c[1] == c[2] || c[0] == c[2];
-  }
+  // Corner k of triangle t counts unless it repeats an earlier corner (only a mesh with degenerate triangles
+  // pays for the test).
   auto distinct = [&](size_t t, int k) {
     const uint32_t* c = &indices[3 * t];
-    return !degenerate || k == 0 || (c[k] != c[0] && (k == 1 || c[2] != c[1]));
+    return !kDegenerate || k == 0 || (c[k] != c[0] && (k == 1 || c[2] != c[1]));
   };
   // Vertex -> triangles (CSR), and per vertex its unused triangles.
   std::vector<uint32_t> offsets(vertices + 1, 0), adjacent(indices.size()), remaining(vertices, 0);
@@ -68,6 +64,7 @@ void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_
     while (cursor < triangles && state[cursor].used) ++cursor;
     if (cursor == triangles) break;
     ClusterPart& part = parts.emplace_back();
+    part.vertices.reserve(max_vertices), part.indices.reserve(3 * max_triangles);  // no regrowth
     frontier.clear();
     ready.clear();
     size_t next_ready = 0;
@@ -144,6 +141,20 @@ void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_
     }
     for (uint32_t v : part.vertices) local[v] = kUnset;
   }
+}
+
+// The DAG drops degenerate triangles first, so there every corner counts without the per-corner test.
+void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
+                   size_t max_vertices, size_t max_triangles, std::vector<ClusterPart>& parts) {
+  bool degenerate = false;
+  for (size_t t = 0; t + 2 < indices.size() && !degenerate; t += 3) {
+    const uint32_t* c = &indices[t];
+    degenerate = c[0] == c[1] || c[1] == c[2] || c[0] == c[2];
+  }
+  if (degenerate)
+    grow<true>(positions, indices, max_vertices, max_triangles, parts);
+  else
+    grow<false>(positions, indices, max_vertices, max_triangles, parts);
 }
 
 }  // namespace
