@@ -42,9 +42,11 @@ void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indice
         if (distinct(t, k)) adjacent[fill[indices[3 * t + k]]++] = uint32_t(t);
   }
   // Per triangle: used, its distinct corners, corners already in the current cluster (valid while listed in
-  // its frontier), and whether it is the last unused triangle of one of its vertices.
+  // its frontier), and flags: it is the last unused triangle of one of its vertices; it is listed in `near`
+  // (valid while listed in the frontier).
+  constexpr uint8_t kLast = 1, kNear = 2;
   struct State {
-    uint8_t used = 0, corners = 0, shared = 0, last = 0;
+    uint8_t used = 0, corners = 0, shared = 0, flags = 0;
   };
   std::vector<State> state(triangles);
   std::vector<glm::vec3> centroid(triangles);
@@ -52,21 +54,24 @@ void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indice
     const uint32_t* c = &indices[3 * t];
     centroid[t] = (positions[c[0]] + positions[c[1]] + positions[c[2]]) * (1.0f / 3.0f);
     for (int k = 0; k < 3; ++k)
-      if (distinct(t, k)) ++state[t].corners, state[t].last |= remaining[c[k]] == 1;
+      if (distinct(t, k)) ++state[t].corners, state[t].flags |= remaining[c[k]] == 1 ? kLast : 0;
   }
 
   constexpr uint32_t kUnset = UINT32_MAX;
   std::vector<uint32_t> local(vertices, kUnset);  // vertex -> cluster vertex number, current cluster only
   std::vector<uint32_t> in_frontier(triangles, kUnset);  // the cluster that listed it
-  std::vector<uint32_t> frontier, ready;  // ready: frontier triangles whose corners are all in the cluster
-  size_t cursor = 0;                      // every triangle before it is used
+  // The frontier, by priority (below): ready, adding no vertex; near, the last unused triangle of one of its
+  // vertices or adding one; far, the rest (adding two; an entry that moves to near stays behind in far, which
+  // skips it). listed: each triangle's place in the order of listing, which breaks ties as one list would.
+  std::vector<uint32_t> ready, near, far, listed(triangles);
+  uint32_t listings = 0;
+  size_t cursor = 0;  // every triangle before it is used
   for (uint32_t cluster = 0;; ++cluster) {
     while (cursor < triangles && state[cursor].used) ++cursor;
     if (cursor == triangles) break;
     ClusterPart& part = parts.emplace_back();
     part.vertices.reserve(max_vertices), part.indices.reserve(3 * max_triangles);  // no regrowth
-    frontier.clear();
-    ready.clear();
+    ready.clear(), near.clear(), far.clear();
     size_t next_ready = 0;
     glm::vec3 sum(0.0f);
     auto add = [&](uint32_t t) {
@@ -76,16 +81,27 @@ void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indice
         const uint32_t v = indices[3 * size_t(t) + k];
         if (distinct(t, k)) {
           if (--remaining[v] == 1)
-            for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) state[adjacent[s]].last = 1;
+            for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) {
+              State& st = state[adjacent[s]];
+              st.flags |= kLast;
+              if (!st.used && in_frontier[adjacent[s]] == cluster && !(st.flags & kNear))
+                st.flags |= kNear, near.push_back(adjacent[s]);
+            }
           if (local[v] == kUnset) {
             local[v] = uint32_t(part.vertices.size());
             part.vertices.push_back(v);
             for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) {
               const uint32_t n = adjacent[s];
-              if (state[n].used) continue;
-              if (in_frontier[n] != cluster)
-                in_frontier[n] = cluster, state[n].shared = 0, frontier.push_back(n);
-              if (++state[n].shared == state[n].corners) ready.push_back(n);
+              State& st = state[n];
+              if (st.used) continue;
+              const bool first = in_frontier[n] != cluster;
+              if (first) in_frontier[n] = cluster, st.shared = 0, st.flags &= ~kNear, listed[n] = listings++;
+              if (++st.shared == st.corners)
+                ready.push_back(n);
+              else if (!(st.flags & kNear) && ((st.flags & kLast) || st.corners - st.shared == 1))
+                st.flags |= kNear, near.push_back(n);
+              else if (first)
+                far.push_back(n);
             }
           }
         }
@@ -106,24 +122,31 @@ void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indice
       // above: such a triangle lies within the cluster's vertices, so which one matters little.)
       uint32_t best = kUnset, best_priority = UINT32_MAX;
       float best_distance = 0.0f;
-      size_t kept = 0;
-      for (size_t i = 0; i < frontier.size(); ++i) {  // drops used entries while scanning
-        const uint32_t t = frontier[i];
-        const State st = state[t];
-        if (st.used) continue;
-        frontier[kept++] = t;
-        const size_t added = size_t(st.corners - st.shared);
-        if (part.vertices.size() + added > max_vertices) continue;
-        const uint32_t priority = st.last ? 1 : uint32_t(added) + 1;
-        if (priority > best_priority) continue;
-        const glm::vec3 d = centroid[t] - center;
-        const float distance = glm::dot(d, d);
-        if (priority < best_priority || distance < best_distance)
-          best = t, best_priority = priority, best_distance = distance;
-      }
-      frontier.resize(kept);
+      // Every near entry comes before every far one, so far is scanned only when no near entry fits.
+      auto scan = [&](std::vector<uint32_t>& list, bool is_far) {
+        size_t kept = 0;
+        for (size_t i = 0; i < list.size();
+             ++i) {  // drops used (and, from far, moved) entries while scanning
+          const uint32_t t = list[i];
+          const State st = state[t];
+          if (st.used || (is_far && (st.flags & kNear))) continue;
+          list[kept++] = t;
+          const size_t added = size_t(st.corners - st.shared);
+          if (part.vertices.size() + added > max_vertices) continue;
+          const uint32_t priority = (st.flags & kLast) ? 1 : uint32_t(added) + 1;
+          if (priority > best_priority) continue;
+          const glm::vec3 d = centroid[t] - center;
+          const float distance = glm::dot(d, d);
+          if (priority < best_priority || distance < best_distance ||
+              (distance == best_distance && listed[t] < listed[best]))
+            best = t, best_priority = priority, best_distance = distance;
+        }
+        list.resize(kept);
+      };
+      scan(near, false);
+      if (best == kUnset) scan(far, true);
       if (best == kUnset) {
-        if (!frontier.empty()) break;
+        if (!near.empty() || !far.empty()) break;
         // The component is used up (no unused triangle touches the cluster): continue with the unused
         // triangle nearest the centroid among the next kJumpWindow of the spatial order (near each other).
         constexpr size_t kJumpWindow = 64;
