@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/bucket_sort.hpp"
 #include "core/representatives.hpp"
 
 namespace lodstream {
@@ -161,27 +162,36 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
     }
   });
 
-  // Corners grouped by position class (counting sort).
-  std::vector<uint32_t> start(nv + 1, 0);
-  auto corners = std::make_unique_for_overwrite<uint32_t[]>(nc);
-  // The scattered counters are prefetched a few corners ahead, like the hash table in representatives.
-  constexpr uint32_t kAhead = 16;
-  for (uint32_t c = 0; c < nc; ++c) {
-    if (c + kAhead < nc) __builtin_prefetch(&start[position[mesh.indices[c + kAhead]] + 1]);
-    ++start[position[mesh.indices[c]] + 1];
-  }
-  for (size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
-  {
-    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-    for (uint32_t c = 0; c < nc; ++c) {
-      if (c + kAhead < nc) {
-        const uint32_t ahead = position[mesh.indices[c + kAhead]];
-        __builtin_prefetch(&fill[ahead]);
-        __builtin_prefetch(&corners[fill[ahead]]);
-      }
-      corners[fill[position[mesh.indices[c]]]++] = c;
+  // Corners grouped by position class, increasing within each (a stable counting sort), on every core: dealt
+  // by their position's high bits into 1024-2047 slices of consecutive positions (core/bucket_sort.hpp),
+  // then each slice counting-sorted by position in cache (was two serial passes with a cache miss per
+  // corner). start[p]: the first of position p's corners in `corners`.
+  const int slice_bits = std::max(0, int(std::bit_width(nv)) - 11);
+  const size_t slices = ((nv - 1) >> slice_bits) + 1;
+  std::vector<uint32_t> by_slice, slice_begin;
+  bucket_sort(
+      nc, slices, [&](size_t c) { return size_t(position[mesh.indices[c]] >> slice_bits); },
+      [](size_t c) { return uint32_t(c); }, by_slice, slice_begin);
+  std::vector<uint32_t> start(nv + 1, 0), corners(nc);
+  tbb::parallel_for(size_t(0), slices, [&](size_t s) {
+    const size_t lo = s << slice_bits, hi = std::min(nv, (s + 1) << slice_bits);
+    for (uint32_t k = slice_begin[s]; k < slice_begin[s + 1]; ++k)
+      ++start[position[mesh.indices[by_slice[k]]]];
+    uint32_t running = slice_begin[s];
+    for (size_t p = lo; p < hi; ++p) {
+      const uint32_t count = start[p];
+      start[p] = running;
+      running += count;
     }
-  }
+    std::vector<uint32_t> fill(start.begin() + lo, start.begin() + hi);
+    for (uint32_t k = slice_begin[s]; k < slice_begin[s + 1]; ++k) {
+      const uint32_t c = by_slice[k];
+      corners[fill[position[mesh.indices[c]] - lo]++] = c;
+    }
+  });
+  start[nv] = uint32_t(nc);
+  by_slice = {};
+  constexpr uint32_t kAhead = 16;  // prefetch distance where corners are gathered in random order
 
   // Per position: group its corners by crease, then give each (welded vertex, group) pair one output vertex.
   // A welded vertex belongs to exactly one position, so all its corners are handled here and the indices can
