@@ -152,6 +152,33 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
     for (uint32_t v = 0; v < nv; ++v) position.push_back(v);
   }
 
+  // Corners grouped by position class, increasing within each (a stable counting sort), on every core: dealt
+  // by their position's high bits into 1024-2047 slices of consecutive positions (core/bucket_sort.hpp),
+  // then each slice counting-sorted by position in cache, in place through a per-thread copy (was two serial
+  // passes with a cache miss per corner). start[p]: the first of position p's corners in `corners`.
+  const int slice_bits = std::max(0, int(std::bit_width(nv)) - 11);
+  const size_t slices = ((nv - 1) >> slice_bits) + 1;
+  std::vector<uint32_t> corners, slice_begin;
+  bucket_sort(
+      nc, slices, [&](size_t c) { return size_t(position[mesh.indices[c]] >> slice_bits); },
+      [](size_t c) { return uint32_t(c); }, corners, slice_begin);
+  std::vector<uint32_t> start(nv + 1, 0);
+  tbb::parallel_for(size_t(0), slices, [&](size_t s) {
+    const size_t lo = s << slice_bits, hi = std::min(nv, (s + 1) << slice_bits);
+    thread_local std::vector<uint32_t> slice;
+    slice.assign(corners.begin() + slice_begin[s], corners.begin() + slice_begin[s + 1]);
+    for (uint32_t c : slice) ++start[position[mesh.indices[c]]];
+    uint32_t running = slice_begin[s];
+    for (size_t p = lo; p < hi; ++p) {
+      const uint32_t count = start[p];
+      start[p] = running;
+      running += count;
+    }
+    std::vector<uint32_t> fill(start.begin() + lo, start.begin() + hi);
+    for (uint32_t c : slice) corners[fill[position[mesh.indices[c]] - lo]++] = c;
+  });
+  start[nv] = uint32_t(nc);
+
   // Face normals, unnormalized: their length is twice the area, which weights the sums.
   auto face = std::make_unique_for_overwrite<glm::vec3[]>(nt);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nt, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
@@ -161,36 +188,6 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
                            mesh.positions[v[2]] - mesh.positions[v[0]]);
     }
   });
-
-  // Corners grouped by position class, increasing within each (a stable counting sort), on every core: dealt
-  // by their position's high bits into 1024-2047 slices of consecutive positions (core/bucket_sort.hpp),
-  // then each slice counting-sorted by position in cache (was two serial passes with a cache miss per
-  // corner). start[p]: the first of position p's corners in `corners`.
-  const int slice_bits = std::max(0, int(std::bit_width(nv)) - 11);
-  const size_t slices = ((nv - 1) >> slice_bits) + 1;
-  std::vector<uint32_t> by_slice, slice_begin;
-  bucket_sort(
-      nc, slices, [&](size_t c) { return size_t(position[mesh.indices[c]] >> slice_bits); },
-      [](size_t c) { return uint32_t(c); }, by_slice, slice_begin);
-  std::vector<uint32_t> start(nv + 1, 0), corners(nc);
-  tbb::parallel_for(size_t(0), slices, [&](size_t s) {
-    const size_t lo = s << slice_bits, hi = std::min(nv, (s + 1) << slice_bits);
-    for (uint32_t k = slice_begin[s]; k < slice_begin[s + 1]; ++k)
-      ++start[position[mesh.indices[by_slice[k]]]];
-    uint32_t running = slice_begin[s];
-    for (size_t p = lo; p < hi; ++p) {
-      const uint32_t count = start[p];
-      start[p] = running;
-      running += count;
-    }
-    std::vector<uint32_t> fill(start.begin() + lo, start.begin() + hi);
-    for (uint32_t k = slice_begin[s]; k < slice_begin[s + 1]; ++k) {
-      const uint32_t c = by_slice[k];
-      corners[fill[position[mesh.indices[c]] - lo]++] = c;
-    }
-  });
-  start[nv] = uint32_t(nc);
-  by_slice = {};
   constexpr uint32_t kAhead = 16;  // prefetch distance where corners are gathered in random order
 
   // Per position: group its corners by crease, then give each (welded vertex, group) pair one output vertex.
