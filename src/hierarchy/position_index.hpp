@@ -36,7 +36,7 @@ class PositionIndex {
 // The id PositionIndex::insert would give each of `positions` in turn (equal positions, bit for bit with
 // -0 = +0, share the id of the first; ids dense in order of first occurrence); `distinct` receives the
 // number of ids. Each position's representative (core/representatives.hpp, on every core), then one in-order
-// pass numbers the representatives. Cost: O(n), 12 bytes per position of scratch besides the result.
+// pass numbers the representatives. Cost: O(n), 4 bytes per position of scratch besides the result.
 std::vector<uint32_t> weld_positions(std::span<const glm::vec3> positions, uint32_t& distinct);
 
 }  // namespace lodstream::hierarchy

@@ -66,10 +66,15 @@ struct VertexKey {
   }
 };
 
-// For every vertex, the first vertex equal to it under `key` (core/representatives.hpp, on every core).
+// For every vertex, the first vertex equal to it under `key` (core/representatives.hpp, on every core), its
+// hashes computed once (they are looked up three times).
 std::vector<uint32_t> representatives(const VertexKey& key, size_t n) {
+  auto hashes = std::make_unique_for_overwrite<uint64_t[]>(n);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v < r.end(); ++v) hashes[v] = key.hash(uint32_t(v));
+  });
   return lodstream::representatives(
-      n, [&key](size_t v) { return key.hash(uint32_t(v)); },
+      n, [&hashes](size_t v) { return hashes[v]; },
       [&key](uint32_t a, uint32_t b) { return key.equal(a, b); });
 }
 
