@@ -28,10 +28,10 @@ struct Builder {
   // grouping, which needs only the clusters' indices, position ids and spheres).
   Mesh input{};
   std::vector<ClusterPart> input_parts{};
-  // Per level, reused (fresh pages cost 4 s/GB to touch): the active clusters' boundary edges and the
-  // scratch of their sort, and by position id the group holding it (UINT32_MAX) and whether clusters of two
-  // groups hold it (0), both reset to those values after each level.
-  std::vector<ClusterEdge> edges{}, edge_scratch{};
+  // Per level, reused (fresh pages cost 4 s/GB to touch): the active clusters' boundary edges, and by
+  // position id the group holding it (UINT32_MAX) and whether clusters of two groups hold it (0), both
+  // reset to those values after each level.
+  std::vector<ClusterEdge> edges{};
   std::vector<uint32_t> owner{};
   std::vector<uint8_t> border{};
 };
@@ -378,7 +378,7 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
     std::vector<std::vector<uint32_t>> groups;
     tbb::parallel_invoke(
         [&] {
-          sort_edges(edges, b.next_position_id, b.edge_scratch);
+          sort_edges(edges, b.next_position_id);
           if (level == 1) mark_open_boundary(b, edges);
           groups =
               partition_clusters(triangles, centroids, edges, last ? active.size() : options.group_clusters);

@@ -30,7 +30,7 @@ constexpr size_t kRecursiveMin = 64;
 
 }  // namespace
 
-void sort_edges(std::vector<ClusterEdge>& edges, uint32_t ids, std::vector<ClusterEdge>& scratch) {
+void sort_edges(std::vector<ClusterEdge>& edges, uint32_t ids) {
   // An edge's rank smaller * ids + larger orders it as its key does and is below ids^2. Its digits, lowest
   // first, each a stable counting-sort pass; a digit has about log2(E) - 2 bits (8 to 16), so that the
   // counters (cleared and summed each pass) cost less than the edges.
@@ -38,7 +38,7 @@ void sort_edges(std::vector<ClusterEdge>& edges, uint32_t ids, std::vector<Clust
   const int bits = int(std::bit_width(uint64_t(ids) * ids));
   const int digit_bits = std::clamp(int(std::bit_width(edges.size())) - 2, 8, 16);
   const uint32_t digit_mask = (1u << digit_bits) - 1;
-  scratch.resize(edges.size());
+  std::vector<ClusterEdge> scratch(edges.size());
   std::vector<uint32_t> start(size_t(digit_mask) + 2);
   for (int shift = 0; shift < bits; shift += digit_bits) {
     auto digit = [&](const ClusterEdge& e) { return uint32_t(rank(e.first) >> shift) & digit_mask; };

@@ -22,10 +22,9 @@ using ClusterEdge = std::pair<uint64_t, uint32_t>;
 // Sorts `edges` (by key, then cluster) when they are listed by increasing cluster and every position id is
 // below `ids`: a radix sort (digits of smaller id * ids + larger id, each a stable counting-sort pass, so
 // ties keep the cluster order). Cost: O(E) per pass, about log2(ids^2) / (log2(E) - 2) passes, one core, 16
-// bytes per edge of scratch in `scratch` (its contents are overwritten; the caller keeps it across levels so
-// that its pages are touched once: fresh pages cost about 4 s/GB here); the comparison sorts it replaces
-// (O(E log E), on every core) took 0.7 CPU-s of an elephant_5m bake.
-void sort_edges(std::vector<ClusterEdge>& edges, uint32_t ids, std::vector<ClusterEdge>& scratch);
+// bytes per edge of scratch; the comparison sorts it replaces (O(E log E), on every core) took 0.7 CPU-s of
+// an elephant_5m bake.
+void sort_edges(std::vector<ClusterEdge>& edges, uint32_t ids);
 
 // Groups of cluster numbers (0 .. triangles.size()-1), each cluster in exactly one group, no group empty.
 // `edges` must be sorted (sort_edges). Cost: O(E) for the adjacency plus METIS (O(n log(n /
