@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <cmath>
@@ -103,17 +104,30 @@ float round_up(double x) {
 
 // Level 0: the input (without degenerate triangles) split into clusters; position ids by exact welding.
 void build_level0(Builder& b, Mesh mesh) {
-  size_t kept = 0;
-  for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
-    const uint32_t a = mesh.indices[t], c1 = mesh.indices[t + 1], c2 = mesh.indices[t + 2];
-    if (a == c1 || c1 == c2 || a == c2) continue;
-    mesh.indices[kept++] = a, mesh.indices[kept++] = c1, mesh.indices[kept++] = c2;
-  }
+  // Import drops zero-area triangles already, so there is usually none to drop: the first one is searched
+  // for on every core, and only the triangles from it on are compacted (on one core).
+  const size_t triangles = mesh.indices.size() / 3;
+  auto degenerate = [&](size_t t) {
+    const uint32_t* c = &mesh.indices[3 * t];
+    return c[0] == c[1] || c[1] == c[2] || c[0] == c[2];
+  };
+  const size_t first = tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, triangles), triangles,
+      [&](const tbb::blocked_range<size_t>& r, size_t found) {
+        for (size_t t = r.begin(); t < std::min(r.end(), found); ++t)
+          if (degenerate(t)) return t;
+        return found;
+      },
+      [](size_t x, size_t y) { return std::min(x, y); });
+  size_t kept = 3 * first;
+  for (size_t t = first; t < triangles; ++t)
+    if (!degenerate(t))
+      for (int k = 0; k < 3; ++k) mesh.indices[kept++] = mesh.indices[3 * t + k];
   mesh.indices.resize(kept);
   b.dag.input_triangles = mesh.triangle_count();
   if (mesh.indices.empty()) return;
 
-  // Welding runs beside the clusterizer's spatial sort (one core).
+  // Welding runs beside the clusterizer (both on every core).
   std::vector<uint32_t> vertex_id;
   std::vector<ClusterPart> parts;
   tbb::parallel_invoke(

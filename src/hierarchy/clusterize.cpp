@@ -1,10 +1,11 @@
 #include "hierarchy/clusterize.hpp"
 
-#include <meshoptimizer.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <span>
+
+#include "hierarchy/spatial_sort.hpp"
 
 namespace lodstream::hierarchy {
 
@@ -18,19 +19,15 @@ namespace {
 // component used up) it continues from the next unused triangle of the spatial order, which is near.
 // `indices` are over `positions` (a run of the spatial order, compact vertex numbers); clusters are
 // appended to `parts`. Cost: O(T * frontier) with a frontier of a few dozen triangles; memory O(V + T).
-void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
-                   size_t max_vertices, size_t max_triangles, std::vector<ClusterPart>& parts) {
+template <bool kDegenerate>
+void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indices, size_t max_vertices,
+          size_t max_triangles, std::vector<ClusterPart>& parts) {
   const size_t triangles = indices.size() / 3, vertices = positions.size();
-  // Corner k of triangle t counts unless it repeats an earlier corner (degenerate input; the DAG drops such
-  // triangles first, so there every corner counts without the per-corner test).
-  bool degenerate = false;
-  for (size_t t = 0; t < triangles && !degenerate; ++t) {
-    const uint32_t* c = &indices[3 * t];
-    degenerate = c[0] == c[1] || c[1] == c[2] || c[0] == c[2];
-  }
+  // Corner k of triangle t counts unless it repeats an earlier corner (only a mesh with degenerate triangles
+  // pays for the test).
   auto distinct = [&](size_t t, int k) {
     const uint32_t* c = &indices[3 * t];
-    return !degenerate || k == 0 || (c[k] != c[0] && (k == 1 || c[2] != c[1]));
+    return !kDegenerate || k == 0 || (c[k] != c[0] && (k == 1 || c[2] != c[1]));
   };
   // Vertex -> triangles (CSR), and per vertex its unused triangles.
   std::vector<uint32_t> offsets(vertices + 1, 0), adjacent(indices.size()), remaining(vertices, 0);
@@ -45,9 +42,11 @@ void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_
         if (distinct(t, k)) adjacent[fill[indices[3 * t + k]]++] = uint32_t(t);
   }
   // Per triangle: used, its distinct corners, corners already in the current cluster (valid while listed in
-  // its frontier), and whether it is the last unused triangle of one of its vertices.
+  // its frontier), and flags: it is the last unused triangle of one of its vertices; it is listed in `near`
+  // (valid while listed in the frontier).
+  constexpr uint8_t kLast = 1, kNear = 2;
   struct State {
-    uint8_t used = 0, corners = 0, shared = 0, last = 0;
+    uint8_t used = 0, corners = 0, shared = 0, flags = 0;
   };
   std::vector<State> state(triangles);
   std::vector<glm::vec3> centroid(triangles);
@@ -55,20 +54,24 @@ void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_
     const uint32_t* c = &indices[3 * t];
     centroid[t] = (positions[c[0]] + positions[c[1]] + positions[c[2]]) * (1.0f / 3.0f);
     for (int k = 0; k < 3; ++k)
-      if (distinct(t, k)) ++state[t].corners, state[t].last |= remaining[c[k]] == 1;
+      if (distinct(t, k)) ++state[t].corners, state[t].flags |= remaining[c[k]] == 1 ? kLast : 0;
   }
 
   constexpr uint32_t kUnset = UINT32_MAX;
   std::vector<uint32_t> local(vertices, kUnset);  // vertex -> cluster vertex number, current cluster only
   std::vector<uint32_t> in_frontier(triangles, kUnset);  // the cluster that listed it
-  std::vector<uint32_t> frontier, ready;  // ready: frontier triangles whose corners are all in the cluster
-  size_t cursor = 0;                      // every triangle before it is used
+  // The frontier, by priority (below): ready, adding no vertex; near, the last unused triangle of one of its
+  // vertices or adding one; far, the rest (adding two; an entry that moves to near stays behind in far, which
+  // skips it). listed: each triangle's place in the order of listing, which breaks ties as one list would.
+  std::vector<uint32_t> ready, near, far, listed(triangles);
+  uint32_t listings = 0;
+  size_t cursor = 0;  // every triangle before it is used
   for (uint32_t cluster = 0;; ++cluster) {
     while (cursor < triangles && state[cursor].used) ++cursor;
     if (cursor == triangles) break;
     ClusterPart& part = parts.emplace_back();
-    frontier.clear();
-    ready.clear();
+    part.vertices.reserve(max_vertices), part.indices.reserve(3 * max_triangles);  // no regrowth
+    ready.clear(), near.clear(), far.clear();
     size_t next_ready = 0;
     glm::vec3 sum(0.0f);
     auto add = [&](uint32_t t) {
@@ -78,16 +81,27 @@ void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_
         const uint32_t v = indices[3 * size_t(t) + k];
         if (distinct(t, k)) {
           if (--remaining[v] == 1)
-            for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) state[adjacent[s]].last = 1;
+            for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) {
+              State& st = state[adjacent[s]];
+              st.flags |= kLast;
+              if (!st.used && in_frontier[adjacent[s]] == cluster && !(st.flags & kNear))
+                st.flags |= kNear, near.push_back(adjacent[s]);
+            }
           if (local[v] == kUnset) {
             local[v] = uint32_t(part.vertices.size());
             part.vertices.push_back(v);
             for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) {
               const uint32_t n = adjacent[s];
-              if (state[n].used) continue;
-              if (in_frontier[n] != cluster)
-                in_frontier[n] = cluster, state[n].shared = 0, frontier.push_back(n);
-              if (++state[n].shared == state[n].corners) ready.push_back(n);
+              State& st = state[n];
+              if (st.used) continue;
+              const bool first = in_frontier[n] != cluster;
+              if (first) in_frontier[n] = cluster, st.shared = 0, st.flags &= ~kNear, listed[n] = listings++;
+              if (++st.shared == st.corners)
+                ready.push_back(n);
+              else if (!(st.flags & kNear) && ((st.flags & kLast) || st.corners - st.shared == 1))
+                st.flags |= kNear, near.push_back(n);
+              else if (first)
+                far.push_back(n);
             }
           }
         }
@@ -108,24 +122,31 @@ void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_
       // above: such a triangle lies within the cluster's vertices, so which one matters little.)
       uint32_t best = kUnset, best_priority = UINT32_MAX;
       float best_distance = 0.0f;
-      size_t kept = 0;
-      for (size_t i = 0; i < frontier.size(); ++i) {  // drops used entries while scanning
-        const uint32_t t = frontier[i];
-        const State st = state[t];
-        if (st.used) continue;
-        frontier[kept++] = t;
-        const size_t added = size_t(st.corners - st.shared);
-        if (part.vertices.size() + added > max_vertices) continue;
-        const uint32_t priority = st.last ? 1 : uint32_t(added) + 1;
-        if (priority > best_priority) continue;
-        const glm::vec3 d = centroid[t] - center;
-        const float distance = glm::dot(d, d);
-        if (priority < best_priority || distance < best_distance)
-          best = t, best_priority = priority, best_distance = distance;
-      }
-      frontier.resize(kept);
+      // Every near entry comes before every far one, so far is scanned only when no near entry fits.
+      auto scan = [&](std::vector<uint32_t>& list, bool is_far) {
+        size_t kept = 0;
+        for (size_t i = 0; i < list.size();
+             ++i) {  // drops used (and, from far, moved) entries while scanning
+          const uint32_t t = list[i];
+          const State st = state[t];
+          if (st.used || (is_far && (st.flags & kNear))) continue;
+          list[kept++] = t;
+          const size_t added = size_t(st.corners - st.shared);
+          if (part.vertices.size() + added > max_vertices) continue;
+          const uint32_t priority = (st.flags & kLast) ? 1 : uint32_t(added) + 1;
+          if (priority > best_priority) continue;
+          const glm::vec3 d = centroid[t] - center;
+          const float distance = glm::dot(d, d);
+          if (priority < best_priority || distance < best_distance ||
+              (distance == best_distance && listed[t] < listed[best]))
+            best = t, best_priority = priority, best_distance = distance;
+        }
+        list.resize(kept);
+      };
+      scan(near, false);
+      if (best == kUnset) scan(far, true);
       if (best == kUnset) {
-        if (!frontier.empty()) break;
+        if (!near.empty() || !far.empty()) break;
         // The component is used up (no unused triangle touches the cluster): continue with the unused
         // triangle nearest the centroid among the next kJumpWindow of the spatial order (near each other).
         constexpr size_t kJumpWindow = 64;
@@ -145,14 +166,26 @@ void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_
   }
 }
 
+// The DAG drops degenerate triangles first, so there every corner counts without the per-corner test.
+void grow_clusters(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
+                   size_t max_vertices, size_t max_triangles, std::vector<ClusterPart>& parts) {
+  bool degenerate = false;
+  for (size_t t = 0; t + 2 < indices.size() && !degenerate; t += 3) {
+    const uint32_t* c = &indices[t];
+    degenerate = c[0] == c[1] || c[1] == c[2] || c[0] == c[2];
+  }
+  if (degenerate)
+    grow<true>(positions, indices, max_vertices, max_triangles, parts);
+  else
+    grow<false>(positions, indices, max_vertices, max_triangles, parts);
+}
+
 }  // namespace
 
 std::vector<ClusterPart> clusterize(const Mesh& mesh, size_t max_vertices, size_t max_triangles) {
   std::vector<ClusterPart> parts;
   if (mesh.indices.empty()) return parts;
-  std::vector<uint32_t> sorted(mesh.indices.size());
-  meshopt_spatialSortTriangles(sorted.data(), mesh.indices.data(), mesh.indices.size(), &mesh.positions[0].x,
-                               mesh.positions.size(), sizeof(glm::vec3));
+  const std::vector<uint32_t> sorted = spatial_sort_triangles(mesh.positions, mesh.indices);
   const size_t chunk_indices = 3 * kChunkClusters * max_triangles;
   if (sorted.size() <= chunk_indices) {
     grow_clusters(mesh.positions, sorted, max_vertices, max_triangles, parts);

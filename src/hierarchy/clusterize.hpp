@@ -1,5 +1,5 @@
 // Splitting a mesh into clusters of at most N triangles and M vertices: triangles are first put in a
-// spatial (Morton) order (meshoptimizer), then each cluster grows greedily over shared vertices from the
+// spatial (Morton) order (spatial_sort.hpp), then each cluster grows greedily over shared vertices from the
 // first unused triangle of that order (fewest new vertices first, then nearest), which keeps clusters
 // spatially coherent with few boundary edges. The rule is that of meshoptimizer's meshlet builder, kept
 // incremental (a frontier of candidate triangles instead of a rescan of the cluster's vertices per step and a
@@ -23,7 +23,7 @@ struct ClusterPart {
 // partly filled and the cut between runs is ragged, so runs are long (1024 clusters).
 inline constexpr size_t kChunkClusters = 1024;
 
-// Clusters of `mesh`'s triangles, every triangle in exactly one. Cost: O(T log T) for the spatial order,
+// Clusters of `mesh`'s triangles, every triangle in exactly one. Cost: O(T) for the spatial order,
 // then O(T) times a frontier of a few dozen triangles; meshes of more than kChunkClusters clusters use every
 // core.
 std::vector<ClusterPart> clusterize(const Mesh& mesh, size_t max_vertices, size_t max_triangles);

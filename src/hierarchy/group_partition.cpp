@@ -8,25 +8,19 @@
 #include <numeric>
 
 #include "core/error.hpp"
+#include "core/morton.hpp"
 
 namespace lodstream::hierarchy {
 namespace {
 
 // 30-bit Morton code of a point inside [lo, lo + extent].
 uint32_t morton(const glm::vec3& p, const glm::vec3& lo, const glm::vec3& extent) {
-  auto spread = [](uint32_t v) {  // 10 bits -> every third bit
-    v = (v | (v << 16)) & 0x030000FF;
-    v = (v | (v << 8)) & 0x0300F00F;
-    v = (v | (v << 4)) & 0x030C30C3;
-    v = (v | (v << 2)) & 0x09249249;
-    return v;
-  };
-  uint32_t code = 0;
+  uint32_t cell[3];
   for (int a = 0; a < 3; ++a) {
-    float t = extent[a] > 0 ? (p[a] - lo[a]) / extent[a] : 0.0f;
-    code |= spread(uint32_t(std::clamp(t, 0.0f, 1.0f) * 1023.0f)) << a;
+    const float t = extent[a] > 0 ? (p[a] - lo[a]) / extent[a] : 0.0f;
+    cell[a] = uint32_t(std::clamp(t, 0.0f, 1.0f) * 1023.0f);
   }
-  return code;
+  return morton_code10(cell[0], cell[1], cell[2]);
 }
 
 // Up to this many clusters are grouped along the Morton curve instead of by METIS.

@@ -1,10 +1,9 @@
 #include "hierarchy/position_index.hpp"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <bit>
+
+#include "core/representatives.hpp"
 
 namespace lodstream::hierarchy {
 namespace {
@@ -77,73 +76,12 @@ uint32_t PositionIndex::find(const glm::vec3& p) const {
 }
 
 std::vector<uint32_t> weld_positions(std::span<const glm::vec3> positions, uint32_t& distinct) {
-  const size_t n = positions.size();
-  std::vector<uint32_t> ids(n);
-  // Buckets by the hash's top bits, about 1024 positions each; positions in chunks, each chunk's bucket
-  // counts apart, so that the counting sort runs on every core and keeps increasing positions per bucket.
-  const int bucket_bits = std::min(16, int(std::bit_width(n / 1024)));
-  const size_t buckets = size_t(1) << bucket_bits;
-  auto bucket_of = [bucket_bits](uint64_t h) {
-    return bucket_bits == 0 ? size_t(0) : size_t(h >> (64 - bucket_bits));
-  };
-  constexpr size_t kChunk = size_t(1) << 16;
-  const size_t chunks = (n + kChunk - 1) / kChunk;
-  std::vector<uint32_t> start(chunks * buckets, 0);  // chunk-major: start[c * buckets + b]
-  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-    uint32_t* count = &start[c * buckets];
-    for (size_t v = c * kChunk; v < std::min(n, (c + 1) * kChunk); ++v)
-      ++count[bucket_of(position_hash(positions[v]))];
-  });
-  std::vector<uint32_t> bucket_begin(buckets + 1, 0);
-  uint32_t running = 0;
-  for (size_t b = 0; b < buckets; ++b) {
-    bucket_begin[b] = running;
-    for (size_t c = 0; c < chunks; ++c) {
-      const uint32_t k = start[c * buckets + b];
-      start[c * buckets + b] = running;
-      running += k;
-    }
-  }
-  bucket_begin[buckets] = running;
-  std::vector<uint32_t> order(n);
-  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-    uint32_t* next = &start[c * buckets];
-    for (size_t v = c * kChunk; v < std::min(n, (c + 1) * kChunk); ++v)
-      order[next[bucket_of(position_hash(positions[v]))]++] = uint32_t(v);
-  });
-  start = {};
-  // Each bucket: every position's first equal position (its representative), through a table of (32 hash
-  // bits, position) slots at load <= 0.5, reused by the thread.
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, buckets, 16), [&](const tbb::blocked_range<size_t>& r) {
-    constexpr uint64_t kEmpty = UINT64_MAX;
-    thread_local std::vector<uint64_t> table;
-    for (size_t b = r.begin(); b < r.end(); ++b) {
-      const uint32_t begin = bucket_begin[b], end = bucket_begin[b + 1];
-      const size_t capacity = std::bit_ceil(std::max<size_t>(16, 2 * size_t(end - begin)));
-      if (table.size() < capacity) table.resize(capacity);
-      std::fill_n(table.begin(), capacity, kEmpty);
-      for (uint32_t i = begin; i < end; ++i) {
-        const uint32_t v = order[i];
-        const uint64_t h = position_hash(positions[v]);
-        const uint64_t tag = uint32_t(h);
-        for (size_t slot = h & (capacity - 1);; slot = (slot + 1) & (capacity - 1)) {
-          const uint64_t e = table[slot];
-          if (e == kEmpty) {
-            table[slot] = tag << 32 | v;
-            ids[v] = v;
-            break;
-          }
-          if (e >> 32 == tag && same_position(positions[uint32_t(e)], positions[v])) {
-            ids[v] = uint32_t(e);
-            break;
-          }
-        }
-      }
-    }
-  });
+  std::vector<uint32_t> ids = representatives(
+      positions.size(), [&](size_t v) { return position_hash(positions[v]); },
+      [&](uint32_t a, uint32_t b) { return same_position(positions[a], positions[b]); });
   // Representatives come first (they are the smallest of their positions): number them in order.
   uint32_t next = 0;
-  for (size_t v = 0; v < n; ++v) ids[v] = ids[v] == v ? next++ : ids[ids[v]];
+  for (size_t v = 0; v < ids.size(); ++v) ids[v] = ids[v] == v ? next++ : ids[ids[v]];
   distinct = next;
   return ids;
 }

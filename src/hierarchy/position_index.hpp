@@ -35,11 +35,8 @@ class PositionIndex {
 
 // The id PositionIndex::insert would give each of `positions` in turn (equal positions, bit for bit with
 // -0 = +0, share the id of the first; ids dense in order of first occurrence); `distinct` receives the
-// number of ids. The positions are dealt by hash into buckets of a few thousand (one counting-sort pass),
-// each bucket welded in a small per-thread table that stays in cache, buckets on every core, then one
-// in-order pass numbers the first occurrences. Cost: O(n), 4 bytes per position of scratch besides the
-// result; one PositionIndex over a whole large mesh (a table of 32 bytes per position, one cache miss per
-// insert) took 0.7 CPU-s on 2.8 M positions, mostly first touches of its pages.
+// number of ids. Each position's representative (core/representatives.hpp, on every core), then one in-order
+// pass numbers the representatives. Cost: O(n), 4 bytes per position of scratch besides the result.
 std::vector<uint32_t> weld_positions(std::span<const glm::vec3> positions, uint32_t& distinct);
 
 }  // namespace lodstream::hierarchy

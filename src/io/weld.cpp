@@ -10,6 +10,9 @@
 #include <memory>
 #include <vector>
 
+#include "core/bucket_sort.hpp"
+#include "core/representatives.hpp"
+
 namespace lodstream {
 
 namespace {
@@ -63,45 +66,16 @@ struct VertexKey {
   }
 };
 
-// For every vertex, the first vertex equal to it under `key`. Open addressing with linear probing at load
-// <= 0.5; each slot keeps 32 bits of the hash next to the vertex, so a probe touches the vertex data only
-// when the hashes agree (one cache miss per vertex in the common case).
+// For every vertex, the first vertex equal to it under `key` (core/representatives.hpp, on every core), its
+// hashes computed once (they are looked up three times).
 std::vector<uint32_t> representatives(const VertexKey& key, size_t n) {
-  size_t capacity = 16;
-  while (capacity < 2 * n) capacity *= 2;
-  constexpr uint64_t kEmpty = UINT64_MAX;
-  std::vector<uint64_t> table(capacity, kEmpty);
-  // Arrays that are written in full are left uninitialized (zero-filling them cost a tenth of an import).
   auto hashes = std::make_unique_for_overwrite<uint64_t[]>(n);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v < r.end(); ++v) hashes[v] = key.hash(uint32_t(v));
   });
-  std::vector<uint32_t> rep;
-  rep.reserve(n);
-  const size_t mask = capacity - 1;
-  // The table is far larger than the caches: prefetching the slot of a vertex a few steps ahead keeps several
-  // misses in flight instead of waiting for each.
-  constexpr uint32_t kAhead = 16;
-  for (uint32_t v = 0; v < n; ++v) {
-    if (v + kAhead < n) __builtin_prefetch(&table[hashes[v + kAhead] & mask]);
-    const uint64_t h = hashes[v];
-    const uint64_t tag = h >> 32;
-    size_t slot = h & mask;
-    for (;;) {
-      const uint64_t e = table[slot];
-      if (e == kEmpty) {
-        table[slot] = (tag << 32) | v;
-        rep.push_back(v);
-        break;
-      }
-      if ((e >> 32) == tag && key.equal(static_cast<uint32_t>(e), v)) {
-        rep.push_back(static_cast<uint32_t>(e));
-        break;
-      }
-      slot = (slot + 1) & mask;
-    }
-  }
-  return rep;
+  return lodstream::representatives(
+      n, [&hashes](size_t v) { return hashes[v]; },
+      [&key](uint32_t a, uint32_t b) { return key.equal(a, b); });
 }
 
 // Keeps the vertices listed in `keep` order; `remap[old]` gives each old vertex's new index. Gathers on
@@ -183,6 +157,33 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
     for (uint32_t v = 0; v < nv; ++v) position.push_back(v);
   }
 
+  // Corners grouped by position class, increasing within each (a stable counting sort), on every core: dealt
+  // by their position's high bits into 1024-2047 slices of consecutive positions (core/bucket_sort.hpp),
+  // then each slice counting-sorted by position in cache, in place through a per-thread copy (was two serial
+  // passes with a cache miss per corner). start[p]: the first of position p's corners in `corners`.
+  const int slice_bits = std::max(0, int(std::bit_width(nv)) - 11);
+  const size_t slices = ((nv - 1) >> slice_bits) + 1;
+  std::vector<uint32_t> corners, slice_begin;
+  bucket_sort(
+      nc, slices, [&](size_t c) { return size_t(position[mesh.indices[c]] >> slice_bits); },
+      [](size_t c) { return uint32_t(c); }, corners, slice_begin);
+  std::vector<uint32_t> start(nv + 1, 0);
+  tbb::parallel_for(size_t(0), slices, [&](size_t s) {
+    const size_t lo = s << slice_bits, hi = std::min(nv, (s + 1) << slice_bits);
+    thread_local std::vector<uint32_t> slice;
+    slice.assign(corners.begin() + slice_begin[s], corners.begin() + slice_begin[s + 1]);
+    for (uint32_t c : slice) ++start[position[mesh.indices[c]]];
+    uint32_t running = slice_begin[s];
+    for (size_t p = lo; p < hi; ++p) {
+      const uint32_t count = start[p];
+      start[p] = running;
+      running += count;
+    }
+    std::vector<uint32_t> fill(start.begin() + lo, start.begin() + hi);
+    for (uint32_t c : slice) corners[fill[position[mesh.indices[c]] - lo]++] = c;
+  });
+  start[nv] = uint32_t(nc);
+
   // Face normals, unnormalized: their length is twice the area, which weights the sums.
   auto face = std::make_unique_for_overwrite<glm::vec3[]>(nt);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nt, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
@@ -192,28 +193,7 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
                            mesh.positions[v[2]] - mesh.positions[v[0]]);
     }
   });
-
-  // Corners grouped by position class (counting sort).
-  std::vector<uint32_t> start(nv + 1, 0);
-  auto corners = std::make_unique_for_overwrite<uint32_t[]>(nc);
-  // The scattered counters are prefetched a few corners ahead, like the hash table in representatives.
-  constexpr uint32_t kAhead = 16;
-  for (uint32_t c = 0; c < nc; ++c) {
-    if (c + kAhead < nc) __builtin_prefetch(&start[position[mesh.indices[c + kAhead]] + 1]);
-    ++start[position[mesh.indices[c]] + 1];
-  }
-  for (size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
-  {
-    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-    for (uint32_t c = 0; c < nc; ++c) {
-      if (c + kAhead < nc) {
-        const uint32_t ahead = position[mesh.indices[c + kAhead]];
-        __builtin_prefetch(&fill[ahead]);
-        __builtin_prefetch(&corners[fill[ahead]]);
-      }
-      corners[fill[position[mesh.indices[c]]]++] = c;
-    }
-  }
+  constexpr uint32_t kAhead = 16;  // prefetch distance where corners are gathered in random order
 
   // Per position: group its corners by crease, then give each (welded vertex, group) pair one output vertex.
   // A welded vertex belongs to exactly one position, so all its corners are handled here and the indices can

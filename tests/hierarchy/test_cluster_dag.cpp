@@ -289,5 +289,32 @@ TEST(ClusterDag, TerminatesOnNonManifoldAndManyTinyComponents) {
   EXPECT_TRUE(build_cluster_dag(Mesh{}).clusters.empty());
 }
 
+// Triangles with a repeated index are dropped before clustering, wherever they stand (first, inside, last):
+// the level-0 clusters hold exactly the other triangles, each once.
+TEST(ClusterDag, DegenerateTrianglesAreDroppedWherePlaced) {
+  const Mesh sphere = test::sphere(1.0f, 16, 32);
+  Mesh mesh = sphere;
+  const size_t n = sphere.triangle_count();
+  for (size_t t : {size_t(0), n / 3, n - 1}) mesh.indices[3 * t + 2] = mesh.indices[3 * t];
+  const ClusterDag dag = build_cluster_dag(mesh);
+  EXPECT_EQ(dag.input_triangles, n - 3);
+  std::multiset<std::tuple<float, float, float, float, float, float, float, float, float>> kept, clustered;
+  auto key = [](const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+    return std::make_tuple(a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z);
+  };
+  for (size_t t = 0; t < n; ++t) {
+    const uint32_t* i = &mesh.indices[3 * t];
+    if (i[0] != i[1] && i[1] != i[2] && i[0] != i[2])
+      kept.insert(key(mesh.positions[i[0]], mesh.positions[i[1]], mesh.positions[i[2]]));
+  }
+  for (const DagCluster& c : dag.clusters) {
+    if (c.level != 0) continue;
+    for (size_t k = 0; k < c.mesh.indices.size(); k += 3)
+      clustered.insert(key(c.mesh.positions[c.mesh.indices[k]], c.mesh.positions[c.mesh.indices[k + 1]],
+                           c.mesh.positions[c.mesh.indices[k + 2]]));
+  }
+  EXPECT_EQ(clustered, kept);
+}
+
 }  // namespace
 }  // namespace lodstream::hierarchy

@@ -1,0 +1,26 @@
+// Morton (Z-order) codes: the bits of three integer coordinates interleaved (x in bit 0, y in bit 1, z in bit
+// 2, then the next bit of each), so that sorting by the code walks space along a Z curve and points near each
+// other in the order are near in space (Morton 1966; the bit spreading of Giesen, "Decoding Morton codes",
+// 2009). Header-only: a few shifts and masks per coordinate.
+#pragma once
+
+#include <cstdint>
+
+namespace lodstream {
+
+// Bit i of the 10 low bits of `v` moved to bit 3i (the other bits zero).
+constexpr uint32_t morton_spread10(uint32_t v) {
+  v &= 0x3FF;
+  v = (v | (v << 16)) & 0x030000FF;
+  v = (v | (v << 8)) & 0x0300F00F;
+  v = (v | (v << 4)) & 0x030C30C3;
+  v = (v | (v << 2)) & 0x09249249;
+  return v;
+}
+
+// The 30-bit Morton code of a point of the 1024^3 grid (coordinates' low 10 bits).
+constexpr uint32_t morton_code10(uint32_t x, uint32_t y, uint32_t z) {
+  return morton_spread10(x) | morton_spread10(y) << 1 | morton_spread10(z) << 2;
+}
+
+}  // namespace lodstream

@@ -1,0 +1,89 @@
+#include "hierarchy/spatial_sort.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <cfloat>
+
+#include "core/bucket_sort.hpp"
+#include "core/morton.hpp"
+
+namespace lodstream::hierarchy {
+
+std::vector<uint32_t> spatial_sort_triangles(std::span<const glm::vec3> positions,
+                                             std::span<const uint32_t> indices) {
+  const size_t n = indices.size() / 3;
+  std::vector<uint32_t> sorted(n * 3);
+  if (n == 0) return sorted;
+  // Centroids, with the same operations in the same order as meshoptimizer, and their bounding box.
+  std::vector<glm::vec3> centroid(n);
+  struct Box {
+    glm::vec3 lo{FLT_MAX}, hi{-FLT_MAX};
+  };
+  auto centroids = [&](size_t begin, size_t end, Box b) {
+    for (size_t t = begin; t < end; ++t) {
+      const glm::vec3 &a = positions[indices[3 * t]], &c1 = positions[indices[3 * t + 1]],
+                      &c2 = positions[indices[3 * t + 2]];
+      const glm::vec3 m((a.x + c1.x + c2.x) / 3.f, (a.y + c1.y + c2.y) / 3.f, (a.z + c1.z + c2.z) / 3.f);
+      centroid[t] = m;
+      b.lo = glm::min(b.lo, m), b.hi = glm::max(b.hi, m);
+    }
+    return b;
+  };
+  const bool parallel = n >= kParallelSortTriangles;
+  const Box box =
+      !parallel
+          ? centroids(0, n, Box{})
+          : tbb::parallel_reduce(
+                tbb::blocked_range<size_t>(0, n), Box{},
+                [&](const tbb::blocked_range<size_t>& r, Box b) { return centroids(r.begin(), r.end(), b); },
+                [](Box a, const Box& b) {
+                  return Box{glm::min(a.lo, b.lo), glm::max(a.hi, b.hi)};
+                });
+  float extent = 0.0f;
+  for (int a = 0; a < 3; ++a) extent = std::max(extent, box.hi[a] - box.lo[a]);
+  const float scale = extent == 0.0f ? 0.0f : 1.0f / extent;
+
+  // (code << 32 | triangle): sorting these sorts by code, ties by triangle (a stable sort by code).
+  auto code_of = [&](size_t t) {
+    const glm::vec3 q = (centroid[t] - box.lo) * scale * 1023.f + 0.5f;
+    return morton_code10(uint32_t(int(q.x)), uint32_t(int(q.y)), uint32_t(int(q.z)));
+  };
+  std::vector<uint64_t> order;
+  if (!parallel) {
+    order.resize(n);
+    for (size_t t = 0; t < n; ++t) order[t] = uint64_t(code_of(t)) << 32 | t;
+    std::sort(order.begin(), order.end());
+  } else {
+    // The triangles are dealt by the code's top 10 bits into 1024 runs (bucket_sort.hpp), then each run is
+    // sorted in cache.
+    constexpr int kRunBits = 10;
+    constexpr size_t kRuns = size_t(1) << kRunBits;
+    std::vector<uint32_t> code(n);
+    tbb::parallel_for(size_t(0), n, [&](size_t t) { code[t] = code_of(t); });
+    centroid = {};
+    std::vector<uint32_t> run_begin;
+    bucket_sort(
+        n, kRuns, [&](size_t t) { return code[t] >> (30 - kRunBits); },
+        [&](size_t t) { return uint64_t(code[t]) << 32 | t; }, order, run_begin);
+    code = {};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, kRuns, 8), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t run = r.begin(); run < r.end(); ++run)
+        std::sort(order.begin() + run_begin[run], order.begin() + run_begin[run + 1]);
+    });
+  }
+  auto gather = [&](size_t i) {
+    const size_t t = uint32_t(order[i]);
+    sorted[3 * i] = indices[3 * t], sorted[3 * i + 1] = indices[3 * t + 1],
+               sorted[3 * i + 2] = indices[3 * t + 2];
+  };
+  if (parallel)
+    tbb::parallel_for(size_t(0), n, gather);
+  else
+    for (size_t i = 0; i < n; ++i) gather(i);
+  return sorted;
+}
+
+}  // namespace lodstream::hierarchy
