@@ -1,6 +1,6 @@
 // Welding by hash: for items 0..n-1 with an equality (equal positions, equal vertices) and a 64-bit hash
 // that agrees with it, each item's representative, the smallest item equal to it. The items are dealt by
-// the hash's top bits into buckets of about 1024 on every core (bucket_sort.hpp, which keeps increasing
+// the hash's top bits into buckets of about 1024 on every core (counting_sort.hpp, which keeps increasing
 // items in each), and each bucket resolved through a small per-thread table of (32 hash
 // bits, item) slots at load <= 0.5 that stays in cache, buckets on every core. One table over all items
 // (one cache miss per item, on one core) took 0.7 CPU-s on 2.8 M positions, mostly first touches of its
@@ -15,7 +15,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/bucket_sort.hpp"
+#include "core/counting_sort.hpp"
 
 namespace lodstream {
 
@@ -32,8 +32,10 @@ std::vector<uint32_t> representatives(size_t n, const Hash& hash, const Equal& e
     return bucket_bits == 0 ? size_t(0) : size_t(hash(i) >> (64 - bucket_bits));
   };
   std::vector<uint32_t> order, bucket_begin;
-  bucket_sort(
-      n, buckets, bucket_of, [](size_t i) { return uint32_t(i); }, order, bucket_begin);
+  order.resize(n);
+  counting_sort(
+      n, uint32_t(buckets), bucket_of, [&](size_t i, uint32_t at) { order[at] = uint32_t(i); },
+      &bucket_begin);
   std::vector<uint32_t> rep(n);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, buckets, 16), [&](const tbb::blocked_range<size_t>& r) {
     constexpr uint64_t kEmpty = UINT64_MAX;

@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <cfloat>
 
-#include "core/bucket_sort.hpp"
+#include "core/counting_sort.hpp"
 #include "core/morton.hpp"
 
 namespace lodstream::hierarchy {
@@ -57,17 +57,18 @@ std::vector<uint32_t> spatial_sort_triangles(std::span<const glm::vec3> position
     for (size_t t = 0; t < n; ++t) order[t] = uint64_t(code_of(t)) << 32 | t;
     std::sort(order.begin(), order.end());
   } else {
-    // The triangles are dealt by the code's top 10 bits into 1024 runs (bucket_sort.hpp), then each run is
-    // sorted in cache.
+    // The triangles are dealt by the code's top 10 bits into 1024 runs (core/counting_sort.hpp), then each
+    // run is sorted in cache.
     constexpr int kRunBits = 10;
     constexpr size_t kRuns = size_t(1) << kRunBits;
     std::vector<uint32_t> code(n);
     tbb::parallel_for(size_t(0), n, [&](size_t t) { code[t] = code_of(t); });
     centroid = {};
     std::vector<uint32_t> run_begin;
-    bucket_sort(
+    order.resize(n);
+    counting_sort(
         n, kRuns, [&](size_t t) { return code[t] >> (30 - kRunBits); },
-        [&](size_t t) { return uint64_t(code[t]) << 32 | t; }, order, run_begin);
+        [&](size_t t, uint32_t at) { order[at] = uint64_t(code[t]) << 32 | t; }, &run_begin);
     code = {};
     tbb::parallel_for(tbb::blocked_range<size_t>(0, kRuns, 8), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t run = r.begin(); run < r.end(); ++run)

@@ -10,7 +10,7 @@
 #include <memory>
 #include <vector>
 
-#include "core/bucket_sort.hpp"
+#include "core/counting_sort.hpp"
 #include "core/representatives.hpp"
 
 namespace lodstream {
@@ -158,15 +158,16 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
   }
 
   // Corners grouped by position class, increasing within each (a stable counting sort), on every core: dealt
-  // by their position's high bits into 1024-2047 slices of consecutive positions (core/bucket_sort.hpp),
+  // by their position's high bits into 1024-2047 slices of consecutive positions (core/counting_sort.hpp),
   // then each slice counting-sorted by position in cache, in place through a per-thread copy (was two serial
   // passes with a cache miss per corner). start[p]: the first of position p's corners in `corners`.
   const int slice_bits = std::max(0, int(std::bit_width(nv)) - 11);
   const size_t slices = ((nv - 1) >> slice_bits) + 1;
   std::vector<uint32_t> corners, slice_begin;
-  bucket_sort(
-      nc, slices, [&](size_t c) { return size_t(position[mesh.indices[c]] >> slice_bits); },
-      [](size_t c) { return uint32_t(c); }, corners, slice_begin);
+  corners.resize(nc);
+  counting_sort(
+      nc, uint32_t(slices), [&](size_t c) { return uint32_t(position[mesh.indices[c]] >> slice_bits); },
+      [&](size_t c, uint32_t at) { corners[at] = uint32_t(c); }, &slice_begin);
   std::vector<uint32_t> start(nv + 1, 0);
   tbb::parallel_for(size_t(0), slices, [&](size_t s) {
     const size_t lo = s << slice_bits, hi = std::min(nv, (s + 1) << slice_bits);

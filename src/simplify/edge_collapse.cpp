@@ -16,8 +16,9 @@
 #include <numeric>
 #include <utility>
 
+#include "core/counting_sort.hpp"
+#include "core/morton.hpp"
 #include "simplify/cluster.hpp"
-#include "simplify/counting_sort.hpp"
 #include "simplify/quadric.hpp"
 #include "simplify/simplify.hpp"
 #include "simplify/uninitialized.hpp"
@@ -398,16 +399,10 @@ class Simplifier {
   // follow (sort_faces). O(V log V), on every core.
   void renumber_spatially() {
     const size_t m = source_.size();
-    auto spread = [](uint64_t x) {  // bit i of x to bit 3i (21 bits)
-      x &= 0x1fffff;
-      x = (x | x << 32) & 0x1f00000000ffffull, x = (x | x << 16) & 0x1f0000ff0000ffull;
-      x = (x | x << 8) & 0x100f00f00f00f00full, x = (x | x << 4) & 0x10c30c30c30c30c3ull;
-      return (x | x << 2) & 0x1249249249249249ull;
-    };
     UninitializedVector<std::pair<uint64_t, uint32_t>> code(m);
     for_each(uint32_t(0), uint32_t(m), [&](uint32_t v) {
       const glm::vec3 q = glm::clamp(pos_[v], 0.0f, 1.0f) * 2097151.0f;  // pos_ is in [0, 1]^3
-      code[v] = {spread(uint64_t(q.x)) | spread(uint64_t(q.y)) << 1 | spread(uint64_t(q.z)) << 2, v};
+      code[v] = {morton_code21(uint32_t(q.x), uint32_t(q.y), uint32_t(q.z)), v};
     });
     tbb::parallel_sort(code.begin(), code.end());  // ties (wedges share a position) by old number
     UninitializedVector<uint32_t> renumbered(m);

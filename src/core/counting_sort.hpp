@@ -1,4 +1,6 @@
-// A stable counting sort whose two scans run on all cores. Internal to src/simplify.
+// A stable counting sort whose two scans run on all cores: the simplifier's face and candidate orders, and
+// large arrays dealt into runs that are then handled in cache (representatives.hpp, io's weld, the spatial
+// sort).
 #pragma once
 
 #include <tbb/parallel_for.h>
@@ -8,7 +10,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace lodstream::simplify {
+namespace lodstream {
 
 // Places the items 0..n-1 by bucket, stably: write(i, position) is called once for every item whose
 // key(i) < buckets, with positions grouped by bucket in increasing order and, within a bucket, in the
@@ -46,4 +48,4 @@ void counting_sort(size_t n, uint32_t buckets, Key&& key, Write&& write,
   });
 }
 
-}  // namespace lodstream::simplify
+}  // namespace lodstream
