@@ -1,6 +1,7 @@
 // `lodstream inspect SCENE.lods [--json] [--verify] [--cuts N] [--parts]`: what a package holds (nodes,
 // pages, levels, bytes, per-level counts and errors; with --parts, each level's bytes per node part, raw and
-// after zstd, and vertices per triangle: package/size_account.hpp) and, with --verify, whether every
+// after zstd, and vertices per triangle: package/size_account.hpp; and the index's bytes per record field:
+// package/index_account.hpp) and, with --verify, whether every
 // invariant of DESIGN.md's Data model holds: the content hash, monotonic errors (a node's parents' pair is
 // its parents' own pair and at least its own), containing spheres, every page and node decodes and matches
 // its record, and crack-free cuts: for N random eyes and thresholds per representation, the cut chosen by the
@@ -23,6 +24,7 @@
 #include "core/image.hpp"
 #include "hierarchy/bounding_sphere.hpp"
 #include "hierarchy/cut.hpp"
+#include "package/index_account.hpp"
 #include "package/progressive_prefix.hpp"
 #include "package/reader.hpp"
 #include "package/records.hpp"
@@ -196,7 +198,8 @@ int run_inspect(const InspectArgs& args) {
   for (const Range& b : root.blobs) texture_bytes += b.size;
 
   std::vector<LevelAccount> account;
-  if (args.parts) account = account_sizes(reader);
+  IndexAccount index_account;
+  if (args.parts) account = account_sizes(reader), index_account = account_index(reader);
 
   std::string violation;
   if (args.verify) {
@@ -343,6 +346,16 @@ int run_inspect(const InspectArgs& args) {
                          {"compressed", compressed}});
       }
       out["parts"] = parts;
+      nlohmann::json raw, compressed;
+      for (size_t f = 0; f < kIndexFields; ++f) {
+        raw[kIndexFieldNames[f]] = index_account.raw[f];
+        compressed[kIndexFieldNames[f]] = index_account.compressed[f];
+      }
+      out["index_parts"] = {{"records", index_account.records},
+                            {"root_stored", index_account.root_stored},
+                            {"pages_stored", index_account.pages_stored},
+                            {"raw", raw},
+                            {"compressed", compressed}};
     }
     if (args.verify) {
       out["verified"] = violation.empty();
@@ -371,6 +384,15 @@ int run_inspect(const InspectArgs& args) {
         for (const PartBytes& b : a.parts) std::printf("   %5.2f / %5.2f", b.raw / t, b.compressed / t);
         std::printf("  %6.3f\n", a.page_bytes / t);
       }
+      const IndexAccount& x = index_account;
+      const double r = double(std::max<uint64_t>(1, x.records));
+      std::printf(
+          "  index: %llu records, root index %llu B and index pages %llu B stored (%.2f B/record);\n"
+          "  bytes per record by field, raw / alone after zstd:\n",
+          (unsigned long long)x.records, (unsigned long long)x.root_stored,
+          (unsigned long long)x.pages_stored, double(x.root_stored + x.pages_stored) / r);
+      for (size_t f = 0; f < kIndexFields; ++f)
+        std::printf("  %18s  %6.2f / %5.2f\n", kIndexFieldNames[f], x.raw[f] / r, x.compressed[f] / r);
     }
     if (args.verify && violation.empty())
       std::printf("verified: every invariant holds (%d cuts per DAG)\n", args.cuts);
@@ -394,7 +416,8 @@ const bool registered = register_command(
            "--parts", args->parts,
            "also each level's vertices and bytes per node part (header, positions, normals, "
            "attributes, locked, connectivity), raw and compressed alone by zstd in page-sized chunks, "
-           "and the stored page bytes per level (JSON key parts)");
+           "and the stored page bytes per level (JSON key parts); and the index's bytes per record field "
+           "(JSON key index_parts)");
        sub.add_option("--cuts", args->cuts, "random cuts checked per cluster DAG with --verify (default 32)");
        sub.add_flag(
            "--json", args->json,

@@ -85,7 +85,7 @@ ErrorPair parent_pair(const NodeRecord& n) {
 }
 
 // The fields of a run of records, each coded into a stream of its own (index.hpp): zstd then sees each
-// field's repetitions and statistics apart from the others'.
+// field's repetitions and statistics apart from the others'. In the order of kIndexFieldNames.
 enum Field : size_t {
   kHead,          // head byte
   kDeltas,        // representation, material, level
@@ -103,10 +103,7 @@ enum Field : size_t {
   kPairRadius,    // sphere radii
   kFields
 };
-constexpr const char* kFieldNames[kFields] = {
-    "record heads",  "record deltas",  "record locations", "record sizes", "triangle counts",
-    "vertex counts", "children",       "parents",          "objects",      "pair codes",
-    "pair errors",   "pair exponents", "sphere centres",   "sphere radii"};
+static_assert(kFields == kIndexFields);
 using FieldWriters = std::array<ByteWriter, kFields>;
 
 // A run's field streams as read: one reader per field over its bytes.
@@ -342,15 +339,9 @@ NodeRecord read_node(FieldReaders& r, const RootIndex& root, uint32_t id, Record
 
 // The records of ids first_id.., coded as one run: for each field, varint byte count then its stream.
 void write_nodes(ByteWriter& w, std::span<const NodeRecord> nodes, uint32_t first_id) {
-  FieldWriters fields;
-  RecordRun run;
-  run.first_id = first_id;
-  for (size_t i = 0; i < nodes.size(); ++i) {
-    run.done = nodes.first(i);
-    write_node(fields, nodes[i], first_id + uint32_t(i), run);
-  }
-  for (const ByteWriter& f : fields) w.varint(f.bytes.size());
-  for (const ByteWriter& f : fields) w.raw(f.bytes);
+  const std::array<std::vector<uint8_t>, kFields> fields = serialize_node_fields(nodes, first_id);
+  for (const std::vector<uint8_t>& f : fields) w.varint(f.size());
+  for (const std::vector<uint8_t>& f : fields) w.raw(f);
 }
 std::vector<NodeRecord> read_nodes(ByteReader& r, const RootIndex& root, uint32_t first_id, size_t count,
                                    std::string_view context) {
@@ -359,9 +350,9 @@ std::vector<NodeRecord> read_nodes(ByteReader& r, const RootIndex& root, uint32_
   for (uint64_t& size : sizes) size = r.varint();
   fields.contexts.reserve(kFields);  // the readers keep views of these
   for (size_t f = 0; f < kFields; ++f) {
-    if (sizes[f] > r.remaining()) r.fail(std::string(kFieldNames[f]) + " stream longer than the run");
-    fields.contexts.push_back(std::string(context) + ": " + kFieldNames[f]);
-    fields.f.emplace_back(r.bytes(size_t(sizes[f]), kFieldNames[f]), fields.contexts.back());
+    if (sizes[f] > r.remaining()) r.fail(std::string(kIndexFieldNames[f]) + " stream longer than the run");
+    fields.contexts.push_back(std::string(context) + ": " + kIndexFieldNames[f]);
+    fields.f.emplace_back(r.bytes(size_t(sizes[f]), kIndexFieldNames[f]), fields.contexts.back());
   }
   std::vector<NodeRecord> nodes;  // grown as records parse (no reserve: a hostile count allocates nothing)
   RecordRun run;
@@ -375,6 +366,20 @@ std::vector<NodeRecord> read_nodes(ByteReader& r, const RootIndex& root, uint32_
 }
 
 }  // namespace
+
+std::array<std::vector<uint8_t>, kIndexFields> serialize_node_fields(std::span<const NodeRecord> nodes,
+                                                                     uint32_t first_id) {
+  FieldWriters fields;
+  RecordRun run;
+  run.first_id = first_id;
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    run.done = nodes.first(i);
+    write_node(fields, nodes[i], first_id + uint32_t(i), run);
+  }
+  std::array<std::vector<uint8_t>, kIndexFields> out;
+  for (size_t f = 0; f < kFields; ++f) out[f] = std::move(fields[f].bytes);
+  return out;
+}
 
 std::vector<uint8_t> serialize_root(const RootIndex& root) {
   ByteWriter w;

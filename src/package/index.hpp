@@ -25,6 +25,7 @@
 // node's parents' pair with its parents' own pair bit for bit.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <limits>
@@ -129,6 +130,15 @@ std::vector<uint8_t> serialize_root(const RootIndex& root);
 RootIndex parse_root(std::span<const uint8_t> raw, const std::string& context);
 
 std::vector<uint8_t> serialize_nodes(std::span<const NodeRecord> nodes, uint32_t first_id);
+// The field streams of a run of records (the header comment's order), as serialize_nodes stores them after
+// their sizes: where a run's bytes go. Cost: one serialization.
+inline constexpr size_t kIndexFields = 14;
+inline constexpr const char* kIndexFieldNames[kIndexFields] = {
+    "record heads",  "record deltas",  "record locations", "record sizes", "triangle counts",
+    "vertex counts", "children",       "parents",          "objects",      "pair codes",
+    "pair errors",   "pair exponents", "sphere centres",   "sphere radii"};
+std::array<std::vector<uint8_t>, kIndexFields> serialize_node_fields(std::span<const NodeRecord> nodes,
+                                                                     uint32_t first_id);
 // Parses exactly `count` records of ids first_id.. and validates each against `root`.
 std::vector<NodeRecord> parse_nodes(std::span<const uint8_t> raw, const RootIndex& root, uint32_t first_id,
                                     uint32_t count, const std::string& context);

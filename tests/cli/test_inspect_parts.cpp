@@ -1,4 +1,5 @@
-// `lodstream inspect --parts` (package/size_account.hpp) and bake's normal precision by level
+// `lodstream inspect --parts` (package/size_account.hpp, package/index_account.hpp) and bake's normal
+// precision by level
 // (--coarse-normal-bits): level 0 keeps --normal-bits, coarser clusters spend fewer normal bytes.
 #include <gtest/gtest.h>
 
@@ -42,6 +43,13 @@ TEST(CliInspectParts, CoarseClustersStoreFewerNormalBitsAndLevelZeroKeepsItsOwn)
   }
   EXPECT_LT(coarse_six, coarse_ten);
   EXPECT_LT(six["bytes"].get<uint64_t>(), ten["bytes"].get<uint64_t>());
+  // The index's account (package/index_account.hpp): every record; the fields that do not say where a node's
+  // bytes are do not depend on the normal bits.
+  ASSERT_TRUE(ten.contains("index_parts"));
+  EXPECT_EQ(ten["index_parts"]["records"], ten["nodes"]);
+  for (const char* field : {"triangle counts", "children", "parents", "pair errors", "sphere centres"})
+    EXPECT_EQ(ten["index_parts"]["raw"][field], six["index_parts"]["raw"][field]) << field;
+  EXPECT_EQ(ten["index_parts"]["raw"]["record heads"], ten["nodes"]);  // one head byte per record
 }
 
 TEST(CliInspectParts, BadCoarseNormalBitsIsAOneLineError) {
