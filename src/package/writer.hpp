@@ -7,7 +7,7 @@
 //
 // Page packing follows the caller: nodes added between two end_group() calls form a group (a DAG group's
 // clusters, a subtree's coarse levels); groups are appended in call order and a page is closed before a group
-// that would overflow it, so a group is split only when it alone exceeds the page size. Memory: 17 pages and
+// that would overflow it, so a group is split only when it alone exceeds the page size. Memory: 34 pages and
 // one group of encoded bytes, plus the node records given to finish() and their index pages — never the
 // whole geometry.
 //
