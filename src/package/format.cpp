@@ -98,8 +98,11 @@ std::vector<uint8_t> zstd_compress(std::span<const uint8_t> raw, int level, int 
 
 std::vector<uint8_t> zstd_compress_parts(std::span<const std::span<const uint8_t>> parts, int level,
                                          int min_match) {
-  std::unique_ptr<ZSTD_CCtx, size_t (*)(ZSTD_CCtx*)> cctx(ZSTD_createCCtx(), ZSTD_freeCCtx);
+  // One context per thread, reset for each frame: a fresh context per frame allocated and cleared its match
+  // tables every time (zstd's output does not depend on the context's history).
+  thread_local std::unique_ptr<ZSTD_CCtx, size_t (*)(ZSTD_CCtx*)> cctx(ZSTD_createCCtx(), ZSTD_freeCCtx);
   if (!cctx) throw Error("out of memory creating a zstd context");
+  ZSTD_CCtx_reset(cctx.get(), ZSTD_reset_session_and_parameters);
   size_t total = 0;
   for (std::span<const uint8_t> p : parts) total += p.size();
   // Each flush may add a block header (3 bytes) beyond the bound of the whole.

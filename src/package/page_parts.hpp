@@ -13,15 +13,16 @@
 // codecs (2, 3) a residual part (positions, normals) is, when not empty, a form byte then either (0) the
 // nodes' planes as the nodes hold them, or (1) the residuals of all the page's nodes as one stream of
 // residual_coder.hpp (an entropy coder of our own, order 0, rANS), which zstd then stores as it is (a block
-// of its own, incompressible). The writer keeps the smaller as zstd stores it (a second compression of the
-// part alone): on scans the coded form (sub-bit codes for the many tiny residuals), on regular synthetic
-// meshes the planes (zstd's matches find repeated residual runs that an order-0 coder cannot: a page of a
-// UV sphere took 6,786 B coded against 5,081 B whole). The coded form must also pay for its decode, about 25
-// instructions a residual against about 3 for zstd's Huffman stage over the planes: it is kept only when
-// it saves at least 0.2 bit a residual. Measured (whole pages, coded against zstd'd planes): on the pages
-// of bench_package (refined_elephant) the positions save 0.12 bit a residual, the normals 0.34; elephant_1m
-// 0.26 and 0.30. With both coded BM_Decode/4 took ~440 instructions a triangle (callgrind, decode_node +
-// unpack_page; 382 all planes), with the rule 404. Sizes in residual_coder.hpp.
+// of its own, incompressible). The writer keeps the smaller as zstd stores it, the planes' size estimated
+// by compressing the part alone at zstd level 1 (page_parts.cpp; measuring it at the pages' level 9 took
+// as long as compressing the page): on scans the coded form (sub-bit codes for the many tiny residuals), on
+// regular synthetic meshes the planes (zstd's matches find repeated residual runs that an order-0 coder
+// cannot: a page of a UV sphere took 6,786 B coded against 5,081 B whole). The coded form must also pay for
+// its decode, about 25 instructions a residual against about 3 for zstd's Huffman stage over the planes: it
+// is kept only when it saves at least 0.2 bit a residual. Measured (whole pages, coded against zstd'd
+// planes): on the pages of bench_package (refined_elephant) the positions save 0.12 bit a residual, the
+// normals 0.34; elephant_1m 0.26 and 0.30. With both coded BM_Decode/4 took ~440 instructions a triangle
+// (callgrind, decode_node + unpack_page; 382 all planes), with the rule 404. Sizes in residual_coder.hpp.
 //
 // The regrouped bytes (the zstd frame's content): six varints, the sizes of the six part streams; then the
 // streams. The header stream holds, per node in page order, varint node size then the node's header; the
@@ -53,7 +54,8 @@ bool residuals_coded(const NodeCodec& codec);
 
 // The stored bytes of a page of whole nodes (`node_sizes`, in page order, add up to page.size()): one zstd
 // frame at `level` / `min_match` (format.hpp's zstd_compress), by part when `codec` parses every node (for
-// codec 1: and that is smaller), else whole. Cost: one zstd compression of the page (two for codec 1).
+// codec 1: and that is smaller), else whole. Cost: one zstd compression of the page (two for codec 1), and
+// for the byte-plane codecs one at zstd level 1 of each residual part and its rANS coding.
 std::vector<uint8_t> compress_page(std::span<const uint8_t> page, std::span<const uint32_t> node_sizes,
                                    const NodeCodec& codec, int level, int min_match);
 

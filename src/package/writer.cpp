@@ -37,6 +37,11 @@ PackageWriter::PackageWriter(std::filesystem::path file, WriterOptions options)
 }
 
 PackageWriter::~PackageWriter() {
+  compressing_.cancel();
+  try {
+    compressing_.wait();
+  } catch (...) {  // a failed compression: the package is abandoned anyway
+  }
   if (out_) {
     std::fclose(out_);
     std::error_code ignored;
@@ -105,23 +110,24 @@ void PackageWriter::end_group() {
 
 void PackageWriter::flush_page() {
   if (page_.empty()) return;
-  pending_.push_back(std::move(page_));
-  pending_nodes_.push_back(std::move(page_nodes_));
+  PendingPage& p = pending_.emplace_back();
+  p.raw = std::move(page_), p.node_sizes = std::move(page_nodes_);
   page_ = {}, page_nodes_ = {};
-  if (pending_.size() >= kPendingPages) write_pending();
+  compressing_.run([&p, codec = options_.codec, level = options_.zstd_level] {
+    p.stored = compress_page(p.raw, p.node_sizes, node_codec(codec), level, page_min_match(codec));
+    p.compressed.store(true, std::memory_order_release);
+  });
+  write_pending(false);
 }
 
-void PackageWriter::write_pending() {
-  std::vector<std::vector<uint8_t>> stored(pending_.size());
-  tbb::parallel_for(size_t(0), pending_.size(), [&](size_t i) {
-    stored[i] = compress_page(pending_[i], pending_nodes_[i], node_codec(options_.codec), options_.zstd_level,
-                              page_min_match(options_.codec));
-  });
-  for (size_t i = 0; i < pending_.size(); ++i) {
-    pages_.push_back(write_stored(stored[i], uint32_t(pending_[i].size())));
-    page_bytes_ += stored[i].size();
+void PackageWriter::write_pending(bool all) {
+  if (all || pending_.size() > kPendingPages) compressing_.wait();  // rethrows a task's error
+  while (!pending_.empty() && pending_.front().compressed.load(std::memory_order_acquire)) {
+    const PendingPage& p = pending_.front();
+    pages_.push_back(write_stored(p.stored, uint32_t(p.raw.size())));
+    page_bytes_ += p.stored.size();
+    pending_.pop_front();
   }
-  pending_.clear(), pending_nodes_.clear();
 }
 
 uint32_t PackageWriter::add_blob(std::span<const uint8_t> bytes) {
@@ -133,7 +139,7 @@ WrittenPackage PackageWriter::finish(PackageScene scene, std::vector<NodeRecord>
   if (!out_) throw Error(file_.string() + ": package already finished");
   end_group();
   flush_page();
-  write_pending();
+  write_pending(true);
   const std::string name = file_.string();
   if (nodes.size() > UINT32_MAX - 1) throw Error(name + ": too many nodes");
   if (locations_.size() > nodes.size()) {

@@ -1,12 +1,13 @@
 // PackageWriter: streams nodes' encoded bytes into zstd-compressed data pages of a new .lods file, then
 // writes the index pages, the root index and the header, and renames the file into place. Data pages are
-// compressed 16 at a time in parallel (TBB), index pages all at once. Until finish() returns, only a
+// compressed as TBB tasks while the caller goes on (encoding, adding), written in page order as they
+// complete; index pages all at once. Until finish() returns, only a
 // temporary file next to the target exists (removed by the destructor if finish() was not reached), so an
 // interrupted bake never leaves a broken package.
 //
 // Page packing follows the caller: nodes added between two end_group() calls form a group (a DAG group's
 // clusters, a subtree's coarse levels); groups are appended in call order and a page is closed before a group
-// that would overflow it, so a group is split only when it alone exceeds the page size. Memory: 17 pages and
+// that would overflow it, so a group is split only when it alone exceeds the page size. Memory: 34 pages and
 // one group of encoded bytes, plus the node records given to finish() and their index pages — never the
 // whole geometry.
 //
@@ -17,7 +18,11 @@
 //   w.finish(scene, records, root_node_count);
 #pragma once
 
+#include <tbb/task_group.h>
+
+#include <atomic>
 #include <cstdio>
+#include <deque>
 #include <filesystem>
 #include <span>
 #include <vector>
@@ -82,8 +87,10 @@ class PackageWriter {
 
  private:
   void place(size_t first, size_t end);  // moves group entries [first, end) into the current page
-  void flush_page();                     // closes the current page: queued, compressed with the next ones
-  void write_pending();                  // compresses the queued pages in parallel and writes them in order
+  void flush_page();                     // closes the current page: its compression starts as a task
+  // Writes the compressed pages at the front of the queue, in page order; waits for every task first when
+  // `all` or when more than kPendingPages are queued.
+  void write_pending(bool all);
   Range write_stored(std::span<const uint8_t> bytes, uint32_t raw_size);
   void write(std::span<const uint8_t> bytes, bool hashed);
 
@@ -105,11 +112,18 @@ class PackageWriter {
   std::vector<Entry> group_;
   std::vector<uint8_t> page_;
   std::vector<uint32_t> page_nodes_;  // the sizes of page_'s nodes, in order (page_parts.hpp)
-  // Closed pages not yet compressed: kPendingPages at a time are compressed on every core (zstd was a serial
-  // 3 % of an elephant_1m bake), then written in page order, so the bytes do not depend on thread timing.
-  static constexpr size_t kPendingPages = 16;
-  std::vector<std::vector<uint8_t>> pending_;
-  std::vector<std::vector<uint32_t>> pending_nodes_;
+  // Closed pages not yet written, in page order, each compressed by a task of compressing_ (zstd was a
+  // serial 3 % of an elephant_1m bake; compressed 16 at a time, the pages left a core idle while the caller
+  // encoded and added nodes on one), written in page order, so the bytes do not depend on thread timing. A
+  // deque: a task's page stays in place while pages are added behind it.
+  struct PendingPage {
+    std::vector<uint8_t> raw, stored;
+    std::vector<uint32_t> node_sizes;
+    std::atomic<bool> compressed{false};
+  };
+  static constexpr size_t kPendingPages = 32;
+  std::deque<PendingPage> pending_;
+  tbb::task_group compressing_;
   std::vector<Location> locations_;  // by node id
   std::vector<Range> pages_, blobs_;
   uint64_t page_bytes_ = 0;

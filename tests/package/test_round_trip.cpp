@@ -252,6 +252,42 @@ TEST(Writer, AnUnfinishedWriteLeavesNoFile) {
   EXPECT_TRUE(std::filesystem::is_empty(dir));
 }
 
+// Pages are compressed as tasks while nodes are still added (writer.hpp): many more pages than are queued at
+// once come back in page order, each node in its own page, and a writer dropped with pages in flight leaves
+// no file.
+TEST(Writer, PagesCompressedWhileAddingAreWrittenInPageOrder) {
+  const std::filesystem::path dir = temp_dir();
+  PackageScene scene;
+  scene.materials.resize(1);
+  scene.representations.resize(1);
+  WriterOptions options;
+  options.page_bytes = 1024;
+  constexpr uint32_t kNodes = 300;  // one page each
+  auto bytes_of = [](uint32_t id) {
+    std::vector<uint8_t> b(1000);
+    for (size_t i = 0; i < b.size(); ++i) b[i] = uint8_t(id * 131 + i * (id % 7 + 1));
+    return b;
+  };
+  {
+    PackageWriter w(dir / "many.lods", options);
+    for (uint32_t id = 0; id < kNodes; ++id) w.add_node(id, bytes_of(id)), w.end_group();
+    EXPECT_EQ(w.finish(scene, std::vector<NodeRecord>(kNodes), 1).pages, kNodes);
+  }
+  PackageReader reader = PackageReader::open(dir / "many.lods");
+  for (uint32_t id = 0; id < kNodes; ++id) {
+    ASSERT_EQ(reader.node(id).page, id);
+    const std::vector<uint8_t> page = reader.read_page(id);
+    const std::span<const uint8_t> bytes = reader.node_bytes(id, page);
+    EXPECT_EQ(std::vector<uint8_t>(bytes.begin(), bytes.end()), bytes_of(id)) << id;
+  }
+  {
+    PackageWriter w(dir / "dropped.lods", options);
+    for (uint32_t id = 0; id < kNodes; ++id) w.add_node(id, bytes_of(id)), w.end_group();
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "dropped.lods"));
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), {}), 1);  // many.lods alone
+}
+
 TEST(Writer, RejectsInconsistentNodesAndLeavesNoFile) {
   std::filesystem::path dir = temp_dir();
   PackageScene scene;
