@@ -1,0 +1,130 @@
+// `lodstream bench decode SCENE.lods [--runs N] [--json]`: decodes every codec node of a package on one core,
+// page by page as a client does (read, checksum, zstd and the page's parts, then each node of the page in id
+// order, so a record of several clusters is decoded once), and prints triangles decoded per second of that
+// thread's CPU time, per level and in all. Issue 4's floor is 25 M triangles per second per core; the package
+// benchmark (bench/bench_package) times level-0 meshlets of one mesh, this times a real package's every
+// level, whose coarse nodes may choose other predictors. A page's time is shared among its nodes' levels by
+// their bytes. Thread CPU time rather than wall: steadier on a loaded machine, and one core by construction.
+#include <time.h>
+
+#include <cstdio>
+#include <map>
+#include <memory>
+
+#include "bench.hpp"
+#include "core/error.hpp"
+#include "package/reader.hpp"
+#include "timing.hpp"
+
+namespace lodstream::cli {
+namespace {
+
+struct BenchArgs {
+  std::string package;
+  int runs = 5;
+  bool json = false;
+};
+
+double thread_cpu_s() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + double(t.tv_nsec) * 1e-9;
+}
+
+struct LevelTimes {
+  uint64_t nodes = 0, triangles = 0;
+  std::vector<double> page_s, node_s;  // per run
+};
+
+int run_bench(const BenchArgs& args) {
+  package::PackageReader reader = package::PackageReader::open(args.package);
+  const uint32_t N = reader.node_count();
+  std::vector<std::vector<uint32_t>> on_page(reader.root().pages.size());
+  std::map<uint32_t, LevelTimes> levels;
+  for (uint32_t id = 0; id < N; ++id) {
+    const package::NodeRecord& n = reader.node(id);
+    if (n.encoding != package::NodeEncoding::codec) continue;
+    on_page[n.page].push_back(id);
+    LevelTimes& l = levels[n.level];
+    ++l.nodes, l.triangles += n.triangles;
+  }
+  if (levels.empty()) throw Error(args.package + ": no codec nodes to decode");
+  std::vector<double> total_s;
+  for (int run = 0; run < args.runs; ++run) {
+    std::map<uint32_t, double> page_s, node_s;
+    for (uint32_t page = 0; page < on_page.size(); ++page) {
+      if (on_page[page].empty()) continue;
+      const double t0 = thread_cpu_s();
+      const std::vector<uint8_t> raw = reader.read_page(page);
+      const double unpack = thread_cpu_s() - t0;
+      uint64_t page_bytes = 0;
+      for (uint32_t id : on_page[page]) page_bytes += reader.node(id).size;
+      for (uint32_t id : on_page[page]) {
+        const package::NodeRecord& n = reader.node(id);
+        const double t1 = thread_cpu_s();
+        reader.decode_node(id, raw);  // the decoded mesh freed inside the timing, as a client would
+        node_s[n.level] += thread_cpu_s() - t1;
+        page_s[n.level] += unpack * double(n.size) / double(std::max<uint64_t>(1, page_bytes));
+      }
+    }
+    double total = 0.0;
+    for (auto& [level, l] : levels) {
+      l.page_s.push_back(page_s[level]), l.node_s.push_back(node_s[level]);
+      total += page_s[level] + node_s[level];
+    }
+    total_s.push_back(total);
+  }
+
+  uint64_t nodes = 0, triangles = 0;
+  nlohmann::json per_level = nlohmann::json::array();
+  for (const auto& [level, l] : levels) {
+    nodes += l.nodes, triangles += l.triangles;
+    const double pages = median(l.page_s), decode = median(l.node_s);
+    per_level.push_back({{"level", level},
+                         {"nodes", l.nodes},
+                         {"triangles", l.triangles},
+                         {"pages_s", pages},
+                         {"nodes_s", decode},
+                         {"mtris_per_s", double(l.triangles) / (pages + decode) * 1e-6},
+                         {"mtris_per_s_nodes_only", double(l.triangles) / decode * 1e-6}});
+  }
+  const double total = median(total_s);
+  const nlohmann::json out = {{"package", args.package}, {"runs", args.runs},
+                              {"nodes", nodes},          {"triangles", triangles},
+                              {"cpu_s", total},          {"mtris_per_s", double(triangles) / total * 1e-6},
+                              {"per_level", per_level}};
+  if (args.json) {
+    print_json(out);
+    return 0;
+  }
+  std::printf(
+      "%s: %llu codec nodes, %llu triangles decoded on one core; thread CPU time, median of %d runs\n",
+      args.package.c_str(), (unsigned long long)nodes, (unsigned long long)triangles, args.runs);
+  std::printf("  level     nodes   triangles   pages (s)   nodes (s)   M tri/s   M tri/s nodes only\n");
+  for (const auto& l : per_level)
+    std::printf("  %5u  %8llu  %10llu  %10.4f  %10.4f  %8.2f  %19.2f\n", l["level"].get<uint32_t>(),
+                (unsigned long long)l["nodes"].get<uint64_t>(),
+                (unsigned long long)l["triangles"].get<uint64_t>(), l["pages_s"].get<double>(),
+                l["nodes_s"].get<double>(), l["mtris_per_s"].get<double>(),
+                l["mtris_per_s_nodes_only"].get<double>());
+  std::printf("  all    %8llu  %10llu  %22.4f  %8.2f   (goal: at least 25 M tri/s per core)\n",
+              (unsigned long long)nodes, (unsigned long long)triangles, total,
+              out["mtris_per_s"].get<double>());
+  return 0;
+}
+
+const bool registered =
+    register_bench({"decode", "every node of a package decoded on one core: triangles per second per level",
+                    [](CLI::App& sub) {
+                      auto args = std::make_shared<BenchArgs>();
+                      sub.add_option("SCENE", args->package, "the package (.lods)")->required();
+                      sub.add_option("--runs", args->runs,
+                                     "times the whole package is decoded; medians are reported (1..50)")
+                          ->capture_default_str()
+                          ->check(CLI::Range(1, 50));
+                      sub.add_flag("--json", args->json, "print one JSON object");
+                      return [args] { return run_bench(*args); };
+                    }});
+
+}  // namespace
+}  // namespace lodstream::cli
