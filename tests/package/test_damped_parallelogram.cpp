@@ -31,6 +31,19 @@ uint32_t damping_of(std::span<const uint8_t> node, uint8_t format) {
   return PredictiveNode::parse(node, format, 15, "node").damping;
 }
 
+// The node decodes to m's vertex count, every position a grid point within half a step of some vertex of m
+// (the codec reorders).
+void expect_quantized_positions(const NodeCodec& codec, std::span<const uint8_t> node, const Mesh& m,
+                                const PositionGrid& pg) {
+  const DecodedNode d = codec.decode(node, pg, "node");
+  ASSERT_EQ(d.mesh.vertex_count(), m.vertex_count());
+  for (const glm::vec3& p : d.mesh.positions) {
+    float nearest = INFINITY;
+    for (const glm::vec3& q : m.positions) nearest = std::min(nearest, glm::length(p - q));
+    EXPECT_LE(nearest, 0.87f * pg.step);
+  }
+}
+
 class DampedParallelogram : public ::testing::TestWithParam<uint32_t> {};
 
 INSTANTIATE_TEST_SUITE_P(Codecs, DampedParallelogram,
@@ -50,14 +63,7 @@ TEST_P(DampedParallelogram, EveryDampingDecodesToTheQuantizedPositions) {
     EXPECT_GE(j, 2u);
     EXPECT_LE(j, 4u);
     (j < 4 ? damped : plain) = true;
-    const DecodedNode d = codec.decode(node, pg, "node");
-    ASSERT_EQ(d.mesh.vertex_count(), m.vertex_count());
-    // Every decoded position is a grid point within half a step of some input vertex (the codec reorders).
-    for (const glm::vec3& p : d.mesh.positions) {
-      float nearest = INFINITY;
-      for (const glm::vec3& q : m.positions) nearest = std::min(nearest, glm::length(p - q));
-      EXPECT_LE(nearest, 0.87f * pg.step);
-    }
+    expect_quantized_positions(codec, node, m, pg);
   }
   EXPECT_TRUE(plain);   // the regular grid: the plain parallelogram is exact
   EXPECT_TRUE(damped);  // the jittered grids predict better damped
@@ -85,13 +91,7 @@ TEST_P(DampedParallelogram, TheMultiParallelogramDecodesToTheQuantizedPositions)
     const bool is_multi = PredictiveNode::parse(node, format, 15, "node").multi;
     EXPECT_EQ(predictor_code(node, format) == 3, is_multi);
     multi += is_multi;
-    const DecodedNode d = codec.decode(node, pg, "node");
-    ASSERT_EQ(d.mesh.vertex_count(), m.vertex_count());
-    for (const glm::vec3& p : d.mesh.positions) {
-      float nearest = INFINITY;
-      for (const glm::vec3& q : m.positions) nearest = std::min(nearest, glm::length(p - q));
-      EXPECT_LE(nearest, 0.87f * pg.step);
-    }
+    expect_quantized_positions(codec, node, m, pg);
   }
   EXPECT_GT(multi, 0);
 }
