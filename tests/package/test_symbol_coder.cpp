@@ -23,10 +23,9 @@ std::vector<uint8_t> random_symbols(uint32_t seed, size_t count, double tagged) 
   uint32_t kind = uint32_t(kVertex);
   for (size_t i = 0; i < count; ++i) {
     const double p = u(rng);
-    kind = kind == kVertex ? (p < 0.7   ? kRight
-                              : p < 0.9 ? kBoundary
-                                        : kSplit)
-                           : (p < 0.8 ? kVertex : uint32_t(rng() % 6));
+    const uint32_t after_vertex = p < 0.7 ? kRight : p < 0.9 ? kBoundary : kSplit;
+    const uint32_t other = p < 0.8 ? uint32_t(kVertex) : uint32_t(rng() % 6);
+    kind = kind == kVertex ? after_vertex : other;
     const uint32_t code = u(rng) < tagged ? (rng() % 4 == 0 ? 1 + rng() % 31 : 1 + rng() % 3) : 0;
     out.push_back(uint8_t(kind | code << 3));
   }
