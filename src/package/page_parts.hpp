@@ -28,7 +28,7 @@
 // codecs the connectivity part, when not empty, is a form byte then either (0) the nodes' bytes or (1) the
 // symbols of all the page's nodes as one stream of symbol_coder.hpp (the previous symbol as context, rANS),
 // when they are all traversal symbols and that saves kMinSavedBits a symbol over zstd (the decode costs
-// about 15 instructions a symbol). The references, varints that zstd compresses to about two thirds, stay
+// about 35 instructions a symbol). The references, varints that zstd compresses to about two thirds, stay
 // bytes in a block of their own. Measured (`lodstream bake --json`, format 6 -> 7): see symbol_coder.hpp.
 //
 // The regrouped bytes (the zstd frame's content): seven varints, the sizes of the seven part streams; then

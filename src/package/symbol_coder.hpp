@@ -15,6 +15,15 @@
 // 0; 122,606 as 5 raw bits); the previous two classes as context gained nothing once learnt per page
 // (adaptive estimate 662,007 against 651,600 for one), the byte itself as context lost it to its tables.
 //
+// Packages, format 6 -> 7 (`lodstream bake --json`, main 067d3fc; pages keep the coded form where it saves
+// 0.2 bit a symbol): elephant_5m 15,862,955 -> 15,407,980 B (-2.9 %), elephant_1m 4,153,943 -> 4,001,261
+// (-3.7 %; connectivity at level 0 0.25 -> 0.20 B/tri, level 1 0.48 -> 0.40 with the references),
+// refined_elephant -2.8 %, motorBike -1.7 %, bunny -2.2 %, horse -2.3 %, city -1.2 %; decoded pages
+// identical. Decode: about 35 instructions a symbol (1.2 symbols a triangle) and 13 tables of 2^10 built per
+// page: BM_Decode/4 (bench_package, records of refined_elephant; callgrind, decode_node + unpack_page)
+// 399.5 -> 446.2 instructions a triangle (+11.7 %). Smaller tables (2^9) or fewer contexts would cut the
+// tables' part (about 20 instructions a triangle).
+//
 // A stream: per context c = 0..11, a u16 LE mask of the classes that follow it (0 for a context that never
 // occurs), then the varint frequencies of those classes but the last, which takes the rest of 2^10; a u32
 // LE mask of the cluster codes (bit g - 1) and their frequencies likewise; varint size of the rANS bytes;
@@ -41,7 +50,7 @@ class SymbolDecoder {
   // Parses the tables. Cost: O(2^10) per context that occurs (the decode tables, 4 KB each) and a copy of
   // the stream.
   SymbolDecoder(std::span<const uint8_t> stream, const std::string& where);
-  // The next `count` symbols into `out`. Cost: O(count), about 15 instructions a symbol.
+  // The next `count` symbols into `out`. Cost: O(count), about 35 instructions a symbol.
   void symbols(size_t count, uint8_t* out);
   // Throws unless every byte of the stream was used and the states are back to their start.
   void finish() const;
