@@ -11,7 +11,7 @@ namespace lodstream::package {
 
 namespace {
 
-constexpr uint32_t kScaleBits = 10, kScale = 1u << kScaleBits;
+constexpr uint32_t kScaleBits = 8, kScale = 1u << kScaleBits;
 constexpr uint32_t kKinds = 6, kClasses = 2 * kKinds, kClusterCodes = 31;
 constexpr uint32_t kTables = kClasses + 1, kCodeTable = kClasses;  // the cluster codes' table comes last
 constexpr uint32_t kStates = 2;
@@ -122,8 +122,8 @@ void SymbolDecoder::symbols(size_t count, uint8_t* out) {
   size_t at = rans_at_;
   const size_t rans_end = rans_end_;
   uint32_t x0 = state_[0], x1 = state_[1], context = context_;
-  // One step (rANS, Duda 2013, eq. 9: D(x) = (s, f_s floor(x / 2^10) + x mod 2^10 - start_s), s the symbol
-  // of slot x mod 2^10 of `table`), then x read back up to kLow from the next 2 rANS bytes; the states
+  // One step (rANS, Duda 2013, eq. 9: D(x) = (s, f_s floor(x / 2^8) + x mod 2^8 - start_s), s the symbol
+  // of slot x mod 2^8 of `table`), then x read back up to kLow from the next 2 rANS bytes; the states
   // alternate.
   const auto step = [&](uint32_t table) __attribute__((always_inline)) {
     const uint32_t e = slots[table * kScale + (x0 & (kScale - 1))];

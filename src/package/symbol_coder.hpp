@@ -6,7 +6,7 @@
 // A symbol byte holds a kind t (bits 0-2: 0..5) and a cluster code g (bits 3-7: 0 for the gate's cluster).
 // Each is coded as its class s = t + 6 [g > 0] (12 classes) under the table of the previous symbol's class
 // (the page's first symbol: under class 0's), followed when g > 0 by g - 1 under one table of cluster codes
-// (order 0). rANS (rans.hpp) with tables of 2^10 and two interleaved states: coding step i (classes and
+// (order 0). rANS (rans.hpp) with tables of 2^8 and two interleaved states: coding step i (classes and
 // cluster codes counted together) takes state i mod 2.
 //
 // Measured before building it (an offline estimate over the pages of the baked packages, each page's tables
@@ -15,17 +15,11 @@
 // 0; 122,606 as 5 raw bits); the previous two classes as context gained nothing once learnt per page
 // (adaptive estimate 662,007 against 651,600 for one), the byte itself as context lost it to its tables.
 //
-// Packages, format 6 -> 7 (`lodstream bake --json`, main 067d3fc; pages keep the coded form where it saves
-// 0.2 bit a symbol): elephant_5m 15,862,955 -> 15,407,980 B (-2.9 %), elephant_1m 4,153,943 -> 4,001,261
-// (-3.7 %; connectivity at level 0 0.25 -> 0.20 B/tri, level 1 0.48 -> 0.40 with the references),
-// refined_elephant -2.8 %, motorBike -1.7 %, bunny -2.2 %, horse -2.3 %, city -1.2 %; decoded pages
-// identical. Decode: about 35 instructions a symbol (1.2 symbols a triangle) and 13 tables of 2^10 built per
-// page: BM_Decode/4 (bench_package, records of refined_elephant; callgrind, decode_node + unpack_page)
-// 399.5 -> 446.2 instructions a triangle (+11.7 %). Smaller tables (2^9) or fewer contexts would cut the
-// tables' part (about 20 instructions a triangle).
+// Tables of 2^8: each page's tables cost bytes and decode time, and 12-class alphabets need little
+// precision: elephant_1m 4,001,261 B with 2^10, 3,997,610 with 2^9, 3,996,354 with 2^8, 3,997,483 with 2^7.
 //
 // A stream: per context c = 0..11, a u16 LE mask of the classes that follow it (0 for a context that never
-// occurs), then the varint frequencies of those classes but the last, which takes the rest of 2^10; a u32
+// occurs), then the varint frequencies of those classes but the last, which takes the rest of 2^8; a u32
 // LE mask of the cluster codes (bit g - 1) and their frequencies likewise; varint size of the rANS bytes;
 // the rANS bytes (the two final states, u32 LE each, then u16 LE reads).
 #pragma once
@@ -47,7 +41,7 @@ std::optional<std::vector<uint8_t>> encode_symbols(std::span<const uint8_t> symb
 // (which the traversal decoder then checks), never reads outside its bytes.
 class SymbolDecoder {
  public:
-  // Parses the tables. Cost: O(2^10) per context that occurs (the decode tables, 4 KB each) and a copy of
+  // Parses the tables. Cost: O(2^8) per table (the decode tables, 1 KB each) and a copy of
   // the stream.
   SymbolDecoder(std::span<const uint8_t> stream, const std::string& where);
   // The next `count` symbols into `out`. Cost: O(count), about 35 instructions a symbol.
@@ -59,7 +53,7 @@ class SymbolDecoder {
   [[noreturn]] void fail(const char* what) const;
 
   std::string where_;
-  // 13 tables of 2^10 slots (12 contexts, then the cluster codes; empty for no stream), each slot: bits
+  // 13 tables of 2^8 slots (12 contexts, then the cluster codes; empty for no stream), each slot: bits
   // 0-10 its symbol's frequency (0 in a table that never occurs), 11-20 the slot minus the symbol's start,
   // 21-25 the symbol.
   std::vector<uint32_t> slot_;
