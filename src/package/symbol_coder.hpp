@@ -18,6 +18,14 @@
 // Tables of 2^8: each page's tables cost bytes and decode time, and 12-class alphabets need little
 // precision: elephant_1m 4,001,261 B with 2^10, 3,997,610 with 2^9, 3,996,354 with 2^8, 3,997,483 with 2^7.
 //
+// Packages, format 6 -> 7 (`lodstream bake --json`, main 067d3fc; pages keep the coded form where it saves
+// 0.2 bit a symbol): elephant_5m 15,862,955 -> 15,388,395 B (-3.0 %), elephant_1m 4,153,943 -> 3,996,354
+// (-3.8 %; connectivity at level 0 0.25 -> 0.20 B/tri, at level 1 0.48 -> 0.40 with the references),
+// refined_elephant -2.9 %, motorBike -1.8 %, bunny -2.3 %, horse -2.5 %, city -1.3 %; decoded pages
+// identical. Decode: about 35 instructions a symbol (1.2 symbols a triangle) and 13 tables built per page:
+// BM_Decode/4 (bench_package, records of refined_elephant; callgrind, decode_node + unpack_page) 399.5 ->
+// 429.6 instructions a triangle (+7.5 %; 446.2 with tables of 2^10).
+//
 // A stream: per context c = 0..11, a u16 LE mask of the classes that follow it (0 for a context that never
 // occurs), then the varint frequencies of those classes but the last, which takes the rest of 2^8; a u32
 // LE mask of the cluster codes (bit g - 1) and their frequencies likewise; varint size of the rANS bytes;
