@@ -113,6 +113,9 @@ struct NodeSizeBreakdown {
   // Of positions() and normals: their first bytes, the low byte planes where the codec stores byte planes
   // (codecs 2 and 3: one byte per vertex and component), 0 otherwise.
   size_t position_low = 0, normal_low = 0;
+  // Of indices: its last bytes, a stream that a page stores apart (page_parts.hpp; codec 3: the traversal's
+  // references), 0 for none.
+  size_t tail = 0;
   // The vertices the node stores (its header's count: a record's shared vertex pool).
   uint32_t stored_vertices = 0;
   size_t total() const { return header + vertices + locked + indices; }

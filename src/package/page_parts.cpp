@@ -9,17 +9,18 @@
 #include "package/format.hpp"
 #include "package/meshopt_codec.hpp"
 #include "package/residual_coder.hpp"
+#include "package/symbol_coder.hpp"
 
 namespace lodstream::package {
 
 namespace {
 
 // NodeSizeBreakdown's parts, in its order.
-constexpr size_t kParts = 6;
-constexpr size_t kPositions = 1, kNormals = 2;
+constexpr size_t kParts = 7;
+constexpr size_t kPositions = 1, kNormals = 2, kConnectivity = 5;
 
 std::array<size_t, kParts> part_sizes(const NodeSizeBreakdown& b) {
-  return {b.header, b.positions(), b.normals, b.attributes, b.locked, b.indices};
+  return {b.header, b.positions(), b.normals, b.attributes, b.locked, b.indices - b.tail, b.tail};
 }
 
 // The byte planes of a node's positions (components 3) or normals (2): `low` bytes of low planes, `bytes` in
@@ -40,9 +41,9 @@ void put_varint(std::vector<uint8_t>& out, uint64_t v) {
   out.insert(out.end(), w.bytes.begin(), w.bytes.end());
 }
 
-// The residual part's forms (page_parts.hpp).
+// The residual and connectivity parts' forms (page_parts.hpp).
 constexpr uint8_t kPlanesForm = 0, kCodedForm = 1;
-// The bits a residual the coded form must save over the zstd'd planes (page_parts.hpp).
+// The bits a residual or symbol the coded form must save over the zstd'd bytes (page_parts.hpp).
 constexpr double kMinSavedBits = 0.2;
 
 // The bytes zstd at `level` / `min_match` stores `planes` in, estimated (page_parts.hpp): for levels above 1
@@ -54,7 +55,7 @@ double estimated_zstd_size(std::span<const uint8_t> planes, int level, int min_m
   return double(zstd_compress(planes, 1, min_match).size()) / 1.02;
 }
 
-// The regrouped bytes (page_parts.hpp), as the size varints and the six streams, each residual part in the
+// The regrouped bytes (page_parts.hpp), as the size varints and the seven streams, each residual part in the
 // smaller form (as zstd at `level` / `min_match` stores it, the planes' size estimated); nullopt when a
 // node's bytes do not parse as the codec's (or, for a byte-plane codec, hold no whole planes).
 std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<const uint8_t> page,
@@ -107,6 +108,8 @@ std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<co
       }
       out[1 + p] = std::move(form);
     }
+  if (coded && !out[1 + kConnectivity].empty())
+    out[1 + kConnectivity] = connectivity_form(out[1 + kConnectivity], level, min_match);
   for (size_t p = 0; p < kParts; ++p) put_varint(out[0], out[1 + p].size());
   return out;
 }
@@ -115,6 +118,17 @@ std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<co
 
 bool residuals_coded(const NodeCodec& codec) {
   return codec.id() != MeshoptCodec::kId;
+}
+
+std::vector<uint8_t> connectivity_form(std::span<const uint8_t> plain, int level, int min_match) {
+  const std::optional<std::vector<uint8_t>> coded = encode_symbols(plain);
+  const bool keep_coded =
+      coded && 8 * (estimated_zstd_size(plain, level, min_match) - double(coded->size())) >=
+                   kMinSavedBits * double(plain.size());
+  std::vector<uint8_t> form = {keep_coded ? kCodedForm : kPlanesForm};
+  const std::span<const uint8_t> content = keep_coded ? std::span<const uint8_t>(*coded) : plain;
+  form.insert(form.end(), content.begin(), content.end());
+  return form;
 }
 
 std::vector<uint8_t> compress_page(std::span<const uint8_t> page, std::span<const uint32_t> node_sizes,
@@ -156,8 +170,15 @@ std::vector<uint8_t> decompress_page(std::span<const uint8_t> stored, uint32_t r
       if (stream[p][0] != kPlanesForm && stream[p][0] != kCodedForm) r.fail("invalid residual part form");
       coded[p] = stream[p][0] == kCodedForm, stream[p] = stream[p].subspan(1);
     }
+  if (residuals_coded(codec) && !stream[kConnectivity].empty()) {
+    if (stream[kConnectivity][0] != kPlanesForm && stream[kConnectivity][0] != kCodedForm)
+      r.fail("invalid connectivity part form");
+    coded[kConnectivity] = stream[kConnectivity][0] == kCodedForm;
+    stream[kConnectivity] = stream[kConnectivity].subspan(1);
+  }
   ResidualDecoder positions(coded[kPositions] ? stream[kPositions] : std::span<const uint8_t>(), where),
       normals(coded[kNormals] ? stream[kNormals] : std::span<const uint8_t>(), where);
+  SymbolDecoder symbols(coded[kConnectivity] ? stream[kConnectivity] : std::span<const uint8_t>(), where);
   std::vector<uint8_t> page(raw_size);
   std::array<size_t, kParts> used{};  // bytes of each stream consumed
   ByteReader headers(stream[0], where);
@@ -169,7 +190,9 @@ std::vector<uint8_t> decompress_page(std::span<const uint8_t> stored, uint32_t r
     const NodeSizeBreakdown b = codec.layout(stream[0].subspan(used[0]), node_size, where);
     const std::array<size_t, kParts> n = part_sizes(b);
     for (size_t p = 0; p < kParts; ++p) {
-      if (coded[p]) {
+      if (coded[p] && p == kConnectivity) {
+        symbols.symbols(n[p], page.data() + at);
+      } else if (coded[p]) {
         const std::optional<Planes> s =
             p == kPositions ? planes_of(n[p], b.position_low, 3) : planes_of(n[p], b.normal_low, 2);
         if (!s) headers.fail("node residuals not in byte planes");
@@ -183,7 +206,7 @@ std::vector<uint8_t> decompress_page(std::span<const uint8_t> stored, uint32_t r
     }
     headers.bytes(n[0], "node header");
   }
-  positions.finish(), normals.finish();
+  positions.finish(), normals.finish(), symbols.finish();
   for (size_t p = 0; p < kParts; ++p)
     if (used[p] != stream[p].size() && !coded[p]) r.fail("page part streams hold bytes of no node");
   if (at != raw_size) r.fail("page part streams hold fewer bytes than the page");

@@ -24,8 +24,16 @@
 // normals 0.34; elephant_1m 0.26 and 0.30. With both coded BM_Decode/4 took ~440 instructions a triangle
 // (callgrind, decode_node + unpack_page; 382 all planes), with the rule 404. Sizes in residual_coder.hpp.
 //
-// The regrouped bytes (the zstd frame's content): six varints, the sizes of the six part streams; then the
-// streams. The header stream holds, per node in page order, varint node size then the node's header; the
+// Format 7: seven parts, the connectivity split into the nodes' connectivity streams and their tails
+// (NodeSizeBreakdown::tail; codec 3: the traversal's symbols, then its references), and for the byte-plane
+// codecs the connectivity part, when not empty, is a form byte then either (0) the nodes' bytes or (1) the
+// symbols of all the page's nodes as one stream of symbol_coder.hpp (the previous symbol as context, rANS),
+// when they are all traversal symbols and that saves kMinSavedBits a symbol over zstd (the decode costs
+// about 35 instructions a symbol). The references, varints that zstd compresses to about two thirds, stay
+// bytes in a block of their own. Measured (`lodstream bake --json`, format 6 -> 7): see symbol_coder.hpp.
+//
+// The regrouped bytes (the zstd frame's content): seven varints, the sizes of the seven part streams; then
+// the streams. The header stream holds, per node in page order, varint node size then the node's header; the
 // other streams the node's part, in the same order (the residual streams: the node's residuals, component
 // by component, in the order of its planes). A reader walks the header stream: the codec's layout() of each
 // header gives the sizes of that node's parts (NodeCodec::layout), and copying them back in order (decoding
@@ -51,6 +59,13 @@ namespace lodstream::package {
 
 // Whether pages of `codec` store their residuals coded (residual_coder.hpp): the byte-plane codecs 2 and 3.
 bool residuals_coded(const NodeCodec& codec);
+
+// A connectivity part of such a codec as a page stores it before zstd: the form byte, then the symbols
+// (`plain`: the nodes' connectivity streams, in page order) coded by symbol_coder.hpp when they are
+// traversal symbols and that saves kMinSavedBits a symbol over `plain` as zstd at `level` / `min_match`
+// stores it (estimated as for the residual parts), else `plain`. Cost: a symbol coding and a zstd level-1
+// compression of `plain`.
+std::vector<uint8_t> connectivity_form(std::span<const uint8_t> plain, int level, int min_match);
 
 // The stored bytes of a page of whole nodes (`node_sizes`, in page order, add up to page.size()): one zstd
 // frame at `level` / `min_match` (format.hpp's zstd_compress), by part when `codec` parses every node (for

@@ -7,14 +7,14 @@
 
 #include "core/error.hpp"
 #include "package/bytes.hpp"
+#include "package/rans.hpp"
 
 namespace lodstream::package {
 
 namespace {
 
 constexpr uint32_t kScaleBits = 12, kScale = 1u << kScaleBits;
-// rANS states lie in [kLow, 2^32), renormalized 16 bits at a time: a decode step reads at most once.
-constexpr uint32_t kLow = 1u << 16;
+using rans::kLow;
 constexpr uint32_t kStates = 4;
 constexpr uint32_t kMaxBits = 40, kMinDirect = 1, kMaxDirect = 6;
 // The size a larger D may cost for its speed (residual_coder.hpp).
@@ -42,22 +42,7 @@ inline uint32_t symbols_for(uint32_t D) {
 std::array<uint32_t, kMaxSymbols> normalized(const std::array<uint32_t, kMaxSymbols>& counts,
                                              uint64_t total) {
   std::array<uint32_t, kMaxSymbols> f{};
-  uint64_t sum = 0;
-  for (uint32_t s = 0; s < kMaxSymbols; ++s) {
-    if (counts[s]) f[s] = std::max<uint32_t>(1, uint32_t(uint64_t(counts[s]) * kScale / total));
-    sum += f[s];
-  }
-  // Rounding down leaves at most kMaxSymbols short; rounding up to 1 at most kMaxSymbols over: the largest
-  // frequency takes the difference (over several steps if it would fall below 1).
-  while (sum != kScale) {
-    const uint32_t largest = uint32_t(std::max_element(f.begin(), f.end()) - f.begin());
-    if (sum < kScale) {
-      f[largest] += uint32_t(kScale - sum), sum = kScale;
-    } else {
-      const uint32_t d = std::min<uint32_t>(uint32_t(sum - kScale), f[largest] - 1);
-      f[largest] -= d, sum -= d;
-    }
-  }
+  rans::normalize(counts, total, kScaleBits, f);
   return f;
 }
 
@@ -87,24 +72,6 @@ double estimated_bits(const std::array<uint32_t, 1u << kMaxDirect>& low,
       bits += counts[s] * (kScaleBits - std::log2(double(f[s])) + (s < (1u << D) ? 0 : raw_bits_of(s, D)));
   }
   return bits;
-}
-
-// x < kLow: x = x << 16 | next and at += 2, else neither; with conditional moves, not a branch (a read
-// comes about every 16 bits of code, every few steps: a branch mispredicts on most, and GCC 12 compiles
-// every C form of the selection, hints included, to a branch).
-inline __attribute__((always_inline)) void renormalize(uint32_t& x, size_t& at, uint16_t next) {
-  const uint32_t read = x << 16 | next;
-#if defined(__x86_64__)
-  const size_t after = at + 2;
-  asm("cmpl %[low], %[x]\n\tcmovbl %[read], %[x]\n\tcmovbq %[after], %[at]"
-      : [x] "+r"(x), [at] "+r"(at)
-      : [read] "r"(read), [after] "r"(after), [low] "i"(kLow)
-      : "cc");
-#else
-  const uint32_t keep = uint32_t(x >= kLow);
-  x = read ^ ((read ^ x) & (0 - keep));
-  at += 2 - 2 * keep;
-#endif
 }
 
 }  // namespace
@@ -158,11 +125,7 @@ std::vector<uint8_t> encode_residuals(std::span<const uint64_t> values) {
   for (size_t i = values.size(); i-- > 0;) {
     uint32_t& x = state[i % kStates];
     const uint32_t s = symbols[i];
-    if (x >= (uint64_t(kLow >> kScaleBits) << 16) * f[s]) {
-      reversed.push_back(uint8_t(x >> 8)), reversed.push_back(uint8_t(x));  // read back as a u16 LE
-      x >>= 16;
-    }
-    x = ((x / f[s]) << kScaleBits) + x % f[s] + start[s];
+    rans::encode(x, start[s], f[s], kScaleBits, reversed);
   }
   ByteWriter w;
   w.u8(uint8_t(D));
@@ -236,7 +199,7 @@ void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, 
     x = (e & 0x1fff) * (x >> kScaleBits) + ((e >> 13) & 0xfff);
     uint16_t next;
     std::memcpy(&next, bytes + at, 2);
-    renormalize(x, at, next);
+    rans::renormalize(x, at, next);
     planes[i] = uint8_t(s);
     if (s >= direct) [[unlikely]] {
       const uint32_t n = s - direct + D;  // k - 1 raw bits below the leading one

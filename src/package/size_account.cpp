@@ -3,12 +3,13 @@
 #include <map>
 
 #include "package/format.hpp"
+#include "package/page_parts.hpp"
 
 namespace lodstream::package {
 
 const char* node_part_name(NodePart part) {
-  static constexpr const char* kNames[kNodeParts] = {"header",     "positions", "normals",
-                                                     "attributes", "locked",    "connectivity"};
+  static constexpr const char* kNames[kNodeParts] = {"header", "positions",    "normals",   "attributes",
+                                                     "locked", "connectivity", "references"};
   return kNames[uint32_t(part)];
 }
 
@@ -44,8 +45,8 @@ std::vector<LevelAccount> account_sizes(PackageReader& reader, const SizeAccount
       if (k > 0 && n.offset == reader.node(on_page[page][k - 1]).offset) continue;
       const std::span<const uint8_t> bytes = reader.node_bytes(id, raw);
       const NodeSizeBreakdown b = reader.codec().breakdown(bytes, "node " + std::to_string(id));
-      const size_t sizes[kNodeParts] = {b.header,     b.positions(), b.normals,
-                                        b.attributes, b.locked,      b.indices};
+      const size_t sizes[kNodeParts] = {b.header, b.positions(),      b.normals, b.attributes,
+                                        b.locked, b.indices - b.tail, b.tail};
       l.account.vertices += b.stored_vertices;
       l.account.page_bytes += double(ranges[page].size) * double(n.size) / double(page_raw);
       size_t at = 0;
@@ -61,7 +62,12 @@ std::vector<LevelAccount> account_sizes(PackageReader& reader, const SizeAccount
     for (uint32_t p = 0; p < kNodeParts; ++p)
       for (size_t at = 0; at < l.bytes[p].size(); at += options.chunk) {
         const auto chunk = std::span(l.bytes[p]).subspan(at, std::min(options.chunk, l.bytes[p].size() - at));
-        l.account.parts[p].compressed += zstd_compress(chunk, options.zstd_level, options.min_match).size();
+        l.account.parts[p].compressed +=
+            p == uint32_t(NodePart::connectivity) && residuals_coded(reader.codec())
+                ? zstd_compress(connectivity_form(chunk, options.zstd_level, options.min_match),
+                                options.zstd_level, options.min_match)
+                      .size()
+                : zstd_compress(chunk, options.zstd_level, options.min_match).size();
       }
     out.push_back(l.account);
   }

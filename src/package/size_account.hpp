@@ -1,12 +1,12 @@
 // Where a package's bytes go: per level, per part of the nodes (header, positions, normals, other attributes,
-// locked stream, connectivity), raw and after zstd, with the vertices each level stores per triangle (a
-// cluster's border vertices repeat in every record that holds it; a record of several clusters stores them
-// once, and its bytes and vertices count at the level of its first cluster). The pages' zstd runs over whole
-// pages, so a part's bytes after zstd are measured by compressing that part alone: each level's bytes of that
-// part, in node order, cut into chunks of `chunk` bytes (the size of a page), each compressed as the writer
-// compresses a page. The sum over parts is therefore close to, not equal to, the pages' stored bytes, which
-// are given per level as well (a page's stored bytes shared among the levels of its nodes by their raw
-// bytes). Used by `lodstream inspect --parts` and the package benchmark.
+// locked stream, connectivity, references), raw and after zstd, with the vertices each level stores per
+// triangle (a cluster's border vertices repeat in every record that holds it; a record of several clusters
+// stores them once, and its bytes and vertices count at the level of its first cluster). The pages' zstd runs
+// over whole pages, so a part's bytes after zstd are measured by compressing that part alone: each level's
+// bytes of that part, in node order, cut into chunks of `chunk` bytes (the size of a page), each compressed
+// as the writer compresses a page. The sum over parts is therefore close to, not equal to, the pages' stored
+// bytes, which are given per level as well (a page's stored bytes shared among the levels of its nodes by
+// their raw bytes). Used by `lodstream inspect --parts` and the package benchmark.
 #pragma once
 
 #include <array>
@@ -17,8 +17,11 @@
 
 namespace lodstream::package {
 
-enum class NodePart : uint32_t { header, positions, normals, attributes, locked, connectivity };
-inline constexpr uint32_t kNodeParts = 6;
+// connectivity: the nodes' connectivity streams (codec 3: the traversal's symbols), compressed as a page
+// stores them (page_parts.hpp: coded with context or zstd'd, whichever it keeps); references: the rest of
+// the nodes' connectivity bytes (NodeSizeBreakdown::tail; codec 3: the traversal's references).
+enum class NodePart : uint32_t { header, positions, normals, attributes, locked, connectivity, references };
+inline constexpr uint32_t kNodeParts = 7;
 // "header", "positions", ... as in the JSON of inspect --parts.
 const char* node_part_name(NodePart part);
 

@@ -70,7 +70,10 @@ DecodedNode TraversalCodec::decode(std::span<const uint8_t> bytes, const Positio
 NodeSizeBreakdown TraversalCodec::layout(std::span<const uint8_t> bytes, size_t node_size,
                                          const std::string& where) const {
   if (!bytes.empty() && bytes[0] == kOrderedFormat) return ordered_codec().layout(bytes, node_size, where);
-  return PredictiveNode::layout(bytes, node_size, kFormat, kAllFlags, where);
+  uint64_t tail = 0;
+  NodeSizeBreakdown b = PredictiveNode::layout(bytes, node_size, kFormat, kAllFlags, where, &tail);
+  b.tail = tail;  // the references
+  return b;
 }
 
 }  // namespace lodstream::package

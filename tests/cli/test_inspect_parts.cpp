@@ -32,7 +32,8 @@ TEST(CliInspectParts, CoarseClustersStoreFewerNormalBitsAndLevelZeroKeepsItsOwn)
     ASSERT_EQ(a["level"], b["level"]);
     EXPECT_EQ(a["triangles"], b["triangles"]);  // the hierarchy does not depend on the normal bits
     EXPECT_GT(a["vertices"].get<uint64_t>(), a["triangles"].get<uint64_t>() / 3);
-    for (const char* part : {"header", "positions", "normals", "attributes", "locked", "connectivity"})
+    for (const char* part :
+         {"header", "positions", "normals", "attributes", "locked", "connectivity", "references"})
       ASSERT_TRUE(a["raw"].contains(part) && a["compressed"].contains(part)) << part;
     if (a["level"] == 0) {
       EXPECT_EQ(a["raw"], b["raw"]);  // level 0: the same bytes

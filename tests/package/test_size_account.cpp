@@ -1,5 +1,6 @@
 // account_sizes (package/size_account.hpp): the parts it reports add up to the nodes' bytes, and it tells
-// normals and other attributes apart for the codecs that store them apart.
+// normals and other attributes, and codec 3's traversal symbols and references, apart for the codecs that
+// store them apart.
 #include <gtest/gtest.h>
 
 #include "package/meshopt_codec.hpp"
@@ -64,6 +65,9 @@ TEST_P(SizeAccount, PartsAddUpToTheNodesAndPagesToTheFile) {
     EXPECT_GT(a.parts[uint32_t(NodePart::header)].raw, 0u);
     EXPECT_GT(a.parts[uint32_t(NodePart::positions)].raw, 0u);
     EXPECT_GT(a.parts[uint32_t(NodePart::connectivity)].raw, 0u);
+    // Codec 3's traversal references (three at least per piece start) apart from its symbols; the other
+    // codecs' connectivity is one stream.
+    EXPECT_EQ(a.parts[uint32_t(NodePart::references)].raw > 0, GetParam() == TraversalCodec::kId);
     page_bytes += a.page_bytes;
   }
   EXPECT_NEAR(page_bytes, stored, 1e-6 * stored);  // every data page is shared out among the levels

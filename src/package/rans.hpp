@@ -1,0 +1,55 @@
+// What the package's two rANS coders share (residual_coder.hpp: residuals, symbol_coder.hpp: traversal
+// symbols): rANS (Duda 2013, "Asymmetric numeral systems: entropy coding combining speed of Huffman coding
+// with compression rate of arithmetic coding", arXiv:1311.2540) with 32-bit states kept in [2^16, 2^32) and
+// renormalized 16 bits at a time, so that a decode step reads at most once; static frequency tables adding
+// up to a power of two.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace lodstream::package::rans {
+
+// The lowest state; every stream starts (encoder) and ends (decoder) with its states at kLow.
+inline constexpr uint32_t kLow = 1u << 16;
+
+// Into `frequencies` (as many as `counts`): frequencies adding up to 2^scale_bits, at least 1 for every
+// symbol counted, 0 for the others, about proportional to `counts` (which add up to `total` > 0; at most
+// 2^scale_bits symbols counted). Cost: O(counts.size()) plus a few passes when rounding overshoots.
+void normalize(std::span<const uint32_t> counts, uint64_t total, uint32_t scale_bits,
+               std::span<uint32_t> frequencies);
+
+// The encoder's step for a symbol of frequency f starting at `start` of 2^scale_bits (Duda 2013, eq. 9
+// inverted: C(s, x) = 2^n floor(x / f_s) + x mod f_s + start_s), first moving 16 bits of x out to `reversed`
+// (which the stream stores reversed, read back as u16 LE) when C would leave 32 bits. Steps run last symbol
+// first. Cost: a division.
+inline void encode(uint32_t& x, uint32_t start, uint32_t f, uint32_t scale_bits,
+                   std::vector<uint8_t>& reversed) {
+  if (x >= (uint64_t(kLow >> scale_bits) << 16) * f) {
+    reversed.push_back(uint8_t(x >> 8)), reversed.push_back(uint8_t(x));
+    x >>= 16;
+  }
+  x = ((x / f) << scale_bits) + x % f + start;
+}
+
+// The decoder's renormalization: x < kLow: x = x << 16 | next and at += 2, else neither; with conditional
+// moves, not a branch (a read comes about every 16 bits of code, every few steps: a branch mispredicts on
+// most, and GCC 12 compiles every C form of the selection, hints included, to a branch).
+inline __attribute__((always_inline)) void renormalize(uint32_t& x, size_t& at, uint16_t next) {
+  const uint32_t read = x << 16 | next;
+#if defined(__x86_64__)
+  const size_t after = at + 2;
+  asm("cmpl %[low], %[x]\n\tcmovbl %[read], %[x]\n\tcmovbq %[after], %[at]"
+      : [x] "+r"(x), [at] "+r"(at)
+      : [read] "r"(read), [after] "r"(after), [low] "i"(kLow)
+      : "cc");
+#else
+  const uint32_t keep = uint32_t(x >= kLow);
+  x = read ^ ((read ^ x) & (0 - keep));
+  at += 2 - 2 * keep;
+#endif
+}
+
+}  // namespace lodstream::package::rans

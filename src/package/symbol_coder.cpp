@@ -1,0 +1,159 @@
+#include "package/symbol_coder.hpp"
+
+#include <array>
+#include <cstring>
+
+#include "core/error.hpp"
+#include "package/bytes.hpp"
+#include "package/rans.hpp"
+
+namespace lodstream::package {
+
+namespace {
+
+constexpr uint32_t kScaleBits = 8, kScale = 1u << kScaleBits;
+constexpr uint32_t kKinds = 6, kClasses = 2 * kKinds, kClusterCodes = 31;
+constexpr uint32_t kTables = kClasses + 1, kCodeTable = kClasses;  // the cluster codes' table comes last
+constexpr uint32_t kStates = 2;
+// The alphabet of table t.
+constexpr uint32_t alphabet(uint32_t t) {
+  return t == kCodeTable ? kClusterCodes : kClasses;
+}
+
+}  // namespace
+
+std::optional<std::vector<uint8_t>> encode_symbols(std::span<const uint8_t> symbols) {
+  std::array<std::array<uint32_t, kClusterCodes>, kTables> counts{};
+  uint32_t context = 0;
+  for (const uint8_t b : symbols) {
+    const uint32_t kind = b & 7, code = b >> 3;
+    if (kind >= kKinds) return std::nullopt;
+    const uint32_t s = kind + (code ? kKinds : 0);
+    ++counts[context][s];
+    if (code) ++counts[kCodeTable][code - 1];
+    context = s;
+  }
+  std::array<std::array<uint32_t, kClusterCodes>, kTables> f{}, start{};
+  ByteWriter w;
+  for (uint32_t t = 0; t < kTables; ++t) {
+    const std::span<const uint32_t> c = std::span(counts[t]).first(alphabet(t));
+    uint64_t total = 0, mask = 0;
+    for (uint32_t s = 0; s < c.size(); ++s) total += c[s], mask |= uint64_t(c[s] > 0) << s;
+    if (t == kCodeTable)
+      w.u32(uint32_t(mask));
+    else
+      w.u16(uint16_t(mask));
+    if (!total) continue;
+    rans::normalize(c, total, kScaleBits, std::span(f[t]).first(c.size()));
+    uint32_t last = 0;
+    for (uint32_t s = 0; s < c.size(); ++s)
+      if (f[t][s]) last = s;
+    for (uint32_t s = 0, at = 0; s < c.size(); at += f[t][s++]) {
+      start[t][s] = at;
+      if (f[t][s] && s != last) w.varint(f[t][s]);
+    }
+  }
+  // The coding steps in order (start and frequency), then rANS last step first.
+  std::vector<std::array<uint32_t, 2>> steps;
+  steps.reserve(symbols.size() + symbols.size() / 8);
+  context = 0;
+  for (const uint8_t b : symbols) {
+    const uint32_t code = b >> 3, s = (b & 7) + (code ? kKinds : 0);
+    steps.push_back({start[context][s], f[context][s]});
+    if (code) steps.push_back({start[kCodeTable][code - 1], f[kCodeTable][code - 1]});
+    context = s;
+  }
+  std::vector<uint8_t> reversed;
+  uint32_t state[kStates] = {rans::kLow, rans::kLow};
+  for (size_t i = steps.size(); i-- > 0;)
+    rans::encode(state[i % kStates], steps[i][0], steps[i][1], kScaleBits, reversed);
+  w.varint(4 * kStates + reversed.size());
+  for (const uint32_t x : state) w.u32(x);
+  w.bytes.insert(w.bytes.end(), reversed.rbegin(), reversed.rend());
+  return std::move(w.bytes);
+}
+
+SymbolDecoder::SymbolDecoder(std::span<const uint8_t> stream, const std::string& where) : where_(where) {
+  if (stream.empty()) return;  // no symbols
+  ByteReader r(stream, where);
+  slot_.assign(size_t(kTables) * kScale, 0);
+  for (uint32_t t = 0; t < kTables; ++t) {
+    const uint32_t A = alphabet(t);
+    const uint32_t mask = t == kCodeTable ? r.u32() : r.u16();
+    if (mask >> A) r.fail("symbol table of an unknown symbol");
+    if (!mask) continue;
+    const uint32_t last = 31 - uint32_t(__builtin_clz(mask));
+    uint32_t* slots = slot_.data() + size_t(t) * kScale;
+    uint32_t sum = 0;
+    for (uint32_t s = 0; s <= last; ++s) {
+      if (!(mask >> s & 1)) continue;
+      uint64_t f = kScale - sum;  // the last takes the rest
+      if (s != last) {
+        f = r.varint();
+        if (f == 0 || f >= kScale - sum) r.fail("symbol frequencies add up past the scale");
+      }
+      const uint32_t entry = uint32_t(f) | s << 21;
+      for (uint32_t j = 0; j < f; ++j) slots[sum + j] = entry | j << 11;
+      sum += uint32_t(f);
+    }
+  }
+  const uint64_t size = r.varint();
+  if (size < 4 * kStates || size != r.remaining()) r.fail("symbol rANS stream not the stream's rest");
+  const std::span<const uint8_t> rest = r.bytes(r.remaining(), "symbol rANS stream");
+  bytes_.resize(rest.size() + 8);
+  std::memcpy(bytes_.data(), rest.data(), rest.size());
+  rans_end_ = size;
+  for (uint32_t k = 0; k < kStates; ++k) {
+    std::memcpy(&state_[k], bytes_.data() + 4 * k, 4);
+    if (state_[k] < rans::kLow) fail("invalid symbol rANS state");
+  }
+  rans_at_ = 4 * kStates;
+}
+
+void SymbolDecoder::fail(const char* what) const {
+  throw Error(where_ + ": " + what);
+}
+
+void SymbolDecoder::symbols(size_t count, uint8_t* out) {
+  if (count == 0) return;
+  if (slot_.empty()) fail("symbols past the symbol stream's end");
+  const uint32_t* slots = slot_.data();
+  const uint8_t* bytes = bytes_.data();
+  size_t at = rans_at_;
+  const size_t rans_end = rans_end_;
+  uint32_t x0 = state_[0], x1 = state_[1], context = context_;
+  // One step (rANS, Duda 2013, eq. 9: D(x) = (s, f_s floor(x / 2^8) + x mod 2^8 - start_s), s the symbol
+  // of slot x mod 2^8 of `table`), then x read back up to kLow from the next 2 rANS bytes; the states
+  // alternate.
+  const auto step = [&](uint32_t table) __attribute__((always_inline)) {
+    const uint32_t e = slots[table * kScale + (x0 & (kScale - 1))];
+    uint32_t x = (e & 0x7ff) * (x0 >> kScaleBits) + ((e >> 11) & 0x3ff);
+    uint16_t next;
+    std::memcpy(&next, bytes + at, 2);
+    rans::renormalize(x, at, next);
+    x0 = x1, x1 = x;
+    return e >> 21;
+  };
+  // A symbol reads at most 4 bytes: started only while at is within the rANS bytes, so that no read leaves
+  // the padding. A class of a table that never occurs decodes as class 0 (its slots are 0).
+  for (size_t i = 0; i < count; ++i) {
+    if (at > rans_end) fail("symbol rANS stream ends early");
+    const uint32_t s = step(context);
+    uint32_t symbol = s;
+    if (s >= kKinds) [[unlikely]]
+      symbol = (s - kKinds) | (step(kCodeTable) + 1) << 3;
+    out[i] = uint8_t(symbol);
+    context = s;  // below kClasses: the tables hold no other classes
+  }
+  if (at > rans_end) fail("symbol rANS stream ends early");
+  state_[0] = x0, state_[1] = x1, context_ = context;
+  rans_at_ = at;
+}
+
+void SymbolDecoder::finish() const {
+  if (slot_.empty()) return;
+  if (rans_at_ != rans_end_ || state_[0] != rans::kLow || state_[1] != rans::kLow)
+    fail("symbol stream holds bytes of no symbol");
+}
+
+}  // namespace lodstream::package
