@@ -110,6 +110,7 @@ struct StarFace {
 // faces and edges, and what its collapses changed (merged into the mesh's totals after the loop).
 struct Scratch {
   uint32_t region = kAnyRegion;  // collapses must keep every face they read inside this region
+  uint32_t region_base = 0;      // region x Simplifier::region_vertices_ (in_region)
   std::vector<uint32_t> na, nb, apex, removed;
   std::vector<StarFace> star_a, star_b;  // the alive faces around a's and b's wedges (for_faces order)
   std::vector<Corners> old;
@@ -363,21 +364,25 @@ class Simplifier {
   // around a vertex lie in a few cache lines of indices_ and slots_: each collapse walks them in cost order,
   // random in space, and in input order the first read of every face was a cache miss (about a third of
   // try_collapse's samples on elephant_1m). Two stable counting sorts, on every core: by runs of `span`
-  // vertices (counting_sort), then each run's faces by their vertex. O(T + V).
+  // vertices (counting_sort), then each run's faces by their vertex. Up to kMaxRuns runs, about kRunFaces
+  // faces each: a DAG group of 800 faces in 4096 runs spent most of its sort on empty runs (77 M of the
+  // bake's 1.6 G simplifier instructions on refined_elephant). The order does not depend on the runs. O(T +
+  // V).
   void sort_faces() {
-    constexpr uint32_t kRuns = 4096;
+    constexpr size_t kMaxRuns = 4096, kRunFaces = 64;
     const size_t faces = indices_.size() / 3;
-    const uint32_t span = uint32_t(source_.size() / kRuns + 1);
+    const uint32_t run_count = uint32_t(std::clamp<size_t>(faces / kRunFaces, 1, kMaxRuns));
+    const uint32_t span = uint32_t(source_.size() / run_count + 1);
     auto key = [&](size_t f) {
       return std::min({indices_[3 * f], indices_[3 * f + 1], indices_[3 * f + 2]});
     };
     UninitializedVector<uint32_t> by_run(faces);
     std::vector<uint32_t> run_start;
     counting_sort(
-        faces, kRuns, [&](size_t f) { return key(f) / span; },
+        faces, run_count, [&](size_t f) { return key(f) / span; },
         [&](size_t f, uint32_t position) { by_run[position] = uint32_t(f); }, &run_start);
     std::vector<uint32_t> sorted(indices_.size());
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, kRuns, 64), [&](const auto& runs) {
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, run_count, 64), [&](const auto& runs) {
       std::vector<uint32_t> start(span + 1);
       for (uint32_t r = runs.begin(); r < runs.end(); ++r) {
         const uint32_t first = r * span, begin = run_start[r], end = run_start[r + 1];
@@ -639,14 +644,16 @@ class Simplifier {
     // chunk's faces add to their corners in its range; a face with a corner in a later range is also listed
     // for that range, which adds it before its own faces. Every vertex then sums its faces in face order, as
     // one loop over the faces would, and the chunks run in parallel.
-    constexpr uint32_t kChunks = 16;
-    std::vector<uint32_t> first_vertex(kChunks + 1), first_face(kChunks + 1);
+    // One chunk for a small mesh: its vertex ranges would be a few dozen vertices, so that most faces
+    // straddle and each computes its planes once per range it touches.
+    const uint32_t chunks = small_ ? 1 : 16;
+    std::vector<uint32_t> first_vertex(chunks + 1), first_face(chunks + 1);
     auto key = [&](size_t f) {
       return std::min({indices_[3 * f], indices_[3 * f + 1], indices_[3 * f + 2]});
     };
     const size_t faces = indices_.size() / 3;
-    for (uint32_t k = 0; k <= kChunks; ++k) {
-      first_vertex[k] = uint32_t(uint64_t(m) * k / kChunks);
+    for (uint32_t k = 0; k <= chunks; ++k) {
+      first_vertex[k] = uint32_t(uint64_t(m) * k / chunks);
       size_t lo = 0, hi = faces;  // the first face whose key is >= first_vertex[k]
       while (lo < hi) {
         const size_t mid = (lo + hi) / 2;
@@ -657,13 +664,13 @@ class Simplifier {
       }
       first_face[k] = uint32_t(lo);
     }
-    std::vector<std::vector<uint32_t>> straddling(kChunks);  // faces with a corner in a later range
-    for_each(uint32_t(0), kChunks, [&](uint32_t k) {
+    std::vector<std::vector<uint32_t>> straddling(chunks);  // faces with a corner in a later range
+    for_each(uint32_t(0), chunks, [&](uint32_t k) {
       for (uint32_t f = first_face[k]; f < first_face[k + 1]; ++f)
         if (std::max({indices_[3 * f], indices_[3 * f + 1], indices_[3 * f + 2]}) >= first_vertex[k + 1])
           straddling[k].push_back(f);
     });
-    for_each(uint32_t(0), kChunks, [&](uint32_t k) {
+    for_each(uint32_t(0), chunks, [&](uint32_t k) {
       std::vector<float> s(3 * size_t(channels_));
       std::vector<AttributeTerm> gradient(channels_);
       const uint32_t lo = first_vertex[k], hi = first_vertex[k + 1];
@@ -985,7 +992,7 @@ class Simplifier {
           const uint32_t begin = region_start_[r], end = region_start_[r + 1];
           const size_t quota = size_t(double(removable) * (end - begin) / double(n));
           const size_t removed_before = s.removed_triangles;
-          s.region = r;
+          s.region = r, s.region_base = r * region_vertices_;
           for (uint32_t k = begin; k < end; ++k) {
             if (s.removed_triangles - removed_before + 2 > quota) break;
             prefetch(k, end);
@@ -1041,6 +1048,11 @@ class Simplifier {
   }
 
   uint32_t region_of(uint32_t v) const { return (v + region_shift_) / region_vertices_; }
+  // region_of(v) == s.region without the division (the try's hot path checks every corner around it):
+  // v + shift - base wraps to above the run when v lies before the region.
+  bool in_region(uint32_t v, const Scratch& s) const {
+    return uint32_t(v + region_shift_ - s.region_base) < region_vertices_;
+  }
 
   // Groups the pass's candidates by region into sorted_ as (cost, order_ index), in cost order within each
   // region (a counting_sort on both cores; candidates whose ends lie in two regions are left out) and sets
@@ -1109,6 +1121,8 @@ class Simplifier {
         if (channels_ > 0) {
           const AttributeTerm* t = &attr_[v * size_t(channels_)];
           __builtin_prefetch(t), __builtin_prefetch(reinterpret_cast<const char*>(t + channels_) - 1);
+          __builtin_prefetch(&plane_quadric_[v]);  // merge adds them
+          __builtin_prefetch(reinterpret_cast<const char*>(&plane_quadric_[v] + 1) - 1);
         }
       }
     }
@@ -1225,16 +1239,15 @@ class Simplifier {
     s.na.clear(), s.nb.clear(), s.apex.clear(), s.removed.clear(), s.star_a.clear(), s.star_b.clear();
     size_t kept_faces = 0;
     bool inside = true;
-    auto in_region = [&](const uint32_t* t) {
-      return s.region == kAnyRegion ||
-             (region_of(t[0]) == s.region && region_of(t[1]) == s.region && region_of(t[2]) == s.region);
+    auto face_in_region = [&](const uint32_t* t) {
+      return s.region == kAnyRegion || (in_region(t[0], s) && in_region(t[1], s) && in_region(t[2], s));
     };
     auto at = [](const uint32_t* q, uint32_t v) {
       return uint8_t((q[0] == v) | (q[1] == v) << 1 | (q[2] == v) << 2);
     };
     for_faces(p.a, [&](uint32_t f) {
       const uint32_t* t = &indices_[3 * size_t(f)];
-      inside = inside && in_region(t);
+      inside = inside && face_in_region(t);
       uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
       const StarFace& star = s.star_a.emplace_back(StarFace{f, at(q, pa), at(q, pb)});
       if (star.at_b) {
@@ -1249,7 +1262,7 @@ class Simplifier {
     });
     for_faces(p.b, [&](uint32_t f) {
       const uint32_t* t = &indices_[3 * size_t(f)];
-      inside = inside && in_region(t);
+      inside = inside && face_in_region(t);
       uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
       const StarFace& star = s.star_b.emplace_back(StarFace{f, at(q, pa), at(q, pb)});
       if (star.at_a) return;
