@@ -533,7 +533,8 @@ class Simplifier {
 
   // classify's first step for one vertex: its open edges (open_out_, open_in_, open_count) and whether its
   // fan is complex (a directed edge twice, more than one open edge, or faces not forming one disc or fan).
-  // Writes only v's entries, so vertices run in parallel.
+  // A complex vertex is locked, so its open edges are not needed: a repeated edge ends the scan. Writes
+  // only v's entries, so vertices run in parallel. O(degree^2) compares, half of them for the repeats.
   void classify_fan(uint32_t v, std::vector<uint32_t>& outs, std::vector<uint32_t>& ins,
                     std::vector<uint8_t>& open_count, std::vector<uint8_t>& complex) {
     fan(v, outs, ins);
@@ -543,10 +544,15 @@ class Simplifier {
       complex[v] = 1;
       return;
     }
+    for (size_t i = 0; i < deg; ++i)
+      for (size_t j = i + 1; j < deg; ++j)
+        if (outs[j] == outs[i]) {
+          complex[v] = 1;
+          return;
+        }
 
     uint32_t n_open_out = 0, n_open_in = 0, start = 0;
     for (size_t i = 0; i < deg; ++i) {
-      if (std::count(outs.begin(), outs.end(), outs[i]) > 1) complex[v] = 1;
       if (std::find(ins.begin(), ins.end(), outs[i]) == ins.end())
         ++n_open_out, open_out_[v] = outs[i], start = uint32_t(i);
       if (std::find(outs.begin(), outs.end(), ins[i]) == outs.end()) ++n_open_in, open_in_[v] = ins[i];
@@ -554,12 +560,12 @@ class Simplifier {
     if (n_open_out > 1 || n_open_in > 1 || n_open_out != n_open_in) complex[v] = 1;
     open_count[v] = uint8_t(std::min<uint32_t>(n_open_out, 2));
     if (complex[v]) return;
-    // Walk the fan from the face after the open edge (or any face): face g follows f when g.out == f.in.
+    // Walk the fan from the face after the open edge (or any face): face g follows f when g.out == f.in
+    // (one such g at most: no out-neighbour repeats).
     size_t visited = 1, cur = start;
     while (visited < deg) {
-      size_t next = deg;
-      for (size_t i = 0; i < deg; ++i)
-        if (outs[i] == ins[cur]) next = i;
+      size_t next = 0;
+      while (next < deg && outs[next] != ins[cur]) ++next;
       if (next == deg || next == start) break;
       cur = next, ++visited;
     }
