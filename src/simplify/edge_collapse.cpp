@@ -110,6 +110,7 @@ struct StarFace {
 // faces and edges, and what its collapses changed (merged into the mesh's totals after the loop).
 struct Scratch {
   uint32_t region = kAnyRegion;  // collapses must keep every face they read inside this region
+  uint32_t region_base = 0;      // region x Simplifier::region_vertices_ (in_region)
   std::vector<uint32_t> na, nb, apex, removed;
   std::vector<StarFace> star_a, star_b;  // the alive faces around a's and b's wedges (for_faces order)
   std::vector<Corners> old;
@@ -214,6 +215,9 @@ class Simplifier {
   std::vector<uint8_t> kind_, touched_, moved_;
   std::vector<float> radius_;  // bound radius r_v (simplify.hpp), normalized units
   UninitializedVector<Quadric> quadric_;
+  // With attribute channels: the position part of quadric_ alone (face and penalty planes), which ranks the
+  // candidates (place); empty without channels, where quadric_ is that already.
+  UninitializedVector<Quadric> plane_quadric_;
   UninitializedVector<AttributeTerm> attr_;  // channels_ per vertex
   // Weighted attribute channels in the cost: one component of the normal, UV or colour, with its weight.
   struct Channel {
@@ -360,21 +364,25 @@ class Simplifier {
   // around a vertex lie in a few cache lines of indices_ and slots_: each collapse walks them in cost order,
   // random in space, and in input order the first read of every face was a cache miss (about a third of
   // try_collapse's samples on elephant_1m). Two stable counting sorts, on every core: by runs of `span`
-  // vertices (counting_sort), then each run's faces by their vertex. O(T + V).
+  // vertices (counting_sort), then each run's faces by their vertex. Up to kMaxRuns runs, about kRunFaces
+  // faces each: a DAG group of 800 faces in 4096 runs spent most of its sort on empty runs (77 M of the
+  // bake's 1.6 G simplifier instructions on refined_elephant). The order does not depend on the runs. O(T +
+  // V).
   void sort_faces() {
-    constexpr uint32_t kRuns = 4096;
+    constexpr size_t kMaxRuns = 4096, kRunFaces = 64;
     const size_t faces = indices_.size() / 3;
-    const uint32_t span = uint32_t(source_.size() / kRuns + 1);
+    const uint32_t run_count = uint32_t(std::clamp<size_t>(faces / kRunFaces, 1, kMaxRuns));
+    const uint32_t span = uint32_t(source_.size() / run_count + 1);
     auto key = [&](size_t f) {
       return std::min({indices_[3 * f], indices_[3 * f + 1], indices_[3 * f + 2]});
     };
     UninitializedVector<uint32_t> by_run(faces);
     std::vector<uint32_t> run_start;
     counting_sort(
-        faces, kRuns, [&](size_t f) { return key(f) / span; },
+        faces, run_count, [&](size_t f) { return key(f) / span; },
         [&](size_t f, uint32_t position) { by_run[position] = uint32_t(f); }, &run_start);
     std::vector<uint32_t> sorted(indices_.size());
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, kRuns, 64), [&](const auto& runs) {
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, run_count, 64), [&](const auto& runs) {
       std::vector<uint32_t> start(span + 1);
       for (uint32_t r = runs.begin(); r < runs.end(); ++r) {
         const uint32_t first = r * span, begin = run_start[r], end = run_start[r + 1];
@@ -525,7 +533,8 @@ class Simplifier {
 
   // classify's first step for one vertex: its open edges (open_out_, open_in_, open_count) and whether its
   // fan is complex (a directed edge twice, more than one open edge, or faces not forming one disc or fan).
-  // Writes only v's entries, so vertices run in parallel.
+  // A complex vertex is locked, so its open edges are not needed: a repeated edge ends the scan. Writes
+  // only v's entries, so vertices run in parallel. O(degree^2) compares, half of them for the repeats.
   void classify_fan(uint32_t v, std::vector<uint32_t>& outs, std::vector<uint32_t>& ins,
                     std::vector<uint8_t>& open_count, std::vector<uint8_t>& complex) {
     fan(v, outs, ins);
@@ -535,10 +544,15 @@ class Simplifier {
       complex[v] = 1;
       return;
     }
+    for (size_t i = 0; i < deg; ++i)
+      for (size_t j = i + 1; j < deg; ++j)
+        if (outs[j] == outs[i]) {
+          complex[v] = 1;
+          return;
+        }
 
     uint32_t n_open_out = 0, n_open_in = 0, start = 0;
     for (size_t i = 0; i < deg; ++i) {
-      if (std::count(outs.begin(), outs.end(), outs[i]) > 1) complex[v] = 1;
       if (std::find(ins.begin(), ins.end(), outs[i]) == ins.end())
         ++n_open_out, open_out_[v] = outs[i], start = uint32_t(i);
       if (std::find(outs.begin(), outs.end(), ins[i]) == outs.end()) ++n_open_in, open_in_[v] = ins[i];
@@ -546,12 +560,12 @@ class Simplifier {
     if (n_open_out > 1 || n_open_in > 1 || n_open_out != n_open_in) complex[v] = 1;
     open_count[v] = uint8_t(std::min<uint32_t>(n_open_out, 2));
     if (complex[v]) return;
-    // Walk the fan from the face after the open edge (or any face): face g follows f when g.out == f.in.
+    // Walk the fan from the face after the open edge (or any face): face g follows f when g.out == f.in
+    // (one such g at most: no out-neighbour repeats).
     size_t visited = 1, cur = start;
     while (visited < deg) {
-      size_t next = deg;
-      for (size_t i = 0; i < deg; ++i)
-        if (outs[i] == ins[cur]) next = i;
+      size_t next = 0;
+      while (next < deg && outs[next] != ins[cur]) ++next;
       if (next == deg || next == start) break;
       cur = next, ++visited;
     }
@@ -592,6 +606,11 @@ class Simplifier {
     Quadric face;  // relative to p0
     face.add_plane(n / len, 0.0f, area);
     face.w = area;
+    // The plane through each corner is this one relative to that corner (n.d = 0), so the plane quadric is
+    // the same at every corner: no shift.
+    if (channels_ > 0)
+      for (uint32_t v : {v0, v1, v2})
+        if (mine(v)) plane_quadric_[v].add(face);
     if (channels_ > 0) {
       float *s0 = s, *s1 = s + channels_, *s2 = s + 2 * channels_;
       channel_values(v0, s0), channel_values(v1, s1), channel_values(v2, s2);
@@ -624,20 +643,23 @@ class Simplifier {
   void build_quadrics() {
     const size_t m = source_.size();
     choose_channels();
-    quadric_.clear(), attr_.clear();
+    quadric_.clear(), plane_quadric_.clear(), attr_.clear();
     quadric_.resize(m), attr_.resize(m * size_t(channels_));  // zeroed per chunk below
+    if (channels_ > 0) plane_quadric_.resize(m);
     // Vertex ranges, one per chunk of faces (faces are sorted by their smallest vertex, sort_faces): a
     // chunk's faces add to their corners in its range; a face with a corner in a later range is also listed
     // for that range, which adds it before its own faces. Every vertex then sums its faces in face order, as
     // one loop over the faces would, and the chunks run in parallel.
-    constexpr uint32_t kChunks = 16;
-    std::vector<uint32_t> first_vertex(kChunks + 1), first_face(kChunks + 1);
+    // One chunk for a small mesh: its vertex ranges would be a few dozen vertices, so that most faces
+    // straddle and each computes its planes once per range it touches.
+    const uint32_t chunks = small_ ? 1 : 16;
+    std::vector<uint32_t> first_vertex(chunks + 1), first_face(chunks + 1);
     auto key = [&](size_t f) {
       return std::min({indices_[3 * f], indices_[3 * f + 1], indices_[3 * f + 2]});
     };
     const size_t faces = indices_.size() / 3;
-    for (uint32_t k = 0; k <= kChunks; ++k) {
-      first_vertex[k] = uint32_t(uint64_t(m) * k / kChunks);
+    for (uint32_t k = 0; k <= chunks; ++k) {
+      first_vertex[k] = uint32_t(uint64_t(m) * k / chunks);
       size_t lo = 0, hi = faces;  // the first face whose key is >= first_vertex[k]
       while (lo < hi) {
         const size_t mid = (lo + hi) / 2;
@@ -648,17 +670,18 @@ class Simplifier {
       }
       first_face[k] = uint32_t(lo);
     }
-    std::vector<std::vector<uint32_t>> straddling(kChunks);  // faces with a corner in a later range
-    for_each(uint32_t(0), kChunks, [&](uint32_t k) {
+    std::vector<std::vector<uint32_t>> straddling(chunks);  // faces with a corner in a later range
+    for_each(uint32_t(0), chunks, [&](uint32_t k) {
       for (uint32_t f = first_face[k]; f < first_face[k + 1]; ++f)
         if (std::max({indices_[3 * f], indices_[3 * f + 1], indices_[3 * f + 2]}) >= first_vertex[k + 1])
           straddling[k].push_back(f);
     });
-    for_each(uint32_t(0), kChunks, [&](uint32_t k) {
+    for_each(uint32_t(0), chunks, [&](uint32_t k) {
       std::vector<float> s(3 * size_t(channels_));
       std::vector<AttributeTerm> gradient(channels_);
       const uint32_t lo = first_vertex[k], hi = first_vertex[k + 1];
       std::fill(quadric_.data() + lo, quadric_.data() + hi, Quadric{});
+      if (channels_ > 0) std::fill(plane_quadric_.data() + lo, plane_quadric_.data() + hi, Quadric{});
       std::fill(attr_.data() + lo * size_t(channels_), attr_.data() + hi * size_t(channels_),
                 AttributeTerm{});
       for (uint32_t earlier = 0; earlier < k; ++earlier)
@@ -683,6 +706,10 @@ class Simplifier {
         const float weight = opt_.boundary_weight * glm::dot(e, e);
         quadric_[v].add_plane(pn, 0.0f, weight);
         quadric_[outs[i]].add_plane(pn, -glm::dot(pn, pa - pb), weight);
+        if (channels_ > 0) {
+          plane_quadric_[v].add_plane(pn, 0.0f, weight);
+          plane_quadric_[outs[i]].add_plane(pn, -glm::dot(pn, pa - pb), weight);
+        }
       }
     }
   }
@@ -729,9 +756,13 @@ class Simplifier {
   // Moves v's quadric and attribute terms to an origin `d` further (Reduced::add: Q(y' + d); an attribute
   // g.y + d_s becomes g.y' + d_s + g.d).
   void rebase(uint32_t v, const glm::dvec3& d) {
-    Quadric moved;
-    moved.add_shifted(quadric_[v], d);
-    quadric_[v] = moved;
+    auto shift = [&](Quadric& q) {
+      Quadric moved;
+      moved.add_shifted(q, d);
+      q = moved;
+    };
+    shift(quadric_[v]);
+    if (channels_ > 0) shift(plane_quadric_[v]);
     for (int j = 0; j < channels_; ++j) {
       AttributeTerm& t = attr_[v * size_t(channels_) + j];
       t.d += float(glm::dot(glm::dvec3(t.g), d));
@@ -760,33 +791,40 @@ class Simplifier {
     }
   }
 
-  // Placement and cost of a planned collapse: the summed quadric Q = Q_a + Q_b of both positions (all
-  // wedges), attribute channels eliminated per merged wedge pair; optimal x when both ends may move, else
-  // x = b. The cost is Q(x) / W, the area-weighted mean squared distance to both ends' planes (and
-  // attribute error). Positions only, it is never below kEndShare times either end's own:
+  // What place() computes: a candidate's rank (its cost) or, for the collapse being tried, its x.
+  enum class Goal { kRank, kPlace };
+
+  // Placement of a planned collapse: the summed quadric Q = Q_a + Q_b of both positions (all wedges),
+  // minimised; optimal x when both ends may move, else x = b. kPlace (try_collapse) uses the full quadrics
+  // with the attribute channels eliminated per merged wedge pair (Hoppe 99), so that x and the merged
+  // attributes balance shape and attributes. kRank ranks by the position part alone (plane_quadric_ with
+  // attribute channels): the cost is Q(x) / W at its own optimum x, the area-weighted mean squared distance
+  // to both ends' planes, never below kEndShare times either end's own:
   //   cost = max(Q(x) / W, k Q_a(x) / W_a, k Q_b(x) / W_b),  k = kEndShare.
   // The sum alone dilutes a small end's error into a large end's area (a ridge vertex merged into one that
   // already stands for a wide smooth region is nearly free). meshoptimizer ranks by the removed end's own
   // quadric, Q_a(b) / W_a, which never dilutes; k = 1 raised the mean distance by 16 %, k = 0.1 keeps it.
-  // Measured with quadrics relative to each vertex (origin_of) it changes little: elephant_1m 10 %
-  // identical, horse 10 % Hausdorff 0.87x -> 0.85x meshoptimizer's, 1 % 0.54x -> 0.52x. With attribute
-  // weights (attributes eliminated per end) it measured mixed, so it applies positions only.
-  void place(Plan& p) const {
+  // Ranking without the attribute terms takes most evaluations (about 7 per collapse, one placement) off
+  // the attribute channels' cost (the attributes then decide only where x goes and what it carries);
+  // default-weight PSNR stays above meshoptimizer's on every row measured (BENCHMARKS.md).
+  void place(Plan& p, Goal goal) const {
     constexpr double kEndShare = 0.1;
+    const bool attributes = goal == Goal::kPlace && channels_ > 0;
+    const Quadric* quadric = attributes || channels_ == 0 ? quadric_.data() : plane_quadric_.data();
     std::array<Reduced, 2> own;  // Q_a, Q_b
     std::array<double, 2> own_w{0.0, 0.0};
     // Everything relative to b's origin o (a's quadrics shifted by o - o_a; b's wedges share o), x = o + y.
     const glm::dvec3 o = origin_of(p.b), shift = o - origin_of(p.a);
     uint32_t v = p.a;
-    do own[0].add(quadric_[v], shift), own_w[0] += quadric_[v].w, v = wedge_[v];
+    do own[0].add(quadric[v], shift), own_w[0] += quadric[v].w, v = wedge_[v];
     while (v != p.a);
     v = p.b;
-    do own[1].add(quadric_[v]), own_w[1] += quadric_[v].w, v = wedge_[v];
+    do own[1].add(quadric[v]), own_w[1] += quadric[v].w, v = wedge_[v];
     while (v != p.b);
     Reduced r = own[0];
     r.add(own[1]);
     const double w = own_w[0] + own_w[1];
-    for (int pair = 0; pair < 2 && channels_ > 0; ++pair) {
+    for (int pair = 0; pair < 2 && attributes; ++pair) {
       uint32_t a = pair ? p.a2 : p.a, b = pair ? p.b2 : p.b;
       if (a == kNone) continue;
       double ww = double(quadric_[a].w) + quadric_[b].w;
@@ -825,8 +863,8 @@ class Simplifier {
     }
     const glm::dvec3 y = p.x;
     p.x += o;
+    if (goal == Goal::kPlace) return;
     p.cost = r.eval(y) / (w + 1e-20);
-    if (channels_ > 0) return;
     // An end's own term can exceed the sum's only when W_side < k W (Q_side(x) <= Q(x), rounding aside:
     // both are sums of squares), so only the smaller end of an unbalanced edge is evaluated.
     for (int side = 0; side < 2; ++side)
@@ -839,12 +877,12 @@ class Simplifier {
     Candidate best{std::numeric_limits<float>::infinity(), kNone, kNone};
     Plan p;
     if (can_remove(i, j, p)) {
-      place(p);
+      place(p, Goal::kRank);
       best = {float(p.cost), i, j};
       if (p.move) return best;  // symmetric: the other direction is the same collapse
     }
     if (can_remove(j, i, p)) {
-      place(p);
+      place(p, Goal::kRank);
       if (float(p.cost) < best.cost) best = {float(p.cost), j, i};
     }
     return best;
@@ -960,7 +998,7 @@ class Simplifier {
           const uint32_t begin = region_start_[r], end = region_start_[r + 1];
           const size_t quota = size_t(double(removable) * (end - begin) / double(n));
           const size_t removed_before = s.removed_triangles;
-          s.region = r;
+          s.region = r, s.region_base = r * region_vertices_;
           for (uint32_t k = begin; k < end; ++k) {
             if (s.removed_triangles - removed_before + 2 > quota) break;
             prefetch(k, end);
@@ -1016,6 +1054,11 @@ class Simplifier {
   }
 
   uint32_t region_of(uint32_t v) const { return (v + region_shift_) / region_vertices_; }
+  // region_of(v) == s.region without the division (the try's hot path checks every corner around it):
+  // v + shift - base wraps to above the run when v lies before the region.
+  bool in_region(uint32_t v, const Scratch& s) const {
+    return uint32_t(v + region_shift_ - s.region_base) < region_vertices_;
+  }
 
   // Groups the pass's candidates by region into sorted_ as (cost, order_ index), in cost order within each
   // region (a counting_sort on both cores; candidates whose ends lie in two regions are left out) and sets
@@ -1084,6 +1127,8 @@ class Simplifier {
         if (channels_ > 0) {
           const AttributeTerm* t = &attr_[v * size_t(channels_)];
           __builtin_prefetch(t), __builtin_prefetch(reinterpret_cast<const char*>(t + channels_) - 1);
+          __builtin_prefetch(&plane_quadric_[v]);  // merge adds them
+          __builtin_prefetch(reinterpret_cast<const char*>(&plane_quadric_[v] + 1) - 1);
         }
       }
     }
@@ -1200,16 +1245,15 @@ class Simplifier {
     s.na.clear(), s.nb.clear(), s.apex.clear(), s.removed.clear(), s.star_a.clear(), s.star_b.clear();
     size_t kept_faces = 0;
     bool inside = true;
-    auto in_region = [&](const uint32_t* t) {
-      return s.region == kAnyRegion ||
-             (region_of(t[0]) == s.region && region_of(t[1]) == s.region && region_of(t[2]) == s.region);
+    auto face_in_region = [&](const uint32_t* t) {
+      return s.region == kAnyRegion || (in_region(t[0], s) && in_region(t[1], s) && in_region(t[2], s));
     };
     auto at = [](const uint32_t* q, uint32_t v) {
       return uint8_t((q[0] == v) | (q[1] == v) << 1 | (q[2] == v) << 2);
     };
     for_faces(p.a, [&](uint32_t f) {
       const uint32_t* t = &indices_[3 * size_t(f)];
-      inside = inside && in_region(t);
+      inside = inside && face_in_region(t);
       uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
       const StarFace& star = s.star_a.emplace_back(StarFace{f, at(q, pa), at(q, pb)});
       if (star.at_b) {
@@ -1224,7 +1268,7 @@ class Simplifier {
     });
     for_faces(p.b, [&](uint32_t f) {
       const uint32_t* t = &indices_[3 * size_t(f)];
-      inside = inside && in_region(t);
+      inside = inside && face_in_region(t);
       uint32_t q[3] = {pid_[t[0]], pid_[t[1]], pid_[t[2]]};
       const StarFace& star = s.star_b.emplace_back(StarFace{f, at(q, pa), at(q, pb)});
       if (star.at_a) return;
@@ -1250,7 +1294,7 @@ class Simplifier {
     for (uint32_t c : s.apex)
       if (!has(s.na, c) && !has(s.nb, c)) return rejected_slot(p, s);
 
-    place(p);
+    place(p, Goal::kPlace);
     const glm::vec3 x(p.x);  // as stored: the bounds use the rounded position
     const double da = glm::length(glm::dvec3(pos_[p.a]) - glm::dvec3(x));
     const double db = glm::length(glm::dvec3(pos_[p.b]) - glm::dvec3(x));
@@ -1519,6 +1563,7 @@ class Simplifier {
       if (!col_.empty()) col_[b] = glm::clamp(col_[b], 0.0f, 1.0f);
     }
     quadric_[b].add_shifted(quadric_[a], shift);
+    if (channels_ > 0) plane_quadric_[b].add_shifted(plane_quadric_[a], shift);
     for (int j = 0; j < channels_; ++j) {
       const AttributeTerm& ta = attr_[a * size_t(channels_) + j];
       attr_[b * size_t(channels_) + j].g += ta.g;
