@@ -9,16 +9,14 @@
 //   the vertices of the common refinement of both fans (0 growth on planar regions, about curvature x
 //   length^2 on smooth ones instead of about length/2).
 //
-// Operator: edge collapse a -> b with optimal placement x (full edge) or x = b (half edge); candidates are
-// ranked by their position quadrics alone, and the collapse taken is placed (and its attributes merged) with
-// the attribute terms (Hoppe 99) as well. Framework: passes of independent collapses in cost order (a lazy
-// queue: each pass re-evaluates, in parallel, the edges with an end touched by the previous one and
-// radix-sorts the candidates), each pass limited to 1.5x the cost of the collapse that would reach the
-// target, which keeps the order close to greedy. A collapse that fails the validity checks is not tried again
-// until an end is touched (or a pass finds nothing). The collapse loop of a large pass runs on many small
-// regions (runs of about 16384 alive vertices in Morton order, at least 2 runs, shifted each pass) on both
-// cores, the collapses that cross a region's border after them, serially; the result does not depend on
-// thread timing.
+// Operator: edge collapse a -> b with optimal placement x (full edge) or x = b (half edge). Framework: passes
+// of independent collapses in quadric-cost order (a lazy queue: each pass re-evaluates, in parallel, the
+// edges with an end touched by the previous one and radix-sorts the candidates), each pass limited to 1.5x
+// the cost of the collapse that would reach the target, which keeps the order close to greedy. A collapse
+// that fails the validity checks is not tried again until an end is touched (or a pass finds nothing). The
+// collapse loop of a large pass runs on many small regions (runs of about 16384 alive vertices in Morton
+// order, at least 2 runs, shifted each pass) on both cores, the collapses that cross a region's border after
+// them, serially; the result does not depend on thread timing.
 //
 // Vertices are classified once (meshoptimizer's vertex kinds, extended): Manifold (interior), Border (one
 // open edge in and out), Seam (two vertices share the position and their open edges pair up: a UV, normal
@@ -46,9 +44,8 @@ struct Options {
   size_t target_triangles = 0;
   double max_error = std::numeric_limits<double>::infinity();
 
-  // Attribute weights in each collapse's placement quadric (attribute units per unit of the bounding-box
-  // extent; the ranking uses positions alone): 0 drops the attribute from it (it is still interpolated). All
-  // 0 gives the positions-only metric.
+  // Attribute weights in the collapse cost (attribute units per unit of the bounding-box extent): 0 drops the
+  // attribute from the cost (it is still interpolated). All 0 gives the positions-only metric.
   float normal_weight = 0.01f;
   float uv_weight = 0.05f;
   float color_weight = 0.05f;
@@ -94,8 +91,7 @@ struct Result {
 
 // Simplifies `mesh`. Cost: O(T log T) time over a few passes, using every core for the set-up (weld,
 // quadrics, classification, sorts), cost evaluation and the collapse loop; memory about 130 bytes per input
-// triangle, 22 more with attribute weights (elephant_1m peak for the whole `lodstream simplify`, import and
-// export included: 192 B/tri with its normals weighted, 147 positions only).
+// triangle (elephant_1m: 169 B/tri peak for the whole `lodstream simplify`, import and export included).
 // Never throws on odd input (non-manifold, degenerate, empty).
 Result simplify_mesh(const Mesh& mesh, const Options& options);
 
