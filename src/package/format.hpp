@@ -27,10 +27,9 @@ inline constexpr std::array<uint8_t, 8> kMagic = {0x89, 'L', 'O', 'D', 'S', '\r'
 // node record names its cluster within a record of several clusters (index.hpp, NodeRecord::cluster); 5:
 // compact (error, sphere) pairs (index.hpp, pair_rounding.hpp); 6: normals coded in the frame of their
 // prediction (predicted_normals.hpp), pages of codecs 2 and 3 store their residuals entropy-coded
-// (page_parts.hpp, residual_coder.hpp); 7: the multi-parallelogram position prediction (predictive_node.hpp,
-// multi_parallelogram.hpp), 9-bit normals' frame scale 0.49 (predicted_normals.cpp), pages store the
-// connectivity's references apart from its symbols and the traversal symbols entropy-coded with context
-// (page_parts.hpp, symbol_coder.hpp).
+// (page_parts.hpp, residual_coder.hpp); 7: 9-bit normals' frame scale 0.49 (predicted_normals.cpp), pages
+// store the connectivity's references apart from its symbols and the traversal symbols entropy-coded with
+// context (page_parts.hpp, symbol_coder.hpp).
 inline constexpr uint32_t kFormatVersion = 7;
 inline constexpr size_t kHeaderSize = 64;
 

@@ -6,7 +6,6 @@
 #include "core/error.hpp"
 #include "package/byte_planes.hpp"
 #include "package/bytes.hpp"
-#include "package/multi_parallelogram.hpp"
 #include "package/predicted_normals.hpp"
 #include "package/vertex_attributes.hpp"
 
@@ -46,28 +45,6 @@ bool predict_positions(const int64_t* residual, uint32_t V, const uint32_t* o, u
   return shifted >= 2 * uint64_t(kMaxCoarse);
 }
 
-// c[v] = multi_parallelogram(v's parallelograms) + residual[v] for v < V, or, for a vertex that closes no
-// triangle, the damped parallelogram (j = 3) of its predictors; otherwise as predict_positions.
-bool predict_multi(const int64_t* residual, uint32_t V, const uint32_t* o, const Parallelograms& p,
-                   uint64_t* c) {
-  const int64_t *rx = residual, *ry = rx + V, *rz = ry + V;
-  uint64_t shifted = 0;
-  for (uint32_t v = 0; v < V; ++v, o += 3) {
-    uint64_t* to = c + 3 * size_t(v);
-    const uint32_t count = p.count[v];
-    if (count == 0) {
-      const uint64_t *x = c + 3 * size_t(o[0]), *y = c + 3 * size_t(o[1]), *z = c + 3 * size_t(o[2]);
-      for (int a = 0; a < 3; ++a) to[a] = damped_parallelogram(x[a], y[a], z[a], 3);
-    } else {
-      multi_parallelogram(c, &p.corners[3 * kMaxParallelograms * size_t(v)], count, to);
-    }
-    to[0] += uint64_t(rx[v]), to[1] += uint64_t(ry[v]), to[2] += uint64_t(rz[v]);
-    shifted |=
-        (to[0] + uint64_t(kMaxCoarse)) | (to[1] + uint64_t(kMaxCoarse)) | (to[2] + uint64_t(kMaxCoarse));
-  }
-  return shifted >= 2 * uint64_t(kMaxCoarse);
-}
-
 // Bits of a zigzagged residual (0 for 0): the encoder's estimate of what a damping costs.
 inline uint32_t residual_bits(uint64_t z) {
   return z ? 64 - uint32_t(__builtin_clzll(z)) : 0;
@@ -85,9 +62,8 @@ PredictiveNode read_layout(ByteReader& r, size_t node_size, uint8_t format, uint
   static_cast<NodeHeader&>(p) = NodeHeader::read(r, format, known_flags, node_size);
   const uint8_t widths = r.u8();
   p.position_bytes = widths & 7, p.smooth_normals = (widths >> 3) & 1;
-  p.normal_bytes = (widths >> 4) & 3, p.multi = (widths >> 6) == 3;
-  p.damping = p.multi ? 3 : 4 - (widths >> 6);
-  if (p.position_bytes < 1 || p.position_bytes > kMaxPositionBytes ||
+  p.normal_bytes = (widths >> 4) & 3, p.damping = 4 - (widths >> 6);
+  if (p.position_bytes < 1 || p.position_bytes > kMaxPositionBytes || p.damping < 2 ||
       (p.normal_bytes == 0) != !(p.flags & kHasNormals) || (p.smooth_normals && p.normal_bytes == 0))
     r.fail("invalid residual widths");
   const uint64_t attribute_size = r.varint(), locked_size = r.varint(), connectivity_size = r.varint();
@@ -143,33 +119,23 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
   PredictiveResiduals r;
   std::vector<int64_t> c(n.c);
   c.insert(c.end(), std::begin(n.cmin), std::end(n.cmin));
-  const uint64_t* cu = reinterpret_cast<const uint64_t*>(c.data());
-  thread_local Parallelograms parallelograms;
-  find_parallelograms(indices, g.first_vertex, uint32_t(V), parallelograms);
-  // The predictor whose residuals take the fewest bits (ties: the larger j, then the single parallelogram).
+  // The damping j whose residuals take the fewest bits (ties: the larger j).
   uint64_t fewest = UINT64_MAX;
   std::vector<uint64_t> residuals(3 * V);
-  for (uint32_t j = 4; j >= 1; --j) {
-    const bool multi = j == 1;  // the multi-parallelogram
+  for (uint32_t j = 4; j >= 2; --j) {
     uint64_t bits = 0, largest = 0;
     for (size_t v = 0; v < V; ++v) {
       const uint32_t* o = &predictors[3 * v];
-      const uint32_t count = parallelograms.count[v];
-      uint64_t mean[3] = {0, 0, 0};
-      if (multi && count)
-        multi_parallelogram(cu, &parallelograms.corners[3 * kMaxParallelograms * v], count, mean);
       for (int a = 0; a < 3; ++a) {
         const int64_t predicted =
-            multi && count ? int64_t(mean[a])
-                           : int64_t(damped_parallelogram(cu[3 * size_t(o[0]) + a], cu[3 * size_t(o[1]) + a],
-                                                          cu[3 * size_t(o[2]) + a], multi ? 3 : j));
+            int64_t(damped_parallelogram(uint64_t(c[3 * size_t(o[0]) + a]), uint64_t(c[3 * size_t(o[1]) + a]),
+                                         uint64_t(c[3 * size_t(o[2]) + a]), j));
         residuals[3 * v + a] = zigzag(c[3 * v + a] - predicted);
         bits += residual_bits(residuals[3 * v + a]), largest = std::max(largest, residuals[3 * v + a]);
       }
     }
     if (bits < fewest)
-      fewest = bits, r.damping = multi ? 3 : j, r.multi = multi, r.position_bytes = bytes_for(largest),
-      r.positions = residuals;
+      fewest = bits, r.damping = j, r.position_bytes = bytes_for(largest), r.positions = residuals;
   }
   if (g.mesh->has_normals()) {
     std::vector<glm::vec3> decoded(V + 1);  // predicted_normals reads one past the last
@@ -190,7 +156,7 @@ std::vector<uint8_t> write_predictive_node(const NodeHeader& header, const Predi
   ByteWriter w;
   header.write(w);
   w.u8(static_cast<uint8_t>(r.position_bytes | r.smooth_normals << 3 | r.normal_bytes << 4 |
-                            (r.multi ? 3 : 4 - r.damping) << 6));
+                            (4 - r.damping) << 6));
   w.varint(attribute_stream.size());
   w.varint(locked_stream.size());
   w.varint(connectivity.size());
@@ -218,10 +184,7 @@ void decode_predicted_vertices(const PredictiveNode& p, std::span<const uint32_t
   thread_local std::vector<int64_t> residual;
   residual.resize(3 * size_t(V));
   read_planes(p.position_planes.data(), V, 3, p.position_bytes, residual.data());
-  thread_local Parallelograms parallelograms;
-  if (p.multi) find_parallelograms(m.indices, p.first_vertex, V, parallelograms);
-  const bool out_of_range = p.multi ? predict_multi(residual.data(), V, predictors.data(), parallelograms, cu)
-                            : p.damping == 4 ? predict_positions<4>(residual.data(), V, predictors.data(), cu)
+  const bool out_of_range = p.damping == 4 ? predict_positions<4>(residual.data(), V, predictors.data(), cu)
                             : p.damping == 3
                                 ? predict_positions<3>(residual.data(), V, predictors.data(), cu)
                                 : predict_positions<2>(residual.data(), V, predictors.data(), cu);

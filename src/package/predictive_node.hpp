@@ -4,8 +4,7 @@
 // Bytes of a node:
 //   the common header (node_header.hpp); u8 widths (bits 0-2: bytes per position residual wp, 1..5; bit 3:
 //   the normals' prediction is smoothed (predicted_normals.hpp); bits 4-5:
-//   bytes per normal residual wn, 0..3, 0 exactly without normals; bits 6-7: the predictor: 0, 1, 2 the
-//   damping j = 4 - value below, 3 the multi-parallelogram, multi_parallelogram.hpp);
+//   bytes per normal residual wn, 0..3, 0 exactly without normals; bits 6-7: the damping j below, 4 - value);
 //   varint sizes of the attribute, locked and connectivity streams; then the position planes (3 wp V bytes),
 //   the normal planes (2 wn V bytes), the attribute stream (vertex_attributes.hpp), the locked stream
 //   (coarse_positions.hpp), the connectivity stream and the tail (the rest: each codec says what).
@@ -15,11 +14,9 @@
 //   in integers P = floor(((4 + j)(c[o1] + c[o2]) - 2j c[o] + 4) / 8), j in {4, 3, 2} chosen per node by the
 //   encoder (j = 4 is the plain parallelogram c[o1] + c[o2] - c[o]; the simplified meshes of coarse levels
 //   are irregular and predict better with j = 3 or 2: measured on elephant_1m, levels 1-10 store 3-5 % fewer
-//   position bits), or the multi-parallelogram (multi_parallelogram.hpp, damped with j = 3), the mean of the
-//   parallelograms that v closes (elephant_1m level 1-2 positions 1.20 / 1.39 -> 1.16 / 1.35 B/tri).
-//   Predictors o1, o2, o lie below v; the codec derives them from the
-//   connectivity; a single predictor x is (x, x, x) (P = x for every j), and index V stands for cmin (no
-//   predictor). The residuals are zigzag-mapped, byte b of axis a at plane 3b + a (byte_planes.hpp).
+//   position bits). Predictors o1, o2, o lie below v; the codec derives them from the connectivity; a single
+//   predictor x is (x, x, x) (P = x for every j), and index V stands for cmin (no predictor). The residuals
+//   are zigzag-mapped, byte b of axis a at plane 3b + a (byte_planes.hpp).
 // Normals: predicted from the decoded positions, plain or smoothed (predicted_normals.hpp).
 #pragma once
 
@@ -36,7 +33,6 @@ namespace lodstream::package {
 struct PredictiveNode : NodeHeader {
   uint32_t position_bytes = 0, normal_bytes = 0;
   uint32_t damping = 4;  // j of the position prediction
-  bool multi = false;    // the multi-parallelogram prediction (damping 3)
   bool smooth_normals = false;
   size_t header_size = 0;
   std::span<const uint8_t> position_planes, normal_planes, attribute_stream, locked_stream, connectivity,
@@ -53,15 +49,13 @@ struct PredictiveNode : NodeHeader {
 };
 
 // The encoder's side. Residuals of the quantized node's coarse coordinates against `predictors` (3 per
-// vertex, as above) or the multi-parallelogram over `indices`, whichever takes the fewest bits, and the
-// normals' against the prediction from the decoded positions over `indices` (the
+// vertex, as above), and the normals' against the prediction from the decoded positions over `indices` (the
 // triangles as the decoder will see them, numbered from first_vertex; `locked_stream` the node's,
-// encode_locked_stream); then the node's bytes. Cost: O(T + V) (find_parallelograms' valence walks).
+// encode_locked_stream); then the node's bytes. Cost: O(T + V).
 struct PredictiveResiduals {
   std::vector<uint64_t> positions, normals;
   uint32_t position_bytes = 0, normal_bytes = 0;
   uint32_t damping = 4;  // j
-  bool multi = false;    // the multi-parallelogram prediction
   bool smooth_normals = false;
 };
 PredictiveResiduals predictive_residuals(const NodeGeometry& geometry, const QuantizedNode& node,
@@ -77,7 +71,7 @@ std::vector<uint8_t> write_predictive_node(const NodeHeader& header, const Predi
 // The decoder's side: out.mesh.positions and (with normals) out.mesh.normals, UVs, colours and vertex_data of
 // a parsed node whose out.mesh.indices are decoded, from `predictors` (3V entries or more; any values: they
 // index entries below V + 1 only). Throws lodstream::Error starting with `where` on positions off the grid's
-// range. Cost: O(T + V), plus find_parallelograms for a multi-parallelogram node.
+// range. Cost: O(T + V).
 void decode_predicted_vertices(const PredictiveNode& node, std::span<const uint32_t> predictors,
                                const PositionGrid& grid, DecodedNode& out, const std::string& where);
 
