@@ -37,10 +37,10 @@
 // runs zstd finds.
 //
 // On a manifold patch about half the symbols are kVertex and most others kLeft / kRight / kBoundary (border
-// edges), so zstd's entropy stage takes them to about 2 bits per triangle; a page codes them with the previous
-// symbol as context (symbol_coder.hpp), and stores the references apart (page_parts.hpp). Levels >= 1 cost
-// about twice level 0's bits per triangle (elephant_1m, format 6: 0.44-0.50 against 0.25 B/tri after zstd):
-// 1.25-1.45 symbols a triangle against 1.11 (kBoundary 0.25-0.45 against 0.11: the borders of smaller,
+// edges), so zstd's entropy stage takes them to about 2 bits per triangle; a page codes them with the
+// previous symbol as context (symbol_coder.hpp), and stores the references apart (page_parts.hpp). Levels >=
+// 1 cost about twice level 0's bits per triangle (elephant_1m, format 6: 0.44-0.50 against 0.25 B/tri after
+// zstd): 1.25-1.45 symbols a triangle against 1.11 (kBoundary 0.25-0.45 against 0.11: the borders of smaller,
 // irregular clusters), kSplit 0.05 against 0.001, and kLeft and kRight about even where level 0 turns right
 // (0.43 kRight, 0.01 kLeft: less predictable). Decode: O(T), no search, no hash.
 #pragma once
