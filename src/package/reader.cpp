@@ -162,7 +162,11 @@ std::span<const uint8_t> PackageReader::node_bytes(uint32_t id, std::span<const 
 
 DecodedNode PackageReader::decode_node(uint32_t id, std::span<const uint8_t> page) {
   const NodeRecord& n = node(id);
-  const std::string what = where("node " + std::to_string(id) + " (page " + std::to_string(n.page) + ")");
+  // The error context, built in a buffer kept across calls: a string built anew took three allocations a
+  // node.
+  std::string& what = node_context_;
+  what.assign(source_->name()).append(": node ").append(std::to_string(id));
+  what.append(" (page ").append(std::to_string(n.page)).append(")");
   if (n.encoding != NodeEncoding::codec) throw Error(what + ": holds raw bytes, not codec geometry");
   std::span<const uint8_t> bytes = node_bytes(id, page);
   const Representation& rep = root_.scene.representations[n.representation];

@@ -84,7 +84,8 @@ class PackageReader {
     uint32_t page = 0, offset = 0, size = 0;
     DecodedNode decoded;
   };
-  LastRecord last_record_;  // decode_node's last record of several clusters
+  LastRecord last_record_;    // decode_node's last record of several clusters
+  std::string node_context_;  // decode_node's error context ("FILE: node N (page P)"), reused
 };
 
 }  // namespace lodstream::package
