@@ -5,8 +5,6 @@
 // benchmark (bench/bench_package) times level-0 meshlets of one mesh, this times a real package's every
 // level, whose coarse nodes may choose other predictors. A page's time is shared among its nodes' levels by
 // their bytes. Thread CPU time rather than wall: steadier on a loaded machine, and one core by construction.
-#include <time.h>
-
 #include <chrono>
 #include <cstdio>
 #include <map>
@@ -25,12 +23,6 @@ struct BenchArgs {
   int runs = 5;
   bool json = false;
 };
-
-double thread_cpu_s() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return double(t.tv_sec) + double(t.tv_nsec) * 1e-9;
-}
 
 struct LevelTimes {
   uint64_t nodes = 0, triangles = 0;
