@@ -6,11 +6,39 @@
 
 #include <algorithm>
 #include <cfloat>
+#include <span>
+#include <utility>
 
 #include "core/counting_sort.hpp"
 #include "core/morton.hpp"
 
 namespace lodstream::hierarchy {
+
+namespace {
+
+// Sorts a run of (code << 32 | triangle) keys whose codes share their top 10 bits and whose triangles
+// increase (as counting_sort deals them): two stable counting passes by the code's bits 0-9, then 10-19,
+// give the order of a sort by (code, triangle) in O(n + 1024) instead of O(n log n); runs under 256 keys,
+// where the 1024-entry counts cost more, are sorted plainly (the keys are distinct: the same order).
+// `scratch` is resized to the run.
+void sort_run(std::span<uint64_t> keys, std::vector<uint64_t>& scratch) {
+  if (keys.size() < 256) {
+    std::sort(keys.begin(), keys.end());
+    return;
+  }
+  scratch.resize(keys.size());
+  std::span<uint64_t> from = keys, to = scratch;
+  for (int shift : {32, 42}) {
+    uint32_t start[1024] = {};
+    for (uint64_t k : from) ++start[k >> shift & 1023];
+    uint32_t position = 0;
+    for (uint32_t& s : start) position += std::exchange(s, position);
+    for (uint64_t k : from) to[start[k >> shift & 1023]++] = k;
+    std::swap(from, to);
+  }
+}
+
+}  // namespace
 
 std::vector<uint32_t> spatial_sort_triangles(std::span<const glm::vec3> positions,
                                              std::span<const uint32_t> indices) {
@@ -71,8 +99,9 @@ std::vector<uint32_t> spatial_sort_triangles(std::span<const glm::vec3> position
         [&](size_t t, uint32_t at) { order[at] = uint64_t(code[t]) << 32 | t; }, &run_begin);
     code = {};
     tbb::parallel_for(tbb::blocked_range<size_t>(0, kRuns, 8), [&](const tbb::blocked_range<size_t>& r) {
+      std::vector<uint64_t> scratch;  // freed after these runs: a run may hold most triangles
       for (size_t run = r.begin(); run < r.end(); ++run)
-        std::sort(order.begin() + run_begin[run], order.begin() + run_begin[run + 1]);
+        sort_run(std::span(order).subspan(run_begin[run], run_begin[run + 1] - run_begin[run]), scratch);
     });
   }
   auto gather = [&](size_t i) {

@@ -15,7 +15,8 @@
 namespace lodstream::hierarchy {
 
 // `indices` (three per triangle, over `positions`) with the triangles in the order above. Cost: O(T) on
-// every core (a counting sort by the code's top 10 bits, then each of the 1024 runs sorted in cache) for
+// every core (a counting sort by the code's top 10 bits, then each of the 1024 runs by two counting passes
+// over its low 20 bits in cache: elephant_1m's level 0, 66 M instructions against 138 M sorting runs) for
 // meshes of at least kParallelSortTriangles triangles, else one O(T log T) sort on the calling thread (on a
 // DAG group's few hundred triangles about 38 k instructions fewer per call than meshoptimizer's three radix
 // passes over 1024-entry histograms); 20 bytes per triangle of scratch.

@@ -44,6 +44,18 @@ TEST(SpatialSort, LargeMeshIsSortedAsMeshoptimizerSortsIt) {
   EXPECT_NE(sorted, mesh.indices);  // the input was not in that order
 }
 
+// One triangle far away makes the grid's cube 1000x the sphere, so the sphere's triangles share a few of
+// the code's top-10-bit runs: runs of thousands of triangles (sorted by counting passes) with ties.
+TEST(SpatialSort, LongRunsAreSortedAsMeshoptimizerSortsIt) {
+  Mesh mesh = shuffled_sphere_with_ties(100, 200);
+  const uint32_t far = uint32_t(mesh.positions.size());
+  mesh.positions.insert(mesh.positions.end(), {{1000, 1000, 1000}, {1001, 1000, 1000}, {1000, 1001, 1000}});
+  mesh.indices.insert(mesh.indices.end(), {far, far + 1, far + 2});
+  const std::vector<uint32_t> sorted = spatial_sort_triangles(mesh.positions, mesh.indices);
+  EXPECT_EQ(sorted, meshopt_order(mesh));
+  EXPECT_NE(sorted, mesh.indices);
+}
+
 TEST(SpatialSort, SmallMeshIsSortedAsMeshoptimizerSortsIt) {
   const Mesh mesh = shuffled_sphere_with_ties(8, 16);
   ASSERT_LT(mesh.triangle_count(), kParallelSortTriangles);
