@@ -240,28 +240,28 @@ GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
     if (stuck(r)) return out;
   }
 
-  // Position ids of the result: positions of the group's input keep theirs (locked ones never move).
-  PositionIndex local(merged.positions.size());
-  std::vector<uint32_t> local_to_id;
-  std::vector<uint8_t> local_locked;
-  for (size_t v = 0; v < merged.positions.size(); ++v) {
-    if (local.insert(merged.positions[v]) == local_to_id.size()) {
-      local_to_id.push_back(merged_ids[v]);
-      local_locked.push_back(so.locked[v]);
-    } else if (so.locked[v]) {
-      local_locked[local.find(merged.positions[v])] = 1;
-    }
-  }
+  // Position ids of the result: a position of the group's input keeps the id of its first input vertex and
+  // is locked when any input vertex there is (locked ones never move); a new position gets a new id, in
+  // result order (seam vertices share one). The result's positions are indexed (about half as many as the
+  // input's) and each input vertex is looked up there.
   const Mesh& result = r.mesh;
+  PositionIndex local(result.positions.size());
+  std::vector<uint32_t> result_local(result.positions.size());
+  for (size_t v = 0; v < result.positions.size(); ++v) result_local[v] = local.insert(result.positions[v]);
+  constexpr uint32_t kNoId = UINT32_MAX;
+  std::vector<uint32_t> local_to_id(local.size(), kNoId);
+  std::vector<uint8_t> local_locked(local.size(), 0);
+  for (size_t v = 0; v < merged.positions.size(); ++v) {
+    const uint32_t l = local.find(merged.positions[v]);
+    if (l == PositionIndex::kMissing) continue;
+    if (local_to_id[l] == kNoId) local_to_id[l] = merged_ids[v];
+    local_locked[l] |= so.locked[v];
+  }
   std::vector<uint32_t> result_ids(result.positions.size());
-  std::vector<uint8_t> result_locked(result.positions.size(), 0);
+  std::vector<uint8_t> result_locked(result.positions.size());
   for (size_t v = 0; v < result.positions.size(); ++v) {
-    // A new position (seam vertices share one) gets one new id.
-    const uint32_t l = local.insert(result.positions[v]);
-    if (l == local_to_id.size()) {
-      local_to_id.push_back(kNewId | out.new_ids++);
-      local_locked.push_back(0);
-    }
+    const uint32_t l = result_local[v];
+    if (local_to_id[l] == kNoId) local_to_id[l] = kNewId | out.new_ids++;
     result_ids[v] = local_to_id[l];
     result_locked[v] = local_locked[l];
   }
