@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "hierarchy/bounding_sphere.hpp"
 #include "hierarchy/clusterize.hpp"
+#include "hierarchy/component_removal.hpp"
 #include "hierarchy/group_partition.hpp"
 #include "hierarchy/position_index.hpp"
 #include "simplify/simplify.hpp"
@@ -237,9 +238,7 @@ GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
     so.max_normal_change_deg = 120.0f;
     r = simplify::simplify_mesh(merged, so);
     outcome = GroupOutcome::positions_only;
-    if (stuck(r)) return out;
   }
-
   // Position ids of the result: positions of the group's input keep theirs (locked ones never move).
   PositionIndex local(merged.positions.size());
   std::vector<uint32_t> local_to_id;
@@ -252,6 +251,17 @@ GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
       local_locked[local.find(merged.positions[v])] = 1;
     }
   }
+  if (stuck(r)) {  // last fallback: whole closed components dropped (component_removal.hpp)
+    std::vector<uint8_t> locked(r.mesh.positions.size());
+    for (size_t v = 0; v < locked.size(); ++v) {
+      const uint32_t l = local.find(r.mesh.positions[v]);
+      locked[v] = l != PositionIndex::kMissing && local_locked[l];
+    }
+    r.error_bound += remove_components(r.mesh, locked, so.target_triangles).bound;
+    outcome = GroupOutcome::components_dropped;
+  }
+  if (stuck(r)) return out;
+
   const Mesh& result = r.mesh;
   std::vector<uint32_t> result_ids(result.positions.size());
   std::vector<uint8_t> result_locked(result.positions.size(), 0);
