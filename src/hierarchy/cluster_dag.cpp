@@ -251,17 +251,6 @@ GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
       local_locked[local.find(merged.positions[v])] = 1;
     }
   }
-  if (stuck(r)) {  // last fallback: whole closed components dropped (component_removal.hpp)
-    std::vector<uint8_t> locked(r.mesh.positions.size());
-    for (size_t v = 0; v < locked.size(); ++v) {
-      const uint32_t l = local.find(r.mesh.positions[v]);
-      locked[v] = l != PositionIndex::kMissing && local_locked[l];
-    }
-    r.error_bound += remove_components(r.mesh, locked, so.target_triangles).bound;
-    outcome = GroupOutcome::components_dropped;
-  }
-  if (stuck(r)) return out;
-
   const Mesh& result = r.mesh;
   std::vector<uint32_t> result_ids(result.positions.size());
   std::vector<uint8_t> result_locked(result.positions.size(), 0);
@@ -275,6 +264,11 @@ GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
     result_ids[v] = local_to_id[l];
     result_locked[v] = local_locked[l];
   }
+  if (stuck(r)) {  // last fallback: whole closed components dropped (component_removal.hpp)
+    r.error_bound += remove_components(r.mesh, result_locked, so.target_triangles).bound;
+    outcome = GroupOutcome::components_dropped;
+  }
+  if (stuck(r)) return out;
 
   DagGroup& g = out.group;
   g.level = level;

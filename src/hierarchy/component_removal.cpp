@@ -31,18 +31,9 @@ double farthest_to_nearest(const Mesh& mesh, std::span<const uint32_t> from, std
   return best;
 }
 
-template <class T>
-void keep_entries(std::vector<T>& values, const std::vector<uint32_t>& remap) {
-  if (values.empty()) return;
-  for (size_t v = 0; v < remap.size(); ++v)
-    if (remap[v] != UINT32_MAX) values[remap[v]] = values[v];
-  values.resize(
-      size_t(std::count_if(remap.begin(), remap.end(), [](uint32_t r) { return r != UINT32_MAX; })));
-}
-
 }  // namespace
 
-ComponentRemoval remove_components(Mesh& mesh, std::vector<uint8_t>& locked, size_t target_triangles) {
+ComponentRemoval remove_components(Mesh& mesh, std::span<const uint8_t> locked, size_t target_triangles) {
   ComponentRemoval out;
   const size_t n = mesh.positions.size(), triangles = mesh.triangle_count();
   if (triangles <= target_triangles) return out;
@@ -101,19 +92,11 @@ ComponentRemoval remove_components(Mesh& mesh, std::vector<uint8_t>& locked, siz
     if (referenced[v] && !dropped[component[v]]) kept.push_back(v);
   for (uint32_t c = 0; c < ids; ++c)
     if (dropped[c]) out.bound = std::max(out.bound, farthest_to_nearest(mesh, vertices[c], kept));
-  // Compact: triangles of kept components, then their vertices.
   size_t w = 0;
   for (size_t t = 0; t < triangles; ++t)
     if (!dropped[component[mesh.indices[3 * t]]])
       for (int k = 0; k < 3; ++k) mesh.indices[w++] = mesh.indices[3 * t + k];
   mesh.indices.resize(w);
-  std::vector<uint32_t> remap(n, UINT32_MAX);
-  uint32_t next = 0;
-  for (uint32_t v = 0; v < n; ++v)
-    if (!dropped[component[v]]) remap[v] = next++;
-  for (uint32_t& i : mesh.indices) i = remap[i];
-  keep_entries(mesh.positions, remap), keep_entries(mesh.normals, remap), keep_entries(mesh.uvs, remap);
-  keep_entries(mesh.colors, remap), keep_entries(locked, remap);
   return out;
 }
 

@@ -15,7 +15,7 @@
 #pragma once
 
 #include <cstdint>
-#include <vector>
+#include <span>
 
 #include "core/mesh.hpp"
 
@@ -26,10 +26,10 @@ struct ComponentRemoval {
   double bound = 0.0;  // max e_C over the dropped components, model units (0 when none)
 };
 
-// Drops unlocked components of `mesh` (locked: one flag per vertex) nearest-first until it has at most
-// `target_triangles` triangles or none is left to drop; the vertices they leave unreferenced are removed
-// (attributes and `locked` compacted in place). Cost: O(T + V) for the components plus O(V_dropped x V_kept)
-// distances (a group holds about a thousand vertices).
-ComponentRemoval remove_components(Mesh& mesh, std::vector<uint8_t>& locked, size_t target_triangles);
+// Drops the triangles of unlocked components of `mesh` (locked: one flag per vertex) nearest-first until it
+// has at most `target_triangles` triangles or none is left to drop; vertices stay (per-vertex data of the
+// caller keeps its numbering), those of dropped components unreferenced. Cost: O(T + V) for the components
+// plus O(V_dropped x V_kept) distances (a group holds about a thousand vertices).
+ComponentRemoval remove_components(Mesh& mesh, std::span<const uint8_t> locked, size_t target_triangles);
 
 }  // namespace lodstream::hierarchy
