@@ -479,7 +479,7 @@ int run_bake(const BakeArgs& args) {
   }
   if (hlod_top > 0) page_group_ends.push_back(order.size());
   uint32_t levels = hlod.levels;
-  size_t abandoned = 0, partial = 0, positions_only = 0, stalled = 0;
+  size_t abandoned = 0, partial = 0, positions_only = 0, dropped_components = 0, stalled = 0;
   for (uint32_t m = 0; m < dags.size(); ++m) {
     const hierarchy::ClusterDag& dag = dags[m];
     if (!pms[m].steps.empty()) {  // a progressive mesh: step 0 is its root
@@ -518,6 +518,7 @@ int run_bake(const BakeArgs& args) {
     for (const hierarchy::DagGroup& g : dag.groups) {
       partial += g.outcome == hierarchy::GroupOutcome::partial;
       positions_only += g.outcome == hierarchy::GroupOutcome::positions_only;
+      dropped_components += g.outcome == hierarchy::GroupOutcome::components_dropped;
     }
   }
   const uint32_t hlod_representation = uint32_t(ps.representations.size());
@@ -762,6 +763,7 @@ int run_bake(const BakeArgs& args) {
                 {"fallbacks",
                  {{"partial", partial},
                   {"positions_only", positions_only},
+                  {"dropped_components", dropped_components},
                   {"abandoned", abandoned},
                   {"stalled_meshes", stalled}}},
                 {"time_s", time_s},
@@ -784,8 +786,11 @@ int run_bake(const BakeArgs& args) {
     if (progressive)
       std::printf("  %zu of %zu meshes are progressive meshes (at most %u triangles)\n", progressive,
                   pms.size(), args.pm_max_triangles);
-    std::printf("  fallbacks: %zu partial, %zu positions-only, %zu abandoned groups, %zu stalled meshes\n",
-                partial, positions_only, abandoned, stalled);
+    std::printf(
+        "  fallbacks: %zu partial, %zu positions-only, %zu dropped components, %zu abandoned groups, %zu "
+        "stalled "
+        "meshes\n",
+        partial, positions_only, dropped_components, abandoned, stalled);
     if (!hlod.nodes.empty())
       std::printf("  hlod: %zu proxies (%zu triangles), %u levels, %.2f s\n", hlod.nodes.size(),
                   hlod_triangles, hlod.levels, hlod_time);

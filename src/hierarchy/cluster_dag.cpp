@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "hierarchy/bounding_sphere.hpp"
 #include "hierarchy/clusterize.hpp"
+#include "hierarchy/component_removal.hpp"
 #include "hierarchy/group_partition.hpp"
 #include "hierarchy/position_index.hpp"
 #include "simplify/simplify.hpp"
@@ -237,7 +238,6 @@ GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
     so.max_normal_change_deg = 120.0f;
     r = simplify::simplify_mesh(merged, so);
     outcome = GroupOutcome::positions_only;
-    if (stuck(r)) return out;
   }
 
   // Position ids of the result: a position of the group's input keeps the id of its first input vertex and
@@ -265,6 +265,11 @@ GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
     result_ids[v] = local_to_id[l];
     result_locked[v] = local_locked[l];
   }
+  if (stuck(r)) {  // last fallback: whole closed components dropped (component_removal.hpp)
+    r.error_bound += remove_components(r.mesh, result_locked, so.target_triangles).bound;
+    outcome = GroupOutcome::components_dropped;
+  }
+  if (stuck(r)) return out;
 
   DagGroup& g = out.group;
   g.level = level;

@@ -9,8 +9,10 @@
 //   until the active clusters hold at most `root_triangles` triangles (or one cluster), or no group of a
 //   level can be reduced.
 // Fallbacks (recorded per group, like meshoptimizer's clusterlod): a group that does not reach 85 % of its
-// triangles with attributes is retried positions-only with a looser normal limit; a group still above 85 %
-// is abandoned and its clusters stay active for the next level (with other neighbours); the build always
+// triangles with attributes is retried positions-only with a looser normal limit, then whole closed
+// components without a locked vertex are dropped from its result, nearest first (component_removal.hpp: a
+// soup of small closed parts that edge collapse cannot reduce); a group still above 85 % is abandoned and
+// its clusters stay active for the next level (with other neighbours); the build always
 // terminates because every accepted group removes triangles, and a level where none is accepted ends it.
 //
 // Errors (totals, object units): a level-0 cluster has error 0; the clusters made by group g all share
@@ -60,7 +62,7 @@ struct DagOptions {
   size_t max_cluster_vertices = 128;   // at most 255
   size_t group_clusters = 8;           // target clusters per group
   double group_ratio = 0.45;           // target triangles after simplifying a group, as a fraction
-  double stuck_ratio = 0.85;           // a group above this fraction after the fallback is abandoned
+  double stuck_ratio = 0.85;           // a group above this fraction after the fallbacks is abandoned
   size_t root_triangles = 256;         // stop when the active clusters hold at most this many
   uint32_t max_levels = 48;
   // Lock the mesh's open boundary at every level: its outline stays exact, which makes "the cut's boundary
@@ -96,9 +98,10 @@ struct DagCluster {
 };
 
 enum class GroupOutcome : uint8_t {
-  halved,          // reached the target with attributes
-  partial,         // accepted with less reduction than the target (under stuck_ratio)
-  positions_only,  // accepted only by the positions-only fallback
+  halved,              // reached the target with attributes
+  partial,             // accepted with less reduction than the target (under stuck_ratio)
+  positions_only,      // accepted only by the positions-only fallback
+  components_dropped,  // accepted only after dropping whole closed components (component_removal.hpp)
 };
 
 struct DagGroup {

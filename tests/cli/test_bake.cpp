@@ -58,6 +58,9 @@ TEST(CliBake, ElephantBuildsAVerifiedHierarchy) {
     wall += j["phases"][phase]["wall_s"].get<double>();
   }
   EXPECT_NEAR(wall, j["time_s"].get<double>(), 0.01);
+  for (const char* fallback :
+       {"partial", "positions_only", "dropped_components", "abandoned", "stalled_meshes"})
+    EXPECT_TRUE(j["fallbacks"].contains(fallback)) << fallback;
 }
 
 TEST(CliBake, EveryNodeCodecVerifiesAndEachIsSmallerThanTheLast) {

@@ -183,9 +183,9 @@ TEST(ClusterDag, SeamsSurviveAndStayCrackFree) {
   for (const DagCluster& c : dag.clusters) EXPECT_EQ(c.mesh.uvs.size(), c.mesh.positions.size());
 }
 
-TEST(ClusterDag, ErrorBoundHoldsAgainstBruteForceDistance) {
-  const Mesh mesh = test::sphere(1.0f, 24, 48);
-  const ClusterDag dag = build_cluster_dag(mesh);
+// Both sides of every cluster's error bound: coarse clusters to the full-resolution surface, and that surface
+// to the coarsest cut.
+void check_error_bound(const Mesh& mesh, const ClusterDag& dag) {
   ASSERT_GE(dag.groups.size(), 2u);
   const std::vector<const Mesh*> full = {&mesh};
   // One-sided from every coarse cluster to the full-resolution surface.
@@ -202,6 +202,11 @@ TEST(ClusterDag, ErrorBoundHoldsAgainstBruteForceDistance) {
   EXPECT_GT(root_error, 0.0f);
   for (const glm::dvec3& p : samples(mesh))
     EXPECT_LE(distance_to(p, roots), double(root_error) * 1.0001 + 1e-6);
+}
+
+TEST(ClusterDag, ErrorBoundHoldsAgainstBruteForceDistance) {
+  const Mesh mesh = test::sphere(1.0f, 24, 48);
+  check_error_bound(mesh, build_cluster_dag(mesh));
 }
 
 // `count` separate tetrahedra scattered in a box: many tiny closed components.
@@ -280,6 +285,15 @@ TEST(ClusterDag, TerminatesOnNonManifoldAndManyTinyComponents) {
   const ClusterDag dag = build_cluster_dag(soup);
   check_invariants(dag);
   check_cuts(dag, soup, 20);
+  // Edge collapse cannot reduce a closed tetrahedron: groups of them fall back to dropping whole
+  // tetrahedra, so the build reaches a small root instead of stalling with 2400 root triangles.
+  EXPECT_FALSE(dag.stalled);
+  size_t root_triangles = 0;
+  for (uint32_t r : dag.roots) root_triangles += dag.clusters[r].mesh.triangle_count();
+  EXPECT_LE(root_triangles, 512u);
+  EXPECT_TRUE(std::any_of(dag.groups.begin(), dag.groups.end(),
+                          [](const DagGroup& g) { return g.outcome == GroupOutcome::components_dropped; }));
+  check_error_bound(soup, dag);
 
   const Mesh odd = test::non_manifold();
   const ClusterDag small = build_cluster_dag(odd);
