@@ -126,46 +126,45 @@ std::vector<uint8_t> zstd_compress_parts(std::span<const std::span<const uint8_t
   return out;
 }
 
-namespace {
-
-// The content size a zstd frame declares; throws unless it declares one.
-unsigned long long declared_size(std::span<const uint8_t> frame, const std::string& context) {
-  unsigned long long declared = ZSTD_getFrameContentSize(frame.data(), frame.size());
+uint64_t zstd_declared_size(std::span<const uint8_t> frame, uint64_t max_size, const std::string& context) {
+  const unsigned long long declared = ZSTD_getFrameContentSize(frame.data(), frame.size());
   if (declared == ZSTD_CONTENTSIZE_ERROR || declared == ZSTD_CONTENTSIZE_UNKNOWN) {
     throw Error(context + ": not a valid zstd frame");
   }
-  return declared;
-}
-
-std::vector<uint8_t> decompress_declared(std::span<const uint8_t> frame, size_t declared,
-                                         const std::string& context) {
-  std::vector<uint8_t> out(declared);
-  size_t n = ZSTD_decompress(out.data(), out.size(), frame.data(), frame.size());
-  if (ZSTD_isError(n)) throw Error(context + ": zstd: " + ZSTD_getErrorName(n));
-  if (n != declared) throw Error(context + ": zstd frame decompressed to a different size");
-  return out;
-}
-
-}  // namespace
-
-std::vector<uint8_t> zstd_decompress(std::span<const uint8_t> frame, uint32_t raw_size,
-                                     const std::string& context) {
-  const unsigned long long declared = declared_size(frame, context);
-  if (declared != raw_size) {
-    throw Error(context + ": zstd frame holds " + std::to_string(declared) + " bytes, the index says " +
-                std::to_string(raw_size));
-  }
-  return decompress_declared(frame, raw_size, context);
-}
-
-std::vector<uint8_t> zstd_decompress_at_most(std::span<const uint8_t> frame, uint64_t max_size,
-                                             const std::string& context) {
-  const unsigned long long declared = declared_size(frame, context);
   if (declared > max_size) {
     throw Error(context + ": zstd frame holds " + std::to_string(declared) + " bytes, more than " +
                 std::to_string(max_size) + " possible");
   }
-  return decompress_declared(frame, size_t(declared), context);
+  return declared;
+}
+
+void zstd_decompress_to(std::span<const uint8_t> frame, std::span<uint8_t> out, const std::string& context) {
+  // One context per thread: ZSTD_decompress created and freed one (about 160 KB, allocated and set up) for
+  // every frame.
+  thread_local std::unique_ptr<ZSTD_DCtx, size_t (*)(ZSTD_DCtx*)> dctx(ZSTD_createDCtx(), ZSTD_freeDCtx);
+  if (!dctx) throw Error("out of memory creating a zstd context");
+  const size_t n = ZSTD_decompressDCtx(dctx.get(), out.data(), out.size(), frame.data(), frame.size());
+  if (ZSTD_isError(n)) throw Error(context + ": zstd: " + ZSTD_getErrorName(n));
+  if (n != out.size()) throw Error(context + ": zstd frame decompressed to a different size");
+}
+
+std::vector<uint8_t> zstd_decompress(std::span<const uint8_t> frame, uint32_t raw_size,
+                                     const std::string& context) {
+  const uint64_t declared = zstd_declared_size(frame, UINT64_MAX, context);
+  if (declared != raw_size) {
+    throw Error(context + ": zstd frame holds " + std::to_string(declared) + " bytes, the index says " +
+                std::to_string(raw_size));
+  }
+  std::vector<uint8_t> out(raw_size);
+  zstd_decompress_to(frame, out, context);
+  return out;
+}
+
+std::vector<uint8_t> zstd_decompress_at_most(std::span<const uint8_t> frame, uint64_t max_size,
+                                             const std::string& context) {
+  std::vector<uint8_t> out(zstd_declared_size(frame, max_size, context));
+  zstd_decompress_to(frame, out, context);
+  return out;
 }
 
 }  // namespace lodstream::package

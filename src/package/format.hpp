@@ -92,5 +92,12 @@ std::vector<uint8_t> zstd_decompress(std::span<const uint8_t> frame, uint32_t ra
 // Decompresses one zstd frame that declares at most `max_size` bytes (checked before allocating).
 std::vector<uint8_t> zstd_decompress_at_most(std::span<const uint8_t> frame, uint64_t max_size,
                                              const std::string& context);
+// The content size that a zstd frame declares; throws unless it declares one of at most `max_size` bytes.
+// Cost: O(1) (the frame header).
+uint64_t zstd_declared_size(std::span<const uint8_t> frame, uint64_t max_size, const std::string& context);
+// Decompresses one zstd frame into `out`, which must be its declared size (zstd_declared_size), with one
+// zstd context per thread (created once); throws on a corrupted frame. Lets a caller decompress into a
+// buffer it keeps. Cost: the decompression.
+void zstd_decompress_to(std::span<const uint8_t> frame, std::span<uint8_t> out, const std::string& context);
 
 }  // namespace lodstream::package

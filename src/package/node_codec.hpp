@@ -138,6 +138,13 @@ class NodeCodec {
   // bytes.size() + 65536 vertices. Thread-safe.
   virtual DecodedNode decode(std::span<const uint8_t> bytes, const PositionGrid& grid,
                              const std::string& where) const = 0;
+  // decode() into `out`, every field of which it overwrites, reusing out's buffers: a caller that decodes
+  // many nodes into one DecodedNode allocates them once, and clears only what outgrows them. This default
+  // moves decode()'s result in. Thread-safe as decode.
+  virtual void decode_into(std::span<const uint8_t> bytes, const PositionGrid& grid, const std::string& where,
+                           DecodedNode& out) const {
+    out = decode(bytes, grid, where);
+  }
   // Where the bytes of an encoded node of `node_size` bytes go, from its first bytes (`bytes` holds at least
   // its header and may end before or run past the node's end: only the header is read). Lets a page stored
   // by part (page_parts.hpp) find each node's parts from the headers alone. Throws like decode, also when the

@@ -149,8 +149,17 @@ std::vector<uint8_t> compress_page(std::span<const uint8_t> page, std::span<cons
 
 std::vector<uint8_t> decompress_page(std::span<const uint8_t> stored, uint32_t raw_size,
                                      const NodeCodec& codec, const std::string& where) {
-  std::vector<uint8_t> content = zstd_decompress_at_most(stored, 2 * uint64_t(raw_size) + 64, where);
-  if (content.size() == raw_size) return content;  // stored whole
+  const uint64_t declared = zstd_declared_size(stored, 2 * uint64_t(raw_size) + 64, where);
+  if (declared == raw_size) {  // stored whole
+    std::vector<uint8_t> page(raw_size);
+    zstd_decompress_to(stored, page, where);
+    return page;
+  }
+  // The regrouped bytes, in a buffer kept across pages: allocated (and cleared) once, not per page.
+  thread_local std::vector<uint8_t> buffer;
+  if (buffer.size() < declared) buffer.resize(declared);
+  const std::span<const uint8_t> content(buffer.data(), declared);
+  zstd_decompress_to(stored, std::span(buffer).first(declared), where);
   ByteReader r(content, where);
   std::array<std::span<const uint8_t>, kParts> stream;
   std::array<uint64_t, kParts> size;

@@ -76,7 +76,8 @@ std::vector<uint8_t> compress_page(std::span<const uint8_t> page, std::span<cons
 
 // The page of whole nodes (raw_size bytes) from its stored frame, either form. Every size is checked: a
 // corrupted or hostile page gives a lodstream::Error starting with `where`, never a crash or an allocation
-// above 2 raw_size + 64 bytes. Cost: a zstd decompression, plus a copy of the page when stored by part.
+// above 2 raw_size + 64 bytes. Cost: a zstd decompression, plus a copy of the page when stored by part (the
+// regrouped bytes decompressed into a per-thread buffer kept at the largest size seen).
 std::vector<uint8_t> decompress_page(std::span<const uint8_t> stored, uint32_t raw_size,
                                      const NodeCodec& codec, const std::string& where);
 

@@ -170,23 +170,16 @@ DecodedNode PackageReader::decode_node(uint32_t id, std::span<const uint8_t> pag
   if (n.encoding != NodeEncoding::codec) throw Error(what + ": holds raw bytes, not codec geometry");
   std::span<const uint8_t> bytes = node_bytes(id, page);
   const Representation& rep = root_.scene.representations[n.representation];
-  DecodedNode decoded;
-  const bool cached = last_record_.valid && last_record_.page == n.page && last_record_.offset == n.offset &&
-                      last_record_.size == n.size;
-  if (cached) {
-    decoded = extract_cluster(last_record_.decoded, n.cluster, what);
-  } else {
-    DecodedNode record = codec_->decode(bytes, rep.grid, what);
-    if (record_clusters(record) == 1) {
-      if (n.cluster != 0) extract_cluster(record, n.cluster, what);  // throws: out of range
-      decoded = std::move(record);
-    } else {
-      // A record of several clusters: its clusters are usually decoded one after another (consecutive ids of
-      // one page group), so it is kept until another record is decoded.
-      decoded = extract_cluster(record, n.cluster, what);
-      last_record_ = {true, n.page, n.offset, n.size, std::move(record)};
-    }
+  // The last record decoded is kept (in buffers reused by the next: no allocation or clearing per record),
+  // so that a record's clusters, usually decoded one after another (consecutive ids of one page group),
+  // decode it once.
+  LastRecord& last = last_record_;
+  if (!(last.valid && last.page == n.page && last.offset == n.offset && last.size == n.size)) {
+    last.valid = false;  // until decoded: a corrupted record leaves none
+    codec_->decode_into(bytes, rep.grid, what, last.decoded);
+    last.valid = true, last.page = n.page, last.offset = n.offset, last.size = n.size;
   }
+  DecodedNode decoded = extract_cluster(last.decoded, n.cluster, what);
   if (decoded.mesh.triangle_count() != n.triangles || decoded.mesh.vertex_count() != n.vertices) {
     throw Error(what + ": record says " + std::to_string(n.triangles) + " triangles / " +
                 std::to_string(n.vertices) + " vertices, its bytes hold " +

@@ -50,8 +50,9 @@ class PackageReader {
   std::span<const uint8_t> node_bytes(uint32_t id, std::span<const uint8_t> page);
   // Decodes codec node `id` from its decompressed page and checks the result against the node's record
   // (counts, and every index within the representation's vertices). A node that is one cluster of a record
-  // (NodeRecord::cluster) gets that cluster alone (records.hpp); the last record of several clusters
-  // decoded is kept, so decoding its clusters one after another (consecutive ids) decodes it once.
+  // (NodeRecord::cluster) gets that cluster alone (records.hpp); the last record decoded is kept (its
+  // buffers reused by the next), so decoding its clusters one after another (consecutive ids) decodes it
+  // once.
   DecodedNode decode_node(uint32_t id, std::span<const uint8_t> page);
   // read_page + decode_node.
   DecodedNode load_node(uint32_t id);
@@ -84,7 +85,7 @@ class PackageReader {
     uint32_t page = 0, offset = 0, size = 0;
     DecodedNode decoded;
   };
-  LastRecord last_record_;    // decode_node's last record of several clusters
+  LastRecord last_record_;    // decode_node's last record
   std::string node_context_;  // decode_node's error context ("FILE: node N (page P)"), reused
 };
 

@@ -94,9 +94,14 @@ DecodedNode extract_cluster(const DecodedNode& record, uint32_t cluster, const s
   uint32_t* const map = compact.data();
   uint32_t* const first_use = used.data();
   uint32_t n = 0;
+  // Without a branch (which mispredicted at about every first use, a fifth of the corners): first_use[n] is
+  // written every time and kept only when v is new.
   for (uint32_t& v : m.indices) {
-    uint32_t c = map[v];
-    if (c == UINT32_MAX) c = map[v] = n, first_use[n++] = v;
+    const uint32_t seen = map[v];
+    const bool fresh = seen == UINT32_MAX;
+    first_use[n] = v;
+    const uint32_t c = fresh ? n : seen;
+    map[v] = c, n += fresh;
     v = c;
   }
   for (uint32_t k = 0; k < n; ++k) map[first_use[k]] = UINT32_MAX;  // before anything may throw

@@ -52,19 +52,30 @@ std::vector<uint8_t> TraversalCodec::encode(const NodeGeometry& g, const Positio
 
 DecodedNode TraversalCodec::decode(std::span<const uint8_t> bytes, const PositionGrid& grid,
                                    const std::string& where) const {
-  if (!bytes.empty() && bytes[0] == kOrderedFormat) return ordered_codec().decode(bytes, grid, where);
+  DecodedNode out;
+  decode_into(bytes, grid, where, out);
+  return out;
+}
+
+void TraversalCodec::decode_into(std::span<const uint8_t> bytes, const PositionGrid& grid,
+                                 const std::string& where, DecodedNode& out) const {
+  if (!bytes.empty() && bytes[0] == kOrderedFormat) {
+    out = ordered_codec().decode(bytes, grid, where);
+    return;
+  }
   const PredictiveNode p = PredictiveNode::parse(bytes, kFormat, kAllFlags, where);
   const uint32_t V = p.vertices;
-  DecodedNode out;
-  out.index_end = V;
-  out.mesh.indices.resize(3 * size_t(p.triangles));
+  // What the node may not hold cleared (capacity kept); the rest overwritten.
+  out.mesh.normals.clear(), out.mesh.uvs.clear(), out.mesh.colors.clear(), out.mesh.material = 0;
+  out.vertex_data.clear(), out.extra.clear();
+  out.first_vertex = 0, out.index_end = V;
+  out.mesh.indices.resize(3 * size_t(p.triangles));  // zero-fills only beyond the size it had
   thread_local std::vector<uint32_t> predictors;
   predictors.resize(3 * (size_t(V) + 1));
   decode_traversal(p.connectivity, p.tail, p.triangles, V, out.mesh.indices.data(), predictors.data(), where,
                    p.cluster_triangles);
   decode_predicted_vertices(p, predictors, grid, out, where);
   out.cluster_triangles = p.cluster_triangles;
-  return out;
 }
 
 NodeSizeBreakdown TraversalCodec::layout(std::span<const uint8_t> bytes, size_t node_size,

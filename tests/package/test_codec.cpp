@@ -274,6 +274,47 @@ TEST_P(NodeCodecTest, AttributesAndLockedVerticesRoundTrip) {
   EXPECT_EQ(got, expected);
 }
 
+TEST_P(NodeCodecTest, DecodeIntoAReusedNodeEqualsAFreshDecode) {
+  // decode_into overwrites every field of a node that held another decode: one with more vertices and
+  // triangles and every attribute, then one smaller and without attributes, then the first again.
+  Mesh big = uv_sphere(1.0f, 9, 14);
+  big.colors.assign(big.vertex_count(), glm::vec4(0.5f, 0.25f, 1.0f, 1.0f));
+  std::vector<uint32_t> id(big.vertex_count());
+  for (size_t v = 0; v < id.size(); ++v) id[v] = uint32_t(7 * v);
+  Mesh small = grid(3);
+  ASSERT_LT(small.vertex_count(), big.vertex_count());
+  ASSERT_FALSE(small.has_uvs() || small.has_colors());
+  Bounds both = big.bounds();
+  both.add(small.bounds());
+  const PositionGrid pg = PositionGrid::for_bounds(both, 14);
+  const NodeCodec& codec = node_codec(GetParam());
+  NodeGeometry g;
+  g.mesh = &big, g.vertex_data = id;
+  const std::vector<uint8_t> big_bytes = codec.encode(g, pg);
+  g = NodeGeometry{};
+  g.mesh = &small;
+  const std::vector<uint8_t> small_bytes = codec.encode(g, pg);
+  auto expect_same = [](const DecodedNode& a, const DecodedNode& b) {
+    EXPECT_EQ(a.mesh.positions, b.mesh.positions);
+    EXPECT_EQ(a.mesh.normals, b.mesh.normals);
+    EXPECT_EQ(a.mesh.uvs, b.mesh.uvs);
+    EXPECT_EQ(a.mesh.colors, b.mesh.colors);
+    EXPECT_EQ(a.mesh.indices, b.mesh.indices);
+    EXPECT_EQ(a.mesh.material, b.mesh.material);
+    EXPECT_EQ(a.first_vertex, b.first_vertex);
+    EXPECT_EQ(a.index_end, b.index_end);
+    EXPECT_EQ(a.vertex_data, b.vertex_data);
+    EXPECT_EQ(a.extra, b.extra);
+    EXPECT_EQ(a.cluster_triangles, b.cluster_triangles);
+  };
+  DecodedNode reused;
+  for (const std::vector<uint8_t>* bytes : {&big_bytes, &small_bytes, &big_bytes}) {
+    codec.decode_into(*bytes, pg, "reused", reused);
+    expect_same(reused, codec.decode(*bytes, pg, "fresh"));
+  }
+  EXPECT_FALSE(reused.mesh.colors.empty());  // the last decode was the node with attributes
+}
+
 TEST(PredictiveCodec, SmoothMeshTakesFewerBytesThanCodecOneAfterZstd) {
   // On a smooth sphere, parallelogram-predicted positions and normals predicted from the decoded triangles
   // leave small residuals: after zstd (as the writer stores pages) codec 2 must be clearly smaller.
