@@ -57,19 +57,21 @@ float frame_scale(uint32_t bits) {
 
 // The encoder's rounding offset of the codes in a prediction's frame (oct_encode): below 0.5 it rounds toward
 // the prediction, a dead-zone quantizer (the residuals are peaked at 0, so a code nearer zero saves more bits
-// than its larger error costs). 9 bits (level 0 and progressive meshes by default) take 0.3, fewer bits
+// than its larger error costs). 9 bits (level 0 and progressive meshes by default) take 0.2, fewer bits
 // (coarser clusters) 0.4; more than 9 bits, a precision asked for explicitly, rounds to the nearest code.
 // Measured (bake, render at 1 px, measure --images against the full model; elephant_1m near / mid / far,
 // refined_elephant the same, motorBike front / side / above): offsets 0.5 / 0.4 / 0.35 / 0.25 everywhere gave
 // elephant_1m 3,929,606 / 3,874,189 / 3,846,263 / 3,791,792 B, refined_elephant 333,606 / 330,060 / 328,499
-// / 325,248 B, motorBike 1,647,075 / 1,636,864 / 1,632,486 / 1,624,476 B; 0.35 cost refined_elephant's far
-// view 0.086 dB (59.951 -> 59.865), 0.25 0.11 dB, 0.35 at 9 bits alone nothing; 0.3 / 0.4 gives 3,843,361 /
-// 328,149 / 1,633,844 B (-2.2 %, -1.6 %, -0.8 %) with PSNR 48.593 / 61.088 / 61.429, 46.588 / 53.576 /
-// 59.952, 47.793 / 46.000 / 48.053 dB against 48.599 / 61.097 / 61.430, 46.594 / 53.559 / 59.951, 47.785 /
-// 45.994 / 48.064 (at most -0.011 dB) and the same triangles. Decoders are unchanged: any code decodes as
-// before.
+// / 325,248 B, motorBike 1,647,075 / 1,636,864 / 1,632,486 / 1,624,476 B; below 0.4 coarse clusters cost
+// refined_elephant's far view 0.086 dB (0.35) and 0.11 dB (0.25). With 0.4 below 9 bits, 0.3 / 0.2 / 0.1 at
+// 9 bits: 3,843,361 / 3,813,972 / 3,786,481 B, 328,149 / 326,598 / 325,330 B, 1,633,844 / 1,631,598 /
+// 1,630,137 B; PSNR at 0.2 48.594 / 61.088 / 61.429, 46.586 / 53.576 / 59.952, 47.791 / 45.998 / 48.044
+// dB against 48.599 / 61.097 / 61.434, 46.594 / 53.559 / 59.937, 47.786 / 46.000 / 48.067 with nearest
+// rounding at 8 bits everywhere above level 0 (at most -0.023 dB; 0.1: motorBike above -0.031 dB, left for
+// the margin that 9 bits keep for close-up and specular views), the same triangles. Decoders are unchanged:
+// any code decodes as before.
 float rounding_offset(uint32_t bits) {
-  return bits > 9 ? 0.5f : bits == 9 ? 0.3f : 0.4f;
+  return bits > 9 ? 0.5f : bits == 9 ? 0.2f : 0.4f;
 }
 
 // Lanes 0-2 of sum[4i .. 4i+3] transposed into x, y, z.
