@@ -18,8 +18,10 @@ inline float sign_not_zero(float v) {
 }
 
 // n need not be unit length; a zero (or non-finite) vector encodes as +z. Returns components in
-// [-scale, scale], rounded; oct_decode with inv_scale = 1 / scale inverts it.
-inline glm::ivec2 oct_encode(glm::vec3 n, float scale) {
+// [-scale, scale], rounded: trunc(x + sign(x) round_offset), so 0.5 rounds to the nearest code and a smaller
+// offset rounds toward zero with a dead zone (|x| < 1 - round_offset gives 0; the error stays below
+// 1 - round_offset code steps); oct_decode with inv_scale = 1 / scale inverts it.
+inline glm::ivec2 oct_encode(glm::vec3 n, float scale, float round_offset = 0.5f) {
   // Selects only (no branch, no short-circuit, the division unconditional), so that a loop of encodes
   // vectorizes.
   const float l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
@@ -28,10 +30,11 @@ inline glm::ivec2 oct_encode(glm::vec3 n, float scale) {
   const bool lower = usable & (n.z < 0.0f);
   const float fx = lower ? (1.0f - std::abs(py)) * sign_not_zero(px) : px;
   const float fy = lower ? (1.0f - std::abs(px)) * sign_not_zero(py) : py;
-  // Round half away from zero without a libm call.
+  // Round (half away from zero at offset 0.5) without a libm call.
   const float x = std::min(std::max(fx, -1.0f), 1.0f) * scale,
               y = std::min(std::max(fy, -1.0f), 1.0f) * scale;
-  return {static_cast<int>(x + std::copysign(0.5f, x)), static_cast<int>(y + std::copysign(0.5f, y))};
+  return {static_cast<int>(x + std::copysign(round_offset, x)),
+          static_cast<int>(y + std::copysign(round_offset, y))};
 }
 
 // The b-bit code: components in [-(2^(bits-1)-1), 2^(bits-1)-1].
