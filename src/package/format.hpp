@@ -29,8 +29,9 @@ inline constexpr std::array<uint8_t, 8> kMagic = {0x89, 'L', 'O', 'D', 'S', '\r'
 // prediction (predicted_normals.hpp), pages of codecs 2 and 3 store their residuals entropy-coded
 // (page_parts.hpp, residual_coder.hpp); 7: 9-bit normals' frame scale 0.49 (predicted_normals.cpp), pages
 // store the connectivity's references apart from its symbols and the traversal symbols entropy-coded with
-// context (page_parts.hpp, symbol_coder.hpp).
-inline constexpr uint32_t kFormatVersion = 7;
+// context (page_parts.hpp, symbol_coder.hpp); 8: traversal symbols' cluster codes stored by recency
+// (symbol_coder.hpp).
+inline constexpr uint32_t kFormatVersion = 8;
 inline constexpr size_t kHeaderSize = 64;
 
 // Hard limits a reader enforces before allocating: no valid writer output exceeds them.

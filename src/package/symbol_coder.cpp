@@ -1,5 +1,6 @@
 #include "package/symbol_coder.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstring>
 
@@ -13,24 +14,49 @@ namespace {
 
 constexpr uint32_t kScaleBits = 8, kScale = 1u << kScaleBits;
 constexpr uint32_t kKinds = 6, kClasses = 2 * kKinds, kClusterCodes = 31;
-constexpr uint32_t kTables = kClasses + 1, kCodeTable = kClasses;  // the cluster codes' table comes last
+constexpr uint32_t kTables = kClasses + 1, kCodeTable = kClasses;  // the ranks' table comes last
 constexpr uint32_t kStates = 2;
 // The alphabet of table t.
 constexpr uint32_t alphabet(uint32_t t) {
   return t == kCodeTable ? kClusterCodes : kClasses;
 }
 
+// Move-to-front (Bentley, Sleator, Tarjan & Wei 1986, "A locally adaptive data compression scheme", CACM
+// 29(4)) over the recent cluster codes (symbol_coder.hpp): the code of rank r, which then moves to the front.
+// Cost: a few instructions for r < 8 (most ranks: the codes of bytes 0..r of one little-endian word move
+// up a byte, without a loop), O(r) above.
+uint32_t to_front(RecentClusterCodes& recent, uint32_t r) {
+  const uint8_t code = recent[r];
+  if (r < 8) [[likely]] {
+    uint64_t word;
+    std::memcpy(&word, recent.data(), 8);
+    const uint64_t moved = ~uint64_t(0) >> (56 - 8 * r);  // bytes 0..r
+    word = (word & ~moved) | ((word << 8) & moved) | code;
+    std::memcpy(recent.data(), &word, 8);
+    return code;
+  }
+  for (; r > 0; --r) recent[r] = recent[r - 1];
+  recent[0] = code;
+  return code;
+}
+
 }  // namespace
 
 std::optional<std::vector<uint8_t>> encode_symbols(std::span<const uint8_t> symbols) {
   std::array<std::array<uint32_t, kClusterCodes>, kTables> counts{};
+  std::vector<uint8_t> ranks;  // of the cluster codes, in order
+  RecentClusterCodes recent = kFirstClusterCodes;
   uint32_t context = 0;
   for (const uint8_t b : symbols) {
     const uint32_t kind = b & 7, code = b >> 3;
     if (kind >= kKinds) return std::nullopt;
     const uint32_t s = kind + (code ? kKinds : 0);
     ++counts[context][s];
-    if (code) ++counts[kCodeTable][code - 1];
+    if (code) {
+      const uint32_t r = uint32_t(std::find(recent.begin(), recent.end(), code) - recent.begin());
+      to_front(recent, r);
+      ranks.push_back(uint8_t(r)), ++counts[kCodeTable][r];
+    }
     context = s;
   }
   std::array<std::array<uint32_t, kClusterCodes>, kTables> f{}, start{};
@@ -57,10 +83,11 @@ std::optional<std::vector<uint8_t>> encode_symbols(std::span<const uint8_t> symb
   std::vector<std::array<uint32_t, 2>> steps;
   steps.reserve(symbols.size() + symbols.size() / 8);
   context = 0;
+  const uint8_t* rank = ranks.data();
   for (const uint8_t b : symbols) {
     const uint32_t code = b >> 3, s = (b & 7) + (code ? kKinds : 0);
     steps.push_back({start[context][s], f[context][s]});
-    if (code) steps.push_back({start[kCodeTable][code - 1], f[kCodeTable][code - 1]});
+    if (code) steps.push_back({start[kCodeTable][*rank], f[kCodeTable][*rank]}), ++rank;
     context = s;
   }
   std::vector<uint8_t> reversed;
@@ -122,6 +149,7 @@ void SymbolDecoder::symbols(size_t count, uint8_t* out) {
   size_t at = rans_at_;
   const size_t rans_end = rans_end_;
   uint32_t x0 = state_[0], x1 = state_[1], context = context_;
+  RecentClusterCodes recent = recent_;  // a local: the loop's stores to `out` cannot alias it
   // One step (rANS, Duda 2013, eq. 9: D(x) = (s, f_s floor(x / 2^8) + x mod 2^8 - start_s), s the symbol
   // of slot x mod 2^8 of `table`), then x read back up to kLow from the next 2 rANS bytes; the states
   // alternate.
@@ -141,12 +169,12 @@ void SymbolDecoder::symbols(size_t count, uint8_t* out) {
     const uint32_t s = step(context);
     uint32_t symbol = s;
     if (s >= kKinds) [[unlikely]]
-      symbol = (s - kKinds) | (step(kCodeTable) + 1) << 3;
+      symbol = (s - kKinds) | to_front(recent, step(kCodeTable)) << 3;
     out[i] = uint8_t(symbol);
     context = s;  // below kClasses: the tables hold no other classes
   }
   if (at > rans_end) fail("symbol rANS stream ends early");
-  state_[0] = x0, state_[1] = x1, context_ = context;
+  state_[0] = x0, state_[1] = x1, context_ = context, recent_ = recent;
   rans_at_ = at;
 }
 

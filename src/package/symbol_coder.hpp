@@ -5,9 +5,10 @@
 //
 // A symbol byte holds a kind t (bits 0-2: 0..5) and a cluster code g (bits 3-7: 0 for the gate's cluster).
 // Each is coded as its class s = t + 6 [g > 0] (12 classes) under the table of the previous symbol's class
-// (the page's first symbol: under class 0's), followed when g > 0 by g - 1 under one table of cluster codes
-// (order 0). rANS (rans.hpp) with tables of 2^8 and two interleaved states: coding step i (classes and
-// cluster codes counted together) takes state i mod 2.
+// (the page's first symbol: under class 0's), followed when g > 0 by the rank of g among the cluster codes,
+// most recently coded first (move-to-front, format 8), under one table of ranks (order 0). rANS (rans.hpp)
+// with tables of 2^8 and two interleaved states: coding step i (classes and ranks counted together) takes
+// state i mod 2.
 //
 // Measured before building it (an offline estimate over the pages of the baked packages, each page's tables
 // alone, table costs included): connectivity symbols after zstd 893,071 B on elephant_1m (0.25 B/tri at level
@@ -26,12 +27,24 @@
 // BM_Decode/4 (bench_package, records of refined_elephant; callgrind, decode_node + unpack_page) 399.5 ->
 // 429.6 instructions a triangle (+7.5 %; 446.2 with tables of 2^10).
 //
+// Cluster codes by rank (format 8): a tag's cluster is usually one that a recent tag named (the traversal
+// crosses between the same few clusters of a record for a while), which the order-0 table of codes could
+// not see. Measured offline first (elephant_1m, each level's tags as one sequence, order-0 entropy): 2.97
+// -> 2.20 bits a code at level 0, 3.10 -> 2.26 at level 1, 19.7 KB in all. Packages (`lodstream bake
+// --json`, format 7 -> 8): elephant_5m 15,159,315 -> 15,081,642 B (-0.51 %), elephant_1m 3,939,809 ->
+// 3,920,643 (-0.49 %; connectivity at level 0 0.20 -> 0.19 B/stored tri, at level 1 0.37 -> 0.36),
+// refined_elephant -0.32 %, motorBike -0.21 %, bunny -0.33 %, horse -0.33 %, city -0.23 %; decoded nodes
+// identical. Decode: a whole refined_elephant (`lodstream bench decode`, callgrind, decode_node +
+// unpack_page) 70.14 M -> 70.45 M instructions (+0.44 %: about 28 instructions a tagged symbol; 51 with a
+// byte loop for every rank; 0.28 M more when forced inline into the symbol loop).
+//
 // A stream: per context c = 0..11, a u16 LE mask of the classes that follow it (0 for a context that never
 // occurs), then the varint frequencies of those classes but the last, which takes the rest of 2^8; a u32
-// LE mask of the cluster codes (bit g - 1) and their frequencies likewise; varint size of the rANS bytes;
-// the rANS bytes (the two final states, u32 LE each, then u16 LE reads).
+// LE mask of the ranks (bit r) and their frequencies likewise; varint size of the rANS bytes; the rANS
+// bytes (the two final states, u32 LE each, then u16 LE reads).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -39,6 +52,13 @@
 #include <vector>
 
 namespace lodstream::package {
+
+// The cluster codes 1..31, most recently coded first: a code is stored as its rank here (0..30), then moves
+// to the front; every stream starts from kFirstClusterCodes.
+using RecentClusterCodes = std::array<uint8_t, 31>;
+inline constexpr RecentClusterCodes kFirstClusterCodes = {1,  2,  3,  4,  5,  6,  7,  8,  9,  10, 11,
+                                                          12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22,
+                                                          23, 24, 25, 26, 27, 28, 29, 30, 31};
 
 // The stream of `symbols`; nullopt when one is not a traversal symbol (kind 6 or 7), as the connectivity
 // bytes of nodes that are no traversal (codec 2's form of codec 3) may be. Cost: O(symbols.size()).
@@ -61,7 +81,7 @@ class SymbolDecoder {
   [[noreturn]] void fail(const char* what) const;
 
   std::string where_;
-  // 13 tables of 2^8 slots (12 contexts, then the cluster codes; empty for no stream), each slot: bits
+  // 13 tables of 2^8 slots (12 contexts, then the cluster codes' ranks; empty for no stream), each slot: bits
   // 0-10 its symbol's frequency (0 in a table that never occurs), 11-20 the slot minus the symbol's start,
   // 21-25 the symbol.
   std::vector<uint32_t> slot_;
@@ -69,6 +89,7 @@ class SymbolDecoder {
   size_t rans_end_ = 0, rans_at_ = 0;
   uint32_t state_[2] = {0, 0};  // the next step's first
   uint32_t context_ = 0;        // the previous symbol's class
+  RecentClusterCodes recent_ = kFirstClusterCodes;
 };
 
 }  // namespace lodstream::package
