@@ -29,6 +29,14 @@ TEST(BenchDecode, DecodesEveryNodeOfEveryLevel) {
     EXPECT_GT(g["mtris_per_s"].get<double>(), 0.0);
     EXPECT_GE(g["mtris_per_s_nodes_only"].get<double>(), g["mtris_per_s"].get<double>());
   }
+  // Pages shared by bytes and records by triangles: the levels' times add up to the run's (one run's medians
+  // are its own figures with --runs 1).
+  auto once = run_lodstream({"bench", "decode", package, "--runs", "1", "--json"});
+  ASSERT_EQ(once.status, 0) << once.err;
+  const auto run = once.json();
+  double levels_s = 0.0;
+  for (const auto& l : run["per_level"]) levels_s += l["pages_s"].get<double>() + l["nodes_s"].get<double>();
+  EXPECT_NEAR(levels_s, run["cpu_s"].get<double>(), 1e-6 + 1e-6 * levels_s);
 }
 
 TEST(BenchDecode, BadArgumentsAreOneLineErrors) {
