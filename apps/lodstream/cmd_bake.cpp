@@ -801,9 +801,8 @@ int run_bake(const BakeArgs& args) {
       std::printf("  %zu of %zu meshes are progressive meshes (at most %u triangles)\n", progressive,
                   pms.size(), args.pm_max_triangles);
     std::printf(
-        "  fallbacks: %zu partial, %zu positions-only, %zu dropped components, %zu abandoned groups, %zu "
-        "stalled "
-        "meshes\n",
+        "  fallbacks: %zu partial, %zu positions-only, %zu dropped components, %zu abandoned groups, "
+        "%zu stalled meshes\n",
         partial, positions_only, dropped_components, abandoned, stalled);
     if (!hlod.nodes.empty())
       std::printf("  hlod: %zu proxies (%zu triangles), %u levels, %.2f s\n", hlod.nodes.size(),

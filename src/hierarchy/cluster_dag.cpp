@@ -266,7 +266,7 @@ GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
     result_locked[v] = local_locked[l];
   }
   if (stuck(r)) {  // last fallback: whole closed components dropped (component_removal.hpp)
-    r.error_bound += remove_components(r.mesh, result_locked, so.target_triangles).bound;
+    r.error_bound += remove_components(r.mesh, result_locked, so.target_triangles);
     outcome = GroupOutcome::components_dropped;
   }
   if (stuck(r)) return out;

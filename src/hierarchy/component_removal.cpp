@@ -33,10 +33,9 @@ double farthest_to_nearest(const Mesh& mesh, std::span<const uint32_t> from, std
 
 }  // namespace
 
-ComponentRemoval remove_components(Mesh& mesh, std::span<const uint8_t> locked, size_t target_triangles) {
-  ComponentRemoval out;
+double remove_components(Mesh& mesh, std::span<const uint8_t> locked, size_t target_triangles) {
   const size_t n = mesh.positions.size(), triangles = mesh.triangle_count();
-  if (triangles <= target_triangles) return out;
+  if (triangles <= target_triangles) return 0.0;
   // Components: triangles joined through shared positions (seams split vertices, not the surface).
   uint32_t ids = 0;
   const std::vector<uint32_t> id = weld_positions(mesh.positions, ids);
@@ -64,7 +63,7 @@ ComponentRemoval remove_components(Mesh& mesh, std::span<const uint8_t> locked, 
   std::vector<uint32_t> candidates;
   for (uint32_t c = 0; c < ids; ++c)
     if (tris[c] > 0 && !has_lock[c]) candidates.push_back(c);
-  if (candidates.empty()) return out;
+  if (candidates.empty()) return 0.0;
   // At least one component stays: the largest candidate when nothing is locked.
   if (std::none_of(has_lock.begin(), has_lock.end(), [](uint8_t l) { return l != 0; })) {
     auto largest = std::max_element(candidates.begin(), candidates.end(),
@@ -84,20 +83,21 @@ ComponentRemoval remove_components(Mesh& mesh, std::span<const uint8_t> locked, 
   size_t left = triangles;
   for (const auto& [distance, c] : order) {
     if (left <= target_triangles) break;
-    dropped[c] = 1, left -= tris[c], out.removed_triangles += tris[c];
+    dropped[c] = 1, left -= tris[c];
   }
   // The bound against what is kept.
   std::vector<uint32_t> kept;
   for (uint32_t v = 0; v < n; ++v)
     if (referenced[v] && !dropped[component[v]]) kept.push_back(v);
+  double bound = 0.0;
   for (uint32_t c = 0; c < ids; ++c)
-    if (dropped[c]) out.bound = std::max(out.bound, farthest_to_nearest(mesh, vertices[c], kept));
+    if (dropped[c]) bound = std::max(bound, farthest_to_nearest(mesh, vertices[c], kept));
   size_t w = 0;
   for (size_t t = 0; t < triangles; ++t)
     if (!dropped[component[mesh.indices[3 * t]]])
       for (int k = 0; k < 3; ++k) mesh.indices[w++] = mesh.indices[3 * t + k];
   mesh.indices.resize(w);
-  return out;
+  return bound;
 }
 
 }  // namespace lodstream::hierarchy
