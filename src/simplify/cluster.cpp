@@ -200,10 +200,15 @@ class Clusterer {
       r.vertex_error.push_back(float(o.error[c] * scale_ * (1 + 1e-5) + slack));
     }
     for (uint32_t c : o.tris) m.indices.push_back(index[c]);
+    // The union of both boxes bounds the distance between the two surfaces; the prior error adds to it
+    // (triangle inequality) when the input carries one.
     Bounds both = in_.bounds();
     both.add(m.bounds());
+    float prior = 0.0f;
+    for (float e : prior_) prior = std::max(prior, e);
+    const float cap = float((double(both.diagonal()) + prior) * (1 + 1e-6));
     for (float& e : r.vertex_error) {
-      e = std::min(e, both.diagonal() * (1 + 1e-6f));
+      e = std::min(e, cap);
       r.error_bound = std::max(r.error_bound, double(e));
     }
     return r;

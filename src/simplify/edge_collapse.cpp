@@ -228,6 +228,7 @@ class Simplifier {
   glm::vec3 origin_{0.0f};
   float scale_ = 1.0f;
   double max_error_ = 0.0;
+  double prior_error_ = 0.0;    // the largest Options::vertex_error, model units
   bool error_limited_ = false;  // a collapse was refused because of Options::max_error
 
   std::vector<uint32_t> indices_;  // alive faces; dead ones have indices_[3f] == kNone during a pass
@@ -343,6 +344,14 @@ class Simplifier {
     radius_.assign(m, 0.0f);
     for (uint32_t v = 0; v < n; ++v)
       if (v < opt_.locked.size() && opt_.locked[v]) kind_[weld_remap_[v]] = kLocked;
+    // Radii carried from a finer surface (Options::vertex_error), normalized and rounded up; welded copies
+    // keep the larger.
+    for (uint32_t v = 0; v < n && v < opt_.vertex_error.size(); ++v) {
+      const double e = double(opt_.vertex_error[v]);
+      prior_error_ = std::max(prior_error_, e);
+      float& r = radius_[weld_remap_[v]];
+      r = std::max(r, std::nextafter(float(e / double(scale_) * (1 + 1e-6)), INFINITY));
+    }
 
     indices_.clear();
     indices_.reserve(in_.indices.size());
@@ -1571,10 +1580,12 @@ class Simplifier {
       }
       v = remap[v];
     }
-    // Both surfaces lie in the union of their boxes, so its diagonal also bounds the Hausdorff distance.
+    // Both surfaces lie in the union of their boxes, so its diagonal also bounds the Hausdorff distance
+    // between them; plus the input's own radius against the finer surface (triangle inequality).
     Bounds both = in_.bounds();
     both.add(out.bounds());
-    for (float& e : result.vertex_error) e = std::min(e, both.diagonal() * (1 + 1e-6f));
+    const float cap = float((double(both.diagonal()) + prior_error_) * (1 + 1e-6));
+    for (float& e : result.vertex_error) e = std::min(e, cap);
     out.indices = std::move(indices_);
     result.error_bound = 0.0;
     for (float e : result.vertex_error) result.error_bound = std::max(result.error_bound, double(e));

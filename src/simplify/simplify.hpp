@@ -57,6 +57,11 @@ struct Options {
   bool half_edge = false;
   // Per input vertex, non-zero = locked (never moves, never removed). Empty = none locked.
   std::vector<uint8_t> locked;
+  // Per input vertex (model units): the radius r_v it already carries against a finer surface this mesh was
+  // simplified from (a previous Result::vertex_error). Empty = 0, the input itself. The invariant above
+  // holds through every mapping whatever the starting radii, so the result's vertex_error and error_bound
+  // then bound the distance to that finer surface directly, not to this input (no sum of bounds).
+  std::vector<float> vertex_error;
   // Record the collapse sequence in Result::collapses (used by progressive meshes).
   bool record_collapses = false;
   // When edge collapse stops short of target_triangles, continue with vertex clustering (cluster.hpp), which
