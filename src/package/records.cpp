@@ -98,7 +98,7 @@ DecodedNode extract_cluster(const DecodedNode& record, uint32_t cluster, const s
   // written every time and kept only when v is new.
   for (uint32_t& v : m.indices) {
     const uint32_t seen = map[v];
-    const bool fresh = seen == UINT32_MAX;
+    const uint32_t fresh = seen >> 31;  // 1 for UINT32_MAX (not used yet): cluster vertices are below 2^31
     first_use[n] = v;
     const uint32_t c = fresh ? n : seen;
     map[v] = c, n += fresh;

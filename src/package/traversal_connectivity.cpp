@@ -16,7 +16,9 @@ constexpr uint32_t kNone = UINT32_MAX;
 class Front {
  public:
   enum State : uint32_t { kPending, kDone, kGone };  // to process; in its loop, processed; out of the loops
-  struct Edge {
+  // 32 bytes (7 fields, aligned): an edge's address is its index shifted, where 28 took three instructions
+  // at every look-up.
+  struct alignas(32) Edge {
     uint32_t a, b, o, prev, next, state;
     uint32_t cluster;  // of its triangle (records of several clusters; 0 otherwise)
   };
