@@ -880,6 +880,10 @@ class Simplifier {
   // change at touched vertices). Every vertex is visited in parallel and reads its neighbours' touched_
   // (O(T / cores) per pass; listing the neighbours of touched vertices first was a serial O(V) scan per pass,
   // 3 % of the wall time on elephant_1m). An edge with a twin is evaluated once, from its smaller end.
+  // Every touched edge is evaluated: elephant_1m 0.1 makes 8.3 evaluations per collapse (3.3 of them the
+  // first pass's, 1 the try's) in 6 passes, and nearly all touched edges fall under the next pass's limit, so
+  // evaluating them lazily (only once the limit reaches their old cost) saved 1.9 % of them, took 10 passes
+  // and raised the bound 2.8x.
   size_t run_pass(size_t target) {
     const size_t m = source_.size();
     const bool all = slots_.size() != indices_.size();
@@ -1302,6 +1306,9 @@ class Simplifier {
     if (p.move)
       for (const StarFace& star : s.star_b) check(star);
     if (!ok) return rejected_slot(p, s);
+    // The vertical bound is the smaller on all but 15 of elephant_1m 0.1's 640,282 collapses, and it is
+    // needed even where the natural one stays under the bound so far: radii feed the later collapses' bounds
+    // (skipping it there: elephant_1m 0.1 bound +39 %, horse 2.1x).
     const double r_new = std::min(r_natural, vertical_bound(p, x, s, r_natural));
     if (r_new > max_error_) {
       s.error_limited = true;
