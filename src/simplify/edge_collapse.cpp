@@ -203,6 +203,16 @@ class Simplifier {
     }
   }
 
+  // f(range) over blocks of [0, end) of at least `grain` on every core, or over all of it at once when
+  // small_ (without a nested TBB call: about 800 instructions each, a few dozen per DAG group).
+  template <class F>
+  void for_blocks(uint32_t end, uint32_t grain, F&& f) const {
+    if (small_)
+      f(tbb::blocked_range<uint32_t>(0, end));
+    else
+      tbb::parallel_for(tbb::blocked_range<uint32_t>(0, end, grain), f);
+  }
+
   // Welded vertices (input vertex -> welded) and their working data (normalized positions).
   std::vector<uint32_t> weld_remap_, source_;  // source_: welded vertex -> first input vertex
   // The UninitializedVector members are first written by parallel loops (weld, renumber_spatially,
@@ -355,7 +365,7 @@ class Simplifier {
         faces, run_count, [&](size_t f) { return key(f) / span; },
         [&](size_t f, uint32_t position) { by_run[position] = uint32_t(f); }, &run_start);
     std::vector<uint32_t> sorted(indices_.size());
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, run_count, 64), [&](const auto& runs) {
+    for_blocks(run_count, 64, [&](const auto& runs) {
       std::vector<uint32_t> start(span + 1);
       for (uint32_t r = runs.begin(); r < runs.end(); ++r) {
         const uint32_t first = r * span, begin = run_start[r], end = run_start[r + 1];
@@ -489,7 +499,7 @@ class Simplifier {
     const size_t m = source_.size();
     open_out_.assign(m, kNone), open_in_.assign(m, kNone);
     std::vector<uint8_t> open_count(m, 0), complex(m, 0);
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 4096), [&](const auto& r) {
+    for_blocks(uint32_t(m), 4096, [&](const auto& r) {
       thread_local std::vector<uint32_t> outs, ins;
       for (uint32_t v = r.begin(); v < r.end(); ++v) classify_fan(v, outs, ins, open_count, complex);
     });
@@ -561,7 +571,7 @@ class Simplifier {
   // Border and seam vertices: their single open edge out and in, this pass (kNone when not single).
   void update_open_edges() {
     const size_t m = source_.size();
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 4096), [&](const auto& r) {
+    for_blocks(uint32_t(m), 4096, [&](const auto& r) {
       thread_local std::vector<uint32_t> outs, ins;
       for (uint32_t v = r.begin(); v < r.end(); ++v) {
         open_out_[v] = open_in_[v] = kNone;
