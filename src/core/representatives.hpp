@@ -37,7 +37,7 @@ std::vector<uint32_t> representatives(size_t n, const Hash& hash, const Equal& e
       n, uint32_t(buckets), bucket_of, [&](size_t i, uint32_t at) { order[at] = uint32_t(i); },
       &bucket_begin);
   std::vector<uint32_t> rep(n);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, buckets, 16), [&](const tbb::blocked_range<size_t>& r) {
+  auto resolve = [&](const tbb::blocked_range<size_t>& r) {
     constexpr uint64_t kEmpty = UINT64_MAX;
     thread_local std::vector<uint64_t> table;
     for (size_t b = r.begin(); b < r.end(); ++b) {
@@ -62,7 +62,12 @@ std::vector<uint32_t> representatives(size_t n, const Hash& hash, const Equal& e
         }
       }
     }
-  });
+  };
+  // One bucket (fewer than 1024 items: a DAG group's weld) is resolved in place, without a nested TBB call.
+  if (buckets == 1)
+    resolve(tbb::blocked_range<size_t>(0, 1));
+  else
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, buckets, 16), resolve);
   return rep;
 }
 

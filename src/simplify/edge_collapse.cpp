@@ -11,13 +11,14 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstring>
-#include <numeric>
 #include <utility>
 
 #include "core/counting_sort.hpp"
 #include "core/morton.hpp"
+#include "core/representatives.hpp"
 #include "simplify/cluster.hpp"
 #include "simplify/quadric.hpp"
 #include "simplify/simplify.hpp"
@@ -124,16 +125,14 @@ struct Scratch {
 
 enum class Outcome { kCollapsed, kRejected, kOutsideRegion };
 
-uint32_t hash_bits(const float* v, size_t n) {
-  uint32_t h = 2166136261u;
-  for (size_t i = 0; i < n; ++i) {
-    uint32_t u;
-    std::memcpy(&u, &v[i], 4);
-    if ((u << 1) == 0) u = 0;  // +0 and -0 hash alike
-    h = (h ^ u) * 16777619u;
-    h ^= h >> 15;
-  }
-  return h;
+// A position's hash for representatives (its top bits pick a bucket, its low 32 bits a slot): equal for
+// equal positions (+0 and -0 hash alike).
+uint64_t position_hash(const glm::vec3& p) {
+  auto bits = [](float f) { return std::bit_cast<uint32_t>(f + 0.0f); };
+  const uint64_t h = uint64_t(bits(p.x)) * 0x9E3779B97F4A7C15ull ^
+                     uint64_t(bits(p.y)) * 0xC2B2AE3D27D4EB4Full ^
+                     uint64_t(bits(p.z)) * 0x165667B19E3779F9ull;
+  return h ^ (h >> 29);
 }
 
 class Simplifier {
@@ -203,6 +202,16 @@ class Simplifier {
     }
   }
 
+  // f(range) over blocks of [0, end) of at least `grain` on every core, or over all of it at once when
+  // small_ (without a nested TBB call: about 800 instructions each, a few dozen per DAG group).
+  template <class F>
+  void for_blocks(uint32_t end, uint32_t grain, F&& f) const {
+    if (small_)
+      f(tbb::blocked_range<uint32_t>(0, end));
+    else
+      tbb::parallel_for(tbb::blocked_range<uint32_t>(0, end, grain), f);
+  }
+
   // Welded vertices (input vertex -> welded) and their working data (normalized positions).
   std::vector<uint32_t> weld_remap_, source_;  // source_: welded vertex -> first input vertex
   // The UninitializedVector members are first written by parallel loops (weld, renumber_spatially,
@@ -258,9 +267,10 @@ class Simplifier {
   // Welds exact duplicates (same position and attributes) and links vertices that share a position into
   // wedge rings, numbered as one loop over the input would: a welded vertex per first input vertex of its
   // position and attributes, in input order; each ring from the position's first wedge to its last, then
-  // back in input order (the first one's successor is the newest). The vertices are sorted by (position
-  // hash, index) on both cores; each then finds the first earlier one of its position and of its position
-  // and attributes among those of its hash (O(wedges) each, as a ring walk).
+  // back in input order (the first one's successor is the newest). Each input vertex's first vertex at its
+  // position, then its first with the same position and attributes, by hash (core/representatives.hpp, on
+  // every core, instead of a sort by position hash), then one pass in input order links the rings. O(V)
+  // expected.
   void weld() {
     const size_t n = in_.vertex_count();
     Bounds box = in_.bounds();
@@ -274,30 +284,20 @@ class Simplifier {
       return (!hn || in_.normals[i] == in_.normals[j]) && (!hu || in_.uvs[i] == in_.uvs[j]) &&
              (!hc || in_.colors[i] == in_.colors[j]);
     };
-    UninitializedVector<std::pair<uint32_t, uint32_t>> sorted(n);  // (position hash, input vertex)
-    for_each(size_t(0), n, [&](size_t v) { sorted[v] = {hash_bits(&in_.positions[v].x, 3), uint32_t(v)}; });
-    tbb::parallel_sort(sorted.begin(), sorted.end());
-    std::vector<uint32_t> run(n);  // where the run of sorted[i]'s hash begins
-    for (size_t i = 0; i < n; ++i)
-      run[i] = i > 0 && sorted[i].first == sorted[i - 1].first ? run[i - 1] : uint32_t(i);
-    // Per input vertex: the first input vertex at its position, and the first with its position and
-    // attributes (its welded vertex's source). Positions compare with == (NaN never equal, as in a hash-table
-    // weld).
-    UninitializedVector<uint32_t> first_at(n), source(n);
-    for_each(size_t(0), n, [&](size_t i) {
-      const uint32_t v = sorted[i].second;
-      uint32_t at = v, same = v;
-      for (size_t j = run[i]; j < i; ++j) {
-        const uint32_t u = sorted[j].second;
-        if (in_.positions[u] != in_.positions[v]) continue;
-        if (at == v) at = u;
-        if (same_attributes(u, v)) {
-          same = u;
-          break;
-        }
-      }
-      first_at[v] = at, source[v] = same;
-    });
+    // Positions compare with == (NaN never equal, -0 = +0, as in a hash-table weld); a vertex's class of
+    // position and attributes lies within its position's, so the second step hashes the first's result.
+    UninitializedVector<uint64_t> hash(n);
+    for_each(size_t(0), n, [&](size_t v) { hash[v] = position_hash(in_.positions[v]); });
+    const std::vector<uint32_t> first_at = representatives(
+        n, [&](size_t v) { return hash[v]; },
+        [&](uint32_t a, uint32_t b) { return in_.positions[a] == in_.positions[b]; });
+    const std::vector<uint32_t> source =
+        !hn && !hu && !hc ? first_at
+                          : representatives(
+                                n, [&](size_t v) { return hash[first_at[v]]; },
+                                [&](uint32_t a, uint32_t b) {
+                                  return first_at[a] == first_at[b] && same_attributes(a, b);
+                                });
     weld_remap_.assign(n, kNone);
     source_.clear();
     for (uint32_t v = 0; v < n; ++v)
@@ -316,27 +316,12 @@ class Simplifier {
       if (hc) col_[k] = in_.colors[v];
       pid_[k] = weld_remap_[first_at[v]];
     });
-    // Rings: a wedge links to the one before it at its position; the first, to the last.
-    for_each(size_t(0), n, [&](size_t i) {
-      const uint32_t v = sorted[i].second;
-      if (source[v] != v) return;
-      auto wedge_at = [&](size_t j) {
-        const uint32_t u = sorted[j].second;
-        return source[u] == u && first_at[u] == first_at[v];
-      };
-      uint32_t link = v;
-      if (first_at[v] != v) {
-        for (size_t j = i; j-- > run[i];)
-          if (wedge_at(j)) {
-            link = sorted[j].second;
-            break;
-          }
-      } else {
-        for (size_t j = i + 1; j < n && sorted[j].first == sorted[i].first; ++j)
-          if (wedge_at(j)) link = sorted[j].second;
-      }
-      wedge_[weld_remap_[v]] = weld_remap_[link];
-    });
+    // Rings, in input order: a position's first wedge links to the newest wedge so far; each later one
+    // links to the one before it (the first's link until then) and becomes the first's link.
+    for (size_t k = 0; k < m; ++k) {
+      const uint32_t first = pid_[k];
+      wedge_[k] = first == k ? uint32_t(k) : std::exchange(wedge_[first], uint32_t(k));
+    }
     renumber_spatially();
     kind_.assign(m, kManifold);
     touched_.assign(m, 1);  // every cost is evaluated in the first pass
@@ -388,7 +373,7 @@ class Simplifier {
         faces, run_count, [&](size_t f) { return key(f) / span; },
         [&](size_t f, uint32_t position) { by_run[position] = uint32_t(f); }, &run_start);
     std::vector<uint32_t> sorted(indices_.size());
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, run_count, 64), [&](const auto& runs) {
+    for_blocks(run_count, 64, [&](const auto& runs) {
       std::vector<uint32_t> start(span + 1);
       for (uint32_t r = runs.begin(); r < runs.end(); ++r) {
         const uint32_t first = r * span, begin = run_start[r], end = run_start[r + 1];
@@ -418,14 +403,19 @@ class Simplifier {
       const glm::vec3 q = glm::clamp(pos_[v], 0.0f, 1.0f) * 2097151.0f;  // pos_ is in [0, 1]^3
       code[v] = {morton_code21(uint32_t(q.x), uint32_t(q.y), uint32_t(q.z)), v};
     });
-    tbb::parallel_sort(code.begin(), code.end());  // ties (wedges share a position) by old number
+    // Ties (wedges share a position) by old number. One std::sort on a small mesh: tbb::parallel_sort's
+    // tasks cost more than the sort there (the pairs are distinct, so both give the same order).
+    if (small_)
+      std::sort(code.begin(), code.end());
+    else
+      tbb::parallel_sort(code.begin(), code.end());
     UninitializedVector<uint32_t> renumbered(m);
     for_each(uint32_t(0), uint32_t(m), [&](uint32_t i) { renumbered[code[i].second] = i; });
     auto permute = [&](auto& values) {
       if (values.size() != m) return;
-      UninitializedVector<typename std::decay_t<decltype(values)>::value_type> old(m);
-      for_each(uint32_t(0), uint32_t(m), [&](uint32_t i) { old[i] = values[i]; });
-      for_each(uint32_t(0), uint32_t(m), [&](uint32_t i) { values[i] = old[code[i].second]; });
+      std::decay_t<decltype(values)> moved(m);
+      for_each(uint32_t(0), uint32_t(m), [&](uint32_t i) { moved[i] = values[code[i].second]; });
+      values.swap(moved);
     };
     permute(source_), permute(pos_), permute(nrm_), permute(uv_), permute(col_), permute(wedge_),
         permute(pid_);
@@ -469,18 +459,22 @@ class Simplifier {
     for_each(uint32_t(0), runs, [&](uint32_t r) {
       const uint32_t lo = r << kAdjacencyRunBits;
       const uint32_t hi = uint32_t(std::min<size_t>(m, size_t(r + 1) << kAdjacencyRunBits));
-      std::vector<uint32_t> parked(run_start[r + 1] - run_start[r]);
-      if (runs > 1)
-        std::copy(faces_.begin() + run_start[r], faces_.begin() + run_start[r + 1], parked.begin());
-      else
-        std::iota(parked.begin(), parked.end(), 0u);
+      // The run's corners: parked in faces_ (copied out before faces_ is written), or all of them.
+      std::vector<uint32_t> parked;
+      if (runs > 1) parked.assign(faces_.begin() + run_start[r], faces_.begin() + run_start[r + 1]);
+      auto for_corners = [&](auto&& f) {
+        if (runs > 1)
+          for (uint32_t c : parked) f(c);
+        else
+          for (uint32_t c = 0; c < corners; ++c) f(c);
+      };
       std::vector<uint32_t> next(hi - lo, 0);  // degrees, then where each vertex's next face goes
-      for (uint32_t c : parked) ++next[indices_[c] - lo];
+      for_corners([&](uint32_t c) { ++next[indices_[c] - lo]; });
       for (uint32_t v = lo, at = run_start[r]; v < hi; ++v) {
         offsets_[v] = at;
         at += std::exchange(next[v - lo], at);
       }
-      for (uint32_t c : parked) faces_[next[indices_[c] - lo]++] = c / 3;
+      for_corners([&](uint32_t c) { faces_[next[indices_[c] - lo]++] = c / 3; });
     });
     offsets_[m] = uint32_t(corners);
   }
@@ -513,7 +507,7 @@ class Simplifier {
     const size_t m = source_.size();
     open_out_.assign(m, kNone), open_in_.assign(m, kNone);
     std::vector<uint8_t> open_count(m, 0), complex(m, 0);
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 4096), [&](const auto& r) {
+    for_blocks(uint32_t(m), 4096, [&](const auto& r) {
       thread_local std::vector<uint32_t> outs, ins;
       for (uint32_t v = r.begin(); v < r.end(); ++v) classify_fan(v, outs, ins, open_count, complex);
     });
@@ -540,7 +534,8 @@ class Simplifier {
   // classify's first step for one vertex: its open edges (open_out_, open_in_, open_count) and whether its
   // fan is complex (a directed edge twice, more than one open edge, or faces not forming one disc or fan).
   // A complex vertex is locked, so its open edges are not needed: a repeated edge ends the scan. Writes
-  // only v's entries, so vertices run in parallel. O(degree^2) compares, half of them for the repeats.
+  // only v's entries, so vertices run in parallel. O(degree^2) compares: the repeats, then one scan of all
+  // (in, out) pairs, which also links the faces for the walk.
   void classify_fan(uint32_t v, std::vector<uint32_t>& outs, std::vector<uint32_t>& ins,
                     std::vector<uint8_t>& open_count, std::vector<uint8_t>& complex) {
     fan(v, outs, ins);
@@ -557,31 +552,34 @@ class Simplifier {
           return;
         }
 
+    // One scan of all (in, out) pairs: next[i], the face g with g.out == face i's in (one at most: no
+    // out-neighbour repeats; kNoFace when face i's in edge is open), and whether face i's out edge has a
+    // twin.
+    constexpr uint16_t kNoFace = UINT16_MAX;
+    std::array<uint16_t, 256> next;
+    std::array<uint8_t, 256> out_closed;
+    for (size_t i = 0; i < deg; ++i) next[i] = kNoFace, out_closed[i] = 0;
+    for (size_t i = 0; i < deg; ++i)
+      for (size_t j = 0; j < deg; ++j)
+        if (outs[j] == ins[i]) next[i] = uint16_t(j), out_closed[j] = 1;
     uint32_t n_open_out = 0, n_open_in = 0, start = 0;
     for (size_t i = 0; i < deg; ++i) {
-      if (std::find(ins.begin(), ins.end(), outs[i]) == ins.end())
-        ++n_open_out, open_out_[v] = outs[i], start = uint32_t(i);
-      if (std::find(outs.begin(), outs.end(), ins[i]) == outs.end()) ++n_open_in, open_in_[v] = ins[i];
+      if (!out_closed[i]) ++n_open_out, open_out_[v] = outs[i], start = uint32_t(i);
+      if (next[i] == kNoFace) ++n_open_in, open_in_[v] = ins[i];
     }
     if (n_open_out > 1 || n_open_in > 1 || n_open_out != n_open_in) complex[v] = 1;
     open_count[v] = uint8_t(std::min<uint32_t>(n_open_out, 2));
     if (complex[v]) return;
-    // Walk the fan from the face after the open edge (or any face): face g follows f when g.out == f.in
-    // (one such g at most: no out-neighbour repeats).
+    // Walk the fan from the face after the open edge (or any face) along next.
     size_t visited = 1, cur = start;
-    while (visited < deg) {
-      size_t next = 0;
-      while (next < deg && outs[next] != ins[cur]) ++next;
-      if (next == deg || next == start) break;
-      cur = next, ++visited;
-    }
+    while (visited < deg && next[cur] != kNoFace && next[cur] != start) cur = next[cur], ++visited;
     if (visited != deg) complex[v] = 1;
   }
 
   // Border and seam vertices: their single open edge out and in, this pass (kNone when not single).
   void update_open_edges() {
     const size_t m = source_.size();
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 4096), [&](const auto& r) {
+    for_blocks(uint32_t(m), 4096, [&](const auto& r) {
       thread_local std::vector<uint32_t> outs, ins;
       for (uint32_t v = r.begin(); v < r.end(); ++v) {
         open_out_[v] = open_in_[v] = kNone;
@@ -597,9 +595,13 @@ class Simplifier {
     });
   }
 
-  // Adds face f's plane quadric and attribute gradients to its corners in [lo, hi) (build_quadrics); s and
-  // gradient: room for 3 x channels_ values and channels_ gradients.
-  void add_face(uint32_t f, uint32_t lo, uint32_t hi, float* s, AttributeTerm* gradient) {
+  // Adds face f's plane quadric and attribute gradients to its corners in [lo, hi) (build_quadrics);
+  // `weighted`: channels_ weighted values per vertex (s_j = weight_j x component_j); gradient: room for
+  // channels_ gradients. kChannels: channels_ when known at compile time (the loops over the channels
+  // unrolled: positions only, or normals only), else -1.
+  template <int kChannels>
+  void add_face(uint32_t f, uint32_t lo, uint32_t hi, const float* weighted, AttributeTerm* gradient) {
+    const int channels = kChannels >= 0 ? kChannels : channels_;
     const uint32_t v0 = indices_[3 * size_t(f)], v1 = indices_[3 * size_t(f) + 1],
                    v2 = indices_[3 * size_t(f) + 2];
     auto mine = [&](uint32_t v) { return v >= lo && v < hi; };
@@ -612,12 +614,12 @@ class Simplifier {
     Quadric face;  // relative to p0
     face.add_plane(n / len, 0.0f, area);
     face.w = area;
-    if (channels_ > 0) {
-      float *s0 = s, *s1 = s + channels_, *s2 = s + 2 * channels_;
-      channel_values(v0, s0), channel_values(v1, s1), channel_values(v2, s2);
+    if (channels > 0) {
+      const float *s0 = weighted + v0 * size_t(channels), *s1 = weighted + v1 * size_t(channels),
+                  *s2 = weighted + v2 * size_t(channels);
       // s(p) = g.(p - p0) + s0 with g = (s1 - s0) ge1 + (s2 - s0) ge2 (the face's gradient).
       const glm::vec3 ge1 = glm::cross(e2, n) / (len * len), ge2 = glm::cross(n, e1) / (len * len);
-      for (int j = 0; j < channels_; ++j) {
+      for (int j = 0; j < channels; ++j) {
         gradient[j] = {(s1[j] - s0[j]) * ge1 + (s2[j] - s0[j]) * ge2, s0[j]};
         face.add_plane(gradient[j].g, gradient[j].d, area);
       }
@@ -630,9 +632,9 @@ class Simplifier {
         quadric_[v].add(face);  // the shift by 0
       else
         quadric_[v].add_shifted(face, glm::dvec3(d));
-      for (int j = 0; j < channels_; ++j) {
-        attr_[v * size_t(channels_) + j].g += area * gradient[j].g;
-        attr_[v * size_t(channels_) + j].d += area * (gradient[j].d + glm::dot(gradient[j].g, d));
+      for (int j = 0; j < channels; ++j) {
+        attr_[v * size_t(channels) + j].g += area * gradient[j].g;
+        attr_[v * size_t(channels) + j].d += area * (gradient[j].d + glm::dot(gradient[j].g, d));
       }
     }
   }
@@ -676,17 +678,31 @@ class Simplifier {
         if (std::max({indices_[3 * f], indices_[3 * f + 1], indices_[3 * f + 2]}) >= first_vertex[k + 1])
           straddling[k].push_back(f);
     });
-    for_each(uint32_t(0), chunks, [&](uint32_t k) {
-      std::vector<float> s(3 * size_t(channels_));
+    // The weighted channel values, once per vertex (add_face reads them once per corner).
+    UninitializedVector<float> weighted(m * size_t(channels_));
+    for_each(size_t(0), m, [&](size_t v) {
+      for (int j = 0; j < channels_; ++j)
+        weighted[v * channels_ + j] = channel(uint32_t(v), j) * channel_[j].weight;
+    });
+    auto add_chunk = [&]<int kChannels>(uint32_t k) {
       std::vector<AttributeTerm> gradient(channels_);
       const uint32_t lo = first_vertex[k], hi = first_vertex[k + 1];
       std::fill(quadric_.data() + lo, quadric_.data() + hi, Quadric{});
       std::fill(attr_.data() + lo * size_t(channels_), attr_.data() + hi * size_t(channels_),
                 AttributeTerm{});
       for (uint32_t earlier = 0; earlier < k; ++earlier)
-        for (uint32_t f : straddling[earlier]) add_face(f, lo, hi, s.data(), gradient.data());
+        for (uint32_t f : straddling[earlier])
+          add_face<kChannels>(f, lo, hi, weighted.data(), gradient.data());
       for (uint32_t f = first_face[k]; f < first_face[k + 1]; ++f)
-        add_face(f, lo, hi, s.data(), gradient.data());
+        add_face<kChannels>(f, lo, hi, weighted.data(), gradient.data());
+    };
+    for_each(uint32_t(0), chunks, [&](uint32_t k) {
+      if (channels_ == 0)
+        add_chunk.template operator()<0>(k);
+      else if (channels_ == 3)
+        add_chunk.template operator()<3>(k);
+      else
+        add_chunk.template operator()<-1>(k);
     });
     // Penalty planes through open edges (borders and both sides of seams), perpendicular to their face.
     // Manifold vertices have none.
@@ -733,11 +749,6 @@ class Simplifier {
     const Channel& c = channel_[j];
     return c.attribute == 0 ? nrm_[v][c.component]
                             : (c.attribute == 1 ? uv_[v][c.component] : col_[v][c.component]);
-  }
-
-  // The weighted channel values of v (s_j = weight_j x component_j).
-  void channel_values(uint32_t v, float* s) {
-    for (int j = 0; j < channels_; ++j) s[j] = channel(v, j) * channel_[j].weight;
   }
 
   // The origin of v's quadric and attribute terms: its current position, the same for all its wedges (a

@@ -219,6 +219,23 @@ TEST(EdgeCollapse, OddInputIsHandled) {
   EXPECT_EQ(e.mesh.triangle_count(), 0u);
 }
 
+TEST(EdgeCollapse, WeldJoinsExactDuplicatesOnly) {
+  // A fan around the origin whose centre is repeated: with the same normal (once as -0), and with another
+  // normal (a wedge of the same position: not welded); a rim vertex repeated with its normal.
+  Mesh in;
+  in.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {-0.0f, 0, -0.0f}, {0, 0, 0}, {1, 0, 0}, {-1, 0, 0}};
+  in.normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}, {0, 0, 1}, {0, 1, 0}, {0, 0, 1}, {0, 0, 1}};
+  in.indices = {0, 1, 2, 3, 2, 6, 4, 5, 2};
+  auto r = simplify_mesh(in, with_target(in.triangle_count()));
+  const std::vector<uint32_t>& w = r.weld_remap;
+  ASSERT_EQ(w.size(), in.vertex_count());
+  EXPECT_EQ(w[3], w[0]);
+  EXPECT_EQ(w[5], w[1]);
+  EXPECT_NE(w[4], w[0]);
+  EXPECT_EQ(std::set<uint32_t>(w.begin(), w.end()).size(), 5u);
+  EXPECT_EQ(r.mesh.triangle_count(), 3u);
+}
+
 TEST(EdgeCollapse, ErrorTargetIsNeverExceeded) {
   Mesh in = lumpy(sphere(1.0f, 16, 32), 7);
   for (double e : {0.05, 0.2, 0.5}) {
