@@ -30,7 +30,12 @@
 //   Measured offline before building it (elephant_1m's levels >= 1, residual symbols' order-0 entropy per
 //   vertex): 17.36 bits plain, 16.20 with the plane prediction in one stream, 15.08 with component 0 in a
 //   stream of its own (a rotation into the plane's frame: 15.02); level 0 (Loop-subdivided, regular) 4.65
-//   plain, 4.94 plane; refined_elephant's levels >= 1 22.75 / 21.87 / 21.29.
+//   plain, 4.94 plane; refined_elephant's levels >= 1 22.75 / 21.87 / 21.29. Decode cost: about 70
+//   instructions a plane-predicted vertex (the cross product, the dominant axis, a division). `lodstream
+//   bench decode --runs 1` (callgrind, decode_node + read_page), format 8 -> 9: elephant_1m 1,221.7 ->
+//   1,336.8 M (+9.4 %: the plane prediction +59 M, the residual coder +58 M as more pages' positions take
+//   a coded form), refined_elephant 70.9 -> 78.2 M (+10.4 %); without the split form elephant_1m 1,282.5 M
+//   (+5.0 %) for 3,709,001 B instead of 3,599,331.
 // Normals: predicted from the decoded positions, plain or smoothed (predicted_normals.hpp).
 #pragma once
 
