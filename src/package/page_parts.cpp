@@ -42,7 +42,7 @@ void put_varint(std::vector<uint8_t>& out, uint64_t v) {
 }
 
 // The residual and connectivity parts' forms (page_parts.hpp).
-constexpr uint8_t kPlanesForm = 0, kCodedForm = 1;
+constexpr uint8_t kPlanesForm = 0, kCodedForm = 1, kSplitForm = 2;
 // The bits a residual or symbol the coded form must save over the zstd'd bytes (page_parts.hpp).
 constexpr double kMinSavedBits = 0.2;
 
@@ -65,6 +65,7 @@ std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<co
   std::array<std::vector<uint8_t>, kParts + 1> out;  // [0]: the stream sizes, [1 + p]: stream p
   const bool coded = residuals_coded(codec);
   std::vector<uint64_t> residuals[kParts];  // of kPositions and kNormals, coded
+  std::vector<uint64_t> split[2];           // the positions' component 0, and components 1 and 2
   std::vector<int64_t> signed_residuals;
   size_t at = 0;
   for (uint32_t size : node_sizes) {
@@ -87,6 +88,8 @@ std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<co
         signed_residuals.resize(s.count * s.components);
         if (s.count) read_planes(node.data() + from, s.count, s.components, s.width, signed_residuals.data());
         for (int64_t r : signed_residuals) residuals[p].push_back(zigzag(r));
+        for (size_t i = 0; p == kPositions && i < signed_residuals.size(); ++i)
+          split[i >= s.count].push_back(zigzag(signed_residuals[i]));
       }
       out[1 + p].insert(out[1 + p].end(), node.begin() + from, node.begin() + from + n[p]);
       from += n[p];
@@ -99,6 +102,14 @@ std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<co
       std::vector<uint8_t> form = {kCodedForm};
       const std::vector<uint8_t> stream = encode_residuals(residuals[p]);
       form.insert(form.end(), stream.begin(), stream.end());
+      if (p == kPositions) {  // the split form when smaller (page_parts.hpp)
+        const std::vector<uint8_t> first = encode_residuals(split[0]), rest = encode_residuals(split[1]);
+        std::vector<uint8_t> split_form = {kSplitForm};
+        put_varint(split_form, first.size());
+        split_form.insert(split_form.end(), first.begin(), first.end());
+        split_form.insert(split_form.end(), rest.begin(), rest.end());
+        if (split_form.size() < form.size()) form = std::move(split_form);
+      }
       // Coded only when it saves kMinSavedBits a residual (page_parts.hpp): not where zstd finds repeats,
       // nor where it saves too little to pay for its decode.
       const double saved_bits = 8 * (estimated_zstd_size(out[1 + p], level, min_match) - double(form.size()));
@@ -172,12 +183,22 @@ std::vector<uint8_t> decompress_page(std::span<const uint8_t> stored, uint32_t r
   if (total != r.remaining()) r.fail("page part streams do not add up to the page");
   for (size_t p = 0; p < kParts; ++p) stream[p] = r.bytes(size[p], "page part stream");
 
-  std::array<bool, kParts> coded{};  // the residual parts in the coded form
+  std::array<bool, kParts> coded{};     // the residual parts in a coded form
+  bool split = false;                   // the positions in the split form: stream[kPositions] its component 0
+  std::span<const uint8_t> split_rest;  // and its other components
   if (residuals_coded(codec))
     for (size_t p : {kPositions, kNormals}) {
       if (stream[p].empty()) continue;
-      if (stream[p][0] != kPlanesForm && stream[p][0] != kCodedForm) r.fail("invalid residual part form");
-      coded[p] = stream[p][0] == kCodedForm, stream[p] = stream[p].subspan(1);
+      const uint8_t form = stream[p][0];
+      if (form != kPlanesForm && form != kCodedForm && !(form == kSplitForm && p == kPositions))
+        r.fail("invalid residual part form");
+      coded[p] = form != kPlanesForm, stream[p] = stream[p].subspan(1);
+      if (form == kSplitForm) {
+        ByteReader s(stream[p], where);
+        const uint64_t first = s.varint();
+        if (first > s.remaining()) s.fail("split residual streams larger than their part");
+        split = true, stream[p] = s.bytes(first, "residual stream"), split_rest = s.bytes(s.remaining(), "");
+      }
     }
   if (residuals_coded(codec) && !stream[kConnectivity].empty()) {
     if (stream[kConnectivity][0] != kPlanesForm && stream[kConnectivity][0] != kCodedForm)
@@ -186,6 +207,7 @@ std::vector<uint8_t> decompress_page(std::span<const uint8_t> stored, uint32_t r
     stream[kConnectivity] = stream[kConnectivity].subspan(1);
   }
   ResidualDecoder positions(coded[kPositions] ? stream[kPositions] : std::span<const uint8_t>(), where),
+      position_rest(split_rest, where),
       normals(coded[kNormals] ? stream[kNormals] : std::span<const uint8_t>(), where);
   SymbolDecoder symbols(coded[kConnectivity] ? stream[kConnectivity] : std::span<const uint8_t>(), where);
   std::vector<uint8_t> page(raw_size);
@@ -205,7 +227,12 @@ std::vector<uint8_t> decompress_page(std::span<const uint8_t> stored, uint32_t r
         const std::optional<Planes> s =
             p == kPositions ? planes_of(n[p], b.position_low, 3) : planes_of(n[p], b.normal_low, 2);
         if (!s) headers.fail("node residuals not in byte planes");
-        (p == kPositions ? positions : normals).planes(s->count, s->components, s->width, page.data() + at);
+        if (p == kPositions && split) {
+          positions.planes(s->count, s->components, s->width, page.data() + at, 0, 1);
+          position_rest.planes(s->count, s->components, s->width, page.data() + at, 1, s->components - 1);
+        } else {
+          (p == kPositions ? positions : normals).planes(s->count, s->components, s->width, page.data() + at);
+        }
       } else {
         if (n[p] > stream[p].size() - used[p]) headers.fail("node part past its stream's end");
         std::memcpy(page.data() + at, stream[p].data() + used[p], n[p]);
@@ -215,7 +242,7 @@ std::vector<uint8_t> decompress_page(std::span<const uint8_t> stored, uint32_t r
     }
     headers.bytes(n[0], "node header");
   }
-  positions.finish(), normals.finish(), symbols.finish();
+  positions.finish(), position_rest.finish(), normals.finish(), symbols.finish();
   for (size_t p = 0; p < kParts; ++p)
     if (used[p] != stream[p].size() && !coded[p]) r.fail("page part streams hold bytes of no node");
   if (at != raw_size) r.fail("page part streams hold fewer bytes than the page");

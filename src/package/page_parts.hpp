@@ -32,6 +32,14 @@
 // about 35 instructions a symbol). The references, varints that zstd compresses to about two thirds, stay
 // bytes in a block of their own. Measured (`lodstream bake --json`, format 6 -> 7): see symbol_coder.hpp.
 //
+// Format 9: the positions' residual part may also take the split form (2): varint size of the first stream,
+// then two streams of residual_coder.hpp, the first holding component 0 of every node's residuals (with the
+// plane prediction, predictive_node.hpp, the distance from the gate triangle's plane: small), the second
+// components 1 and 2; the writer keeps it when smaller than the one stream. `lodstream bake --json`, format
+// 8 -> 9 (the plane prediction in one stream, then split): elephant_1m 3,794,801 -> 3,709,001 -> 3,599,331 B
+// (-5.2 %), refined_elephant 325,520 -> 321,226 -> 318,287 (-2.2 %), motorBike 1,628,092 -> 1,596,611 ->
+// 1,580,314 (-2.9 %).
+//
 // The regrouped bytes (the zstd frame's content): seven varints, the sizes of the seven part streams; then
 // the streams. The header stream holds, per node in page order, varint node size then the node's header; the
 // other streams the node's part, in the same order (the residual streams: the node's residuals, component

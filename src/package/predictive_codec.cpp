@@ -15,7 +15,8 @@ namespace lodstream::package {
 namespace {
 
 constexpr uint8_t kFormat = 1;
-constexpr uint32_t kAllFlags = kHasNormals | kHasUvs | kHasColors | kHasVertexData | kProgressive;
+constexpr uint32_t kAllFlags =
+    kHasNormals | kHasUvs | kHasColors | kHasVertexData | kProgressive | kPlanePrediction;
 constexpr uint32_t kNone = UINT32_MAX;
 // Triangles before a vertex's first triangle searched for the one across the parallelogram's edge.
 constexpr uint32_t kAcrossWindow = 8;

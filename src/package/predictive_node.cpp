@@ -1,6 +1,7 @@
 #include "package/predictive_node.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <iterator>
 
 #include "core/error.hpp"
@@ -26,23 +27,68 @@ inline uint64_t damped_parallelogram(uint64_t a, uint64_t b, uint64_t c, uint32_
   return uint64_t(int64_t((4 + j) * (a + b) - 2 * j * c + 4) >> 3);
 }
 
+// The plane prediction of predictive_node.hpp at the gate triangle x y z (coarse coordinates, wrapping):
+// the dominant axis d of its normal n = (x - z) x (y - z) and, for the residuals ra, rb of axes d + 1, d + 2
+// (mod 3), the offset floor(-(n[d+1] ra + n[d+2] rb) / n[d] + 1/2) of axis d's residual; d = 0 and offset 0
+// when n = 0. In doubles, the same operations in the same order for the encoder and the decoder (no
+// contraction: x86-64 has no FMA without -mfma), so both get the same bits. |n[d+1]|, |n[d+2]| <= |n[d]|, so
+// |offset| <= |ra| + |rb| + 1 and the conversion back is in range for any residuals below 2^40 (hostile
+// coordinates wrap in the cross product; any n is finite).
+struct PlaneGate {
+  double n[3];
+  uint32_t d;
+  PlaneGate(const uint64_t* x, const uint64_t* y, const uint64_t* z) {
+    const uint64_t e[2][3] = {{x[0] - z[0], x[1] - z[1], x[2] - z[2]},
+                              {y[0] - z[0], y[1] - z[1], y[2] - z[2]}};
+    n[0] = double(int64_t(e[0][1] * e[1][2] - e[0][2] * e[1][1]));
+    n[1] = double(int64_t(e[0][2] * e[1][0] - e[0][0] * e[1][2]));
+    n[2] = double(int64_t(e[0][0] * e[1][1] - e[0][1] * e[1][0]));
+    const double a0 = std::fabs(n[0]), a1 = std::fabs(n[1]), a2 = std::fabs(n[2]);
+    d = a0 >= a1 ? (a0 >= a2 ? 0 : 2) : (a1 >= a2 ? 1 : 2);
+  }
+  int64_t offset(int64_t ra, int64_t rb) const {
+    if (n[d] == 0.0) return 0;
+    const uint32_t a = d == 2 ? 0 : d + 1, b = d == 0 ? 2 : d - 1;
+    const double t = -(n[a] * double(ra) + n[b] * double(rb)) / n[d] + 0.5;
+    const int64_t i = int64_t(t);  // toward zero; floor below (no libm call)
+    return i - (t < double(i));
+  }
+};
+
 // c[v] = P + residual[v] per axis for v < V (predictive_node.hpp), wrapping, the residuals as read_planes
-// leaves them (one array per axis). One pass; returns whether a result lies outside [-kMaxCoarse,
-// kMaxCoarse).
-template <uint32_t j>
+// leaves them (one array per component), with the plane prediction when `plane`. One pass; returns whether a
+// result lies outside [-kMaxCoarse, kMaxCoarse).
+template <uint32_t j, bool plane>
 bool predict_positions(const int64_t* residual, uint32_t V, const uint32_t* o, uint64_t* c) {
-  const int64_t *rx = residual, *ry = rx + V, *rz = ry + V;
+  const int64_t *r0 = residual, *r1 = r0 + V, *r2 = r1 + V;
   uint64_t shifted = 0;  // OR of c + kMaxCoarse: in range while below 2 kMaxCoarse
   for (uint32_t v = 0; v < V; ++v, o += 3) {
     const uint64_t *x = c + 3 * size_t(o[0]), *y = c + 3 * size_t(o[1]), *z = c + 3 * size_t(o[2]);
     uint64_t* to = c + 3 * size_t(v);
-    to[0] = damped_parallelogram(x[0], y[0], z[0], j) + uint64_t(rx[v]);
-    to[1] = damped_parallelogram(x[1], y[1], z[1], j) + uint64_t(ry[v]);
-    to[2] = damped_parallelogram(x[2], y[2], z[2], j) + uint64_t(rz[v]);
+    if constexpr (plane) {
+      const PlaneGate gate(x, y, z);
+      const uint32_t d = gate.d, a = d == 2 ? 0 : d + 1, b = d == 0 ? 2 : d - 1;
+      uint64_t r[3];
+      r[a] = uint64_t(r1[v]), r[b] = uint64_t(r2[v]),
+      r[d] = uint64_t(r0[v]) + uint64_t(gate.offset(r1[v], r2[v]));
+      to[0] = damped_parallelogram(x[0], y[0], z[0], j) + r[0];
+      to[1] = damped_parallelogram(x[1], y[1], z[1], j) + r[1];
+      to[2] = damped_parallelogram(x[2], y[2], z[2], j) + r[2];
+    } else {
+      to[0] = damped_parallelogram(x[0], y[0], z[0], j) + uint64_t(r0[v]);
+      to[1] = damped_parallelogram(x[1], y[1], z[1], j) + uint64_t(r1[v]);
+      to[2] = damped_parallelogram(x[2], y[2], z[2], j) + uint64_t(r2[v]);
+    }
     shifted |=
         (to[0] + uint64_t(kMaxCoarse)) | (to[1] + uint64_t(kMaxCoarse)) | (to[2] + uint64_t(kMaxCoarse));
   }
   return shifted >= 2 * uint64_t(kMaxCoarse);
+}
+
+template <uint32_t j>
+bool predict_positions(bool plane, const int64_t* residual, uint32_t V, const uint32_t* o, uint64_t* c) {
+  return plane ? predict_positions<j, true>(residual, V, o, c)
+               : predict_positions<j, false>(residual, V, o, c);
 }
 
 // Bits of a zigzagged residual (0 for 0): the encoder's estimate of what a damping costs.
@@ -119,24 +165,33 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
   PredictiveResiduals r;
   std::vector<int64_t> c(n.c);
   c.insert(c.end(), std::begin(n.cmin), std::end(n.cmin));
-  // The damping j whose residuals take the fewest bits (ties: the larger j).
+  // The damping j and plane prediction whose residuals take the fewest bits (ties: the larger j, no plane).
   uint64_t fewest = UINT64_MAX;
   std::vector<uint64_t> residuals(3 * V);
-  for (uint32_t j = 4; j >= 2; --j) {
-    uint64_t bits = 0, largest = 0;
-    for (size_t v = 0; v < V; ++v) {
-      const uint32_t* o = &predictors[3 * v];
-      for (int a = 0; a < 3; ++a) {
-        const int64_t predicted =
-            int64_t(damped_parallelogram(uint64_t(c[3 * size_t(o[0]) + a]), uint64_t(c[3 * size_t(o[1]) + a]),
-                                         uint64_t(c[3 * size_t(o[2]) + a]), j));
-        residuals[3 * v + a] = zigzag(c[3 * v + a] - predicted);
-        bits += residual_bits(residuals[3 * v + a]), largest = std::max(largest, residuals[3 * v + a]);
+  const uint64_t* cu = reinterpret_cast<const uint64_t*>(c.data());
+  for (bool plane : {false, true})
+    for (uint32_t j = 4; j >= 2; --j) {
+      uint64_t bits = 0, largest = 0;
+      for (size_t v = 0; v < V; ++v) {
+        const uint32_t* o = &predictors[3 * v];
+        const uint64_t *x = cu + 3 * size_t(o[0]), *y = cu + 3 * size_t(o[1]), *z = cu + 3 * size_t(o[2]);
+        int64_t d[3];
+        for (int a = 0; a < 3; ++a) d[a] = c[3 * v + a] - int64_t(damped_parallelogram(x[a], y[a], z[a], j));
+        if (plane) {  // components (d - offset, d + 1, d + 2) of the dominant axis d
+          const PlaneGate gate(x, y, z);
+          const uint32_t g = gate.d, a = g == 2 ? 0 : g + 1, b = g == 0 ? 2 : g - 1;
+          const int64_t e = d[g] - gate.offset(d[a], d[b]), ra = d[a], rb = d[b];
+          d[0] = e, d[1] = ra, d[2] = rb;
+        }
+        for (int a = 0; a < 3; ++a) {
+          residuals[3 * v + a] = zigzag(d[a]);
+          bits += residual_bits(residuals[3 * v + a]), largest = std::max(largest, residuals[3 * v + a]);
+        }
       }
+      if (bits < fewest)
+        fewest = bits, r.damping = j, r.plane = plane, r.position_bytes = bytes_for(largest),
+        r.positions = residuals;
     }
-    if (bits < fewest)
-      fewest = bits, r.damping = j, r.position_bytes = bytes_for(largest), r.positions = residuals;
-  }
   if (g.mesh->has_normals()) {
     std::vector<glm::vec3> decoded(V + 1);  // predicted_normals reads one past the last
     decode_positions(n.c, LockedStream::parse(locked_stream, V, g.position_shift, "node codec"), grid,
@@ -154,7 +209,9 @@ std::vector<uint8_t> write_predictive_node(const NodeHeader& header, const Predi
                                            std::span<const uint8_t> connectivity,
                                            std::span<const uint8_t> tail) {
   ByteWriter w;
-  header.write(w);
+  NodeHeader h = header;
+  if (r.plane) h.flags |= kPlanePrediction;
+  h.write(w);
   w.u8(static_cast<uint8_t>(r.position_bytes | r.smooth_normals << 3 | r.normal_bytes << 4 |
                             (4 - r.damping) << 6));
   w.varint(attribute_stream.size());
@@ -184,10 +241,11 @@ void decode_predicted_vertices(const PredictiveNode& p, std::span<const uint32_t
   thread_local std::vector<int64_t> residual;
   residual.resize(3 * size_t(V));
   read_planes(p.position_planes.data(), V, 3, p.position_bytes, residual.data());
-  const bool out_of_range = p.damping == 4 ? predict_positions<4>(residual.data(), V, predictors.data(), cu)
-                            : p.damping == 3
-                                ? predict_positions<3>(residual.data(), V, predictors.data(), cu)
-                                : predict_positions<2>(residual.data(), V, predictors.data(), cu);
+  const bool plane = p.flags & kPlanePrediction;
+  const bool out_of_range =
+      p.damping == 4   ? predict_positions<4>(plane, residual.data(), V, predictors.data(), cu)
+      : p.damping == 3 ? predict_positions<3>(plane, residual.data(), V, predictors.data(), cu)
+                       : predict_positions<2>(plane, residual.data(), V, predictors.data(), cu);
   if (out_of_range) throw Error(where + ": predicted position out of the grid's range");
   // Decoded into scratch and copied (no zero-fill of m.positions first); one spare entry for
   // predicted_normals.

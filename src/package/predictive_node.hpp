@@ -16,7 +16,26 @@
 //   are irregular and predict better with j = 3 or 2: measured on elephant_1m, levels 1-10 store 3-5 % fewer
 //   position bits). Predictors o1, o2, o lie below v; the codec derives them from the connectivity; a single
 //   predictor x is (x, x, x) (P = x for every j), and index V stands for cmin (no predictor). The residuals
-//   are zigzag-mapped, byte b of axis a at plane 3b + a (byte_planes.hpp).
+//   are zigzag-mapped, byte b of component a at plane 3b + a (byte_planes.hpp); component a is axis a's
+//   residual, but in a node flagged kPlanePrediction.
+// Plane prediction (kPlanePrediction, chosen per node by the encoder with j, whichever residuals take the
+//   fewest bits): P lies in the plane of the gate triangle o1 o2 o, and on a smooth surface v lies near that
+//   plane however far it lies from P along it (the vertices of simplified levels sit at quadric-optimal
+//   points, off the parallelogram along the surface). With n = (c[o1] - c[o]) x (c[o2] - c[o]), d its
+//   dominant axis (the first of the largest |n[a]|), a = d + 1 and b = d + 2 (mod 3), r = c[v] - P: the
+//   components are (r[d] - offset, r[a], r[b]), offset = floor(-(n[a] r[a] + n[b] r[b]) / n[d] + 1/2), that
+//   is r[d] predicted so that r lies in the plane (a lifting step: exact in integers, whatever the rounding);
+//   d = 0 and offset 0 when n = 0 (single predictors). Component 0 is then the distance from the plane
+//   (along d) and small, the page codes it in a stream of its own (page_parts.hpp, the split form).
+//   Measured offline before building it (elephant_1m's levels >= 1, residual symbols' order-0 entropy per
+//   vertex): 17.36 bits plain, 16.20 with the plane prediction in one stream, 15.08 with component 0 in a
+//   stream of its own (a rotation into the plane's frame: 15.02); level 0 (Loop-subdivided, regular) 4.65
+//   plain, 4.94 plane; refined_elephant's levels >= 1 22.75 / 21.87 / 21.29. Decode cost: about 70
+//   instructions a plane-predicted vertex (the cross product, the dominant axis, a division). `lodstream
+//   bench decode --runs 1` (callgrind, decode_node + read_page), format 8 -> 9: elephant_1m 1,221.7 ->
+//   1,336.8 M (+9.4 %: the plane prediction +59 M, the residual coder +58 M as more pages' positions take
+//   a coded form), refined_elephant 70.9 -> 78.2 M (+10.4 %); without the split form elephant_1m 1,282.5 M
+//   (+5.0 %) for 3,709,001 B instead of 3,599,331.
 // Normals: predicted from the decoded positions, plain or smoothed (predicted_normals.hpp).
 #pragma once
 
@@ -29,6 +48,9 @@
 #include "package/node_header.hpp"
 
 namespace lodstream::package {
+
+// Header flag (node_header.hpp) of a node whose positions use the plane prediction (above).
+constexpr uint32_t kPlanePrediction = 16;
 
 struct PredictiveNode : NodeHeader {
   uint32_t position_bytes = 0, normal_bytes = 0;
@@ -56,6 +78,7 @@ struct PredictiveResiduals {
   std::vector<uint64_t> positions, normals;
   uint32_t position_bytes = 0, normal_bytes = 0;
   uint32_t damping = 4;  // j
+  bool plane = false;    // kPlanePrediction
   bool smooth_normals = false;
 };
 PredictiveResiduals predictive_residuals(const NodeGeometry& geometry, const QuantizedNode& node,

@@ -175,12 +175,14 @@ void ResidualDecoder::fail(const char* what) const {
   throw Error(where_ + ": " + what);
 }
 
-void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, uint8_t* planes) {
+void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, uint8_t* planes,
+                             uint32_t first, uint32_t taken) {
   if (count == 0) return;
   if (slot_.empty()) fail("residuals past the residual stream's end");
-  const size_t values = components * count;
+  const size_t values = taken * count, stride = components * count;  // stride: from one plane to the next
+  planes += first * count;
   // The higher planes are zero but for values of raw bits, which write their higher bytes themselves.
-  std::memset(planes + values, 0, (width - 1) * values);
+  for (uint32_t b = 1; b < width; ++b) std::memset(planes + b * stride, 0, values);
   // The decoder's state in locals (registers) for the loop, written back after it; x0 decodes next.
   const uint32_t* slots = slot_.data();
   const uint8_t* bytes = bytes_.data();
@@ -209,7 +211,7 @@ void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, 
       const uint64_t z = uint64_t(1) << n | ((word >> (raw_at & 7)) & ((uint64_t(1) << n) - 1));
       raw_at += n;
       if (z > largest) fail("residual wider than its node's planes");
-      for (uint32_t b = 0; b < width; ++b) planes[b * values + i] = uint8_t(z >> (8 * b));
+      for (uint32_t b = 0; b < width; ++b) planes[b * stride + i] = uint8_t(z >> (8 * b));
     }
   };
   // Values in blocks of kStates, then one by one, rotating the states. A block reads at most 8 bytes:

@@ -52,11 +52,16 @@ class ResidualDecoder {
  public:
   // Parses the table. Cost: O(2^12) (the decode table, 16 KB) and a copy of the stream.
   ResidualDecoder(std::span<const uint8_t> stream, const std::string& where);
-  // The next count * components values, component by component, as `width` byte planes (put_planes'
-  // layout: byte b of component a of value i at planes[(b * components + a) * count + i]); a value needing
-  // more than 8 width bytes throws. Cost: O(count * components * width); about 25 instructions a direct
+  // The next count * taken values, components first .. first + taken - 1 of `components` one after the
+  // other, as `width` byte planes (put_planes' layout: byte b of component a of value i at
+  // planes[(b * components + a) * count + i]; the other components' planes are left as they are); a value
+  // needing more than `width` bytes throws. Cost: O(count * taken * width); about 25 instructions a direct
   // value.
-  void planes(size_t count, uint32_t components, uint32_t width, uint8_t* planes);
+  void planes(size_t count, uint32_t components, uint32_t width, uint8_t* planes, uint32_t first,
+              uint32_t taken);
+  void planes(size_t count, uint32_t components, uint32_t width, uint8_t* planes) {
+    this->planes(count, components, width, planes, 0, components);
+  }
   // Throws unless every byte and bit of the stream was used and the states are back to their start.
   void finish() const;
 

@@ -14,7 +14,8 @@ namespace {
 
 constexpr uint8_t kFormat = 2;
 constexpr uint8_t kOrderedFormat = 1;  // codec 2's bytes
-constexpr uint32_t kAllFlags = kHasNormals | kHasUvs | kHasColors | kHasVertexData | kClusters;
+constexpr uint32_t kAllFlags =
+    kHasNormals | kHasUvs | kHasColors | kHasVertexData | kClusters | kPlanePrediction;
 
 const PredictiveCodec& ordered_codec() {
   static const PredictiveCodec codec;

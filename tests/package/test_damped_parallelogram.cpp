@@ -28,7 +28,7 @@ Mesh jittered_grid(int n, uint32_t seed) {
 }
 
 uint32_t damping_of(std::span<const uint8_t> node, uint8_t format) {
-  return PredictiveNode::parse(node, format, 15, "node").damping;
+  return PredictiveNode::parse(node, format, 15 | kPlanePrediction, "node").damping;
 }
 
 class DampedParallelogram : public ::testing::TestWithParam<uint32_t> {};
@@ -71,7 +71,7 @@ TEST(DampedParallelogram, AnInvalidDampingIsAnError) {
   const NodeCodec& codec = node_codec(TraversalCodec::kId);
   std::vector<uint8_t> node = codec.encode(g, pg);
   ByteReader r(node, "node");
-  NodeHeader::read(r, 2, 15, node.size());
+  NodeHeader::read(r, 2, 15 | kPlanePrediction, node.size());
   const size_t at = r.position();  // the widths byte follows the common header
   ASSERT_EQ(node[at] >> 6, 4 - damping_of(node, 2));
   node[at] |= 3 << 6;  // j = 1

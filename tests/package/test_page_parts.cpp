@@ -125,7 +125,7 @@ TEST(PageParts, NoisyResidualsAreStoredCodedAndSmaller) {
     EXPECT_EQ(decompress_page(stored, uint32_t(page.bytes.size()), codec, "page"), page.bytes);
     // Positions coded; the normals, coded in the frame of their prediction (predicted_normals.hpp), are
     // spread so evenly here that the coded form saves under kMinSavedBits on them: either form.
-    EXPECT_EQ(residual_forms(content(stored)).first, 1u) << "codec " << id;
+    EXPECT_GE(residual_forms(content(stored)).first, 1u) << "codec " << id;  // coded, one stream or split
     EXPECT_LT(stored.size(), zstd_compress(page.bytes, 9, 6).size());
   }
 }
@@ -146,7 +146,7 @@ TEST(PageParts, HostileRegroupedBytesAreErrorsOrPagesOfTheRightSize) {
   const uint32_t raw_size = uint32_t(page.bytes.size());
   const std::vector<uint8_t> good = content(compress_page(page.bytes, page.node_sizes, codec, 9, 6));
   ASSERT_NE(good.size(), raw_size);
-  ASSERT_EQ(residual_forms(good).first, 1u);
+  ASSERT_GE(residual_forms(good).first, 1u);
   auto unpack = [&](const std::vector<uint8_t>& regrouped) {
     return decompress_page(zstd_compress(regrouped, 1), raw_size, codec, "page 7");
   };
@@ -170,7 +170,7 @@ TEST(PageParts, HostileRegroupedBytesAreErrorsOrPagesOfTheRightSize) {
   expect_error(bad, "stream sizes");
   expect_error(std::vector<uint8_t>(2 * size_t(raw_size) + 65, 0), "larger than any regrouping");
   bad = good;
-  bad[form_at(good, 1)] = 2;  // the positions' form: neither
+  bad[form_at(good, 1)] = 3;  // the positions' form: none of the three
   expect_error(bad, "residual part form");
 
   std::mt19937 rng(7);
