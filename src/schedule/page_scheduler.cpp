@@ -216,13 +216,38 @@ void add_hlod_exchange(const package::PackageScene& scene, const NodeSource& rec
   e.secondary = std::max(e.secondary, v.weight * std::min(p_error_px, 1e300));
 }
 
+// How many levels member_gain looks below a member that keeps its parents' error.
+constexpr int kLookahead = 12;
+
+// The projected error a member r of G leaves once refined as far as it must be to lower its error: r's own,
+// or, when r keeps its parents' error (error_g = max of its inputs' carries a fallback's error up unchanged),
+// the largest of its children's, and so on for up to kLookahead levels while the records are known. Such a
+// member removes nothing by itself and the exchange below it cannot be ranked until it is held, so by its own
+// gain a chain of them ranked last by benefit per byte and stalled. City (bench stream gen:fly, 10 Mbit/s 80
+// ms): push / oracle to benefit 0.95 0.93 / 0.90 -> 0.83 / 0.80 s (at group ratio 0.4: 1.40 / 1.37 -> 1.30 /
+// 1.27, behind a 30 px node whose children kept its error 22.4); motorBike and elephant_1m unchanged.
+double refined_error_px(const package::PackageScene& scene, const NodeSource& records, uint32_t object,
+                        const package::NodeRecord& r, const View& view) {
+  const package::NodeRecord* at = &r;
+  for (int depth = 0; depth < kLookahead && at->error >= at->parent_error && !at->children.empty(); ++depth) {
+    const package::NodeRecord* worst = nullptr;
+    for (uint32_t c : at->children) {
+      const package::NodeRecord* child = records.record(c);
+      if (!child) return projected_error(scene, object, *at, view);
+      if (!worst || child->error > worst->error) worst = child;
+    }
+    at = worst;
+  }
+  return projected_error(scene, object, *at, view);
+}
+
 // The log gain of replacing P (projected error `p_error_px`) by the members `g` of `object`: the mean over
 // the members, weighted by the screen area of each member's sphere (unweighted when none has any), of
-// ln(max(e_P, tau) / max(e_g, tau)). G's members come from different groups, so their errors differ: a member
-// that is refined further (e_g close to e_P) gains nearly nothing, its siblings may gain much. The gain of
-// one member chosen by id order made an exchange worth nothing when its first member was the nearly-useless
-// one (city, mixed-precision records: a chain of five such exchanges under 20 px held the oracle at benefit
-// 0.92 for 0.7 s). Cost: O(|G|).
+// ln(max(e_P, tau) / max(e_g, tau)), e_g as refined_error_px. G's members come from different groups, so
+// their errors differ: a member that is refined further (e_g close to e_P) gains nearly nothing, its siblings
+// may gain much. The gain of one member chosen by id order made an exchange worth nothing when its first
+// member was the nearly-useless one (city, mixed-precision records: a chain of five such exchanges under 20
+// px held the oracle at benefit 0.92 for 0.7 s). Cost: O(|G|).
 double member_gain(const package::PackageScene& scene, const NodeSource& records, uint32_t object,
                    const std::vector<uint32_t>& g, const View& view, double p_error_px, double tau) {
   if (g.empty()) return 0.0;
@@ -231,8 +256,8 @@ double member_gain(const package::PackageScene& scene, const NodeSource& records
   double weighted = 0.0, weight = 0.0, plain = 0.0;
   for (uint32_t n : g) {
     const package::NodeRecord& r = *records.record(n);
-    const double gain =
-        std::log(std::max(p_error_px, tau) / std::max(projected_error(scene, object, r, view), tau));
+    const double gain = std::log(std::max(p_error_px, tau) /
+                                 std::max(refined_error_px(scene, records, object, r, view), tau));
     const double a = projected_area(to_world(r.sphere, transform, scale), view);
     weighted += a * gain, weight += a, plain += gain;
   }

@@ -211,6 +211,48 @@ TEST(PageScheduler, AnExchangeIsWorthWhatAllItsMembersGainWhicheverComesFirst) {
   }
 }
 
+TEST(PageScheduler, AGroupThatKeepsItsParentsErrorIsWorthWhatTheLevelBelowItGains) {
+  // Two objects as above, each a root P of error 1 (about 60 px). Object 0's G (nodes 2-4) keeps P's error
+  // (a fallback's error carried up by error_g = max of its inputs) and is refined by G' (nodes 8-10, exact);
+  // object 1's G (nodes 5-7) has error 0.13 (about 8 px). Taking object 0's G removes nothing by itself but
+  // is the only way to its exact level, so it comes first (by its own gain it came last and stalled).
+  std::vector<package::NodeRecord> records(11);
+  package::PackageScene scene;
+  auto node = [&](uint32_t id, uint32_t object, float error, float radius) -> package::NodeRecord& {
+    package::NodeRecord& r = records[id];
+    r.representation = object;
+    r.triangles = 10;
+    r.error = error;
+    r.sphere = {{0.0f, 0.0f, 0.0f}, radius};
+    return r;
+  };
+  auto group = [&](std::vector<uint32_t> parents, std::vector<uint32_t> children) {
+    for (uint32_t c : children) {
+      records[c].parents = parents;
+      records[c].parent_error = records[parents[0]].error;
+      records[c].parent_sphere = records[parents[0]].sphere;
+    }
+    for (uint32_t p : parents) records[p].children = children;
+  };
+  for (uint32_t i = 0; i < 2; ++i) {
+    node(i, i, 1.0f, 1.0f).level = 2;
+    for (uint32_t k = 0; k < 3; ++k) node(2 + 3 * i + k, i, i == 0 ? 1.0f : 0.13f, 0.6f).level = 1;
+    group({i}, {2 + 3 * i, 3 + 3 * i, 4 + 3 * i});
+    add_object_beside_the_axis(scene, i);
+  }
+  for (uint32_t k = 0; k < 3; ++k) node(8 + k, 0, 0.0f, 0.4f);
+  group({2, 3, 4}, {8, 9, 10});
+  auto reader = write_package("keeps.lods", records, scene, 11, [](uint32_t) -> size_t { return 500; });
+  PageScheduler s(reader.root());
+  PackageRecords all(reader);
+  const WeightedView views[] = {{look({0, 0, 0}, {0, 0, -1}), 1.0, 0.0}};
+  const auto order = drain(s, reader.scene(), all, views, 1.0, 1);
+  ASSERT_EQ(order.size(), 11u);
+  const size_t kept = position(order, PageKind::data, all.record(2)->page);
+  const size_t coarse = position(order, PageKind::data, all.record(5)->page);
+  EXPECT_LT(kept, coarse);
+}
+
 TEST(PageScheduler, WithAMovingCameraThePagesForWhereItWillBeArriveSooner) {
   // The camera flies along the DAG (x from 0 to 16 at 4 units per second, 1.5 units away); each 0.1 s the
   // link delivers 4 pages. The view it will have at t = 2 s (x = 8) is complete sooner when the scheduler
