@@ -65,8 +65,9 @@ struct DagOptions {
   // of 16 clusters (-6.3 %) 21-31 % more: a coarser unit of selection refines more than it needs.
   // Measured again with errors from carried radii (tighter at coarse levels), 0.4 against 0.45 with summed
   // errors: elephant_5m 2.551 -> 2.269 B per input triangle and fewer drawn (1,428k / 642k / 217k -> 1,289k /
-  // 538k / 203k), motorBike -6.8 % (+6..+9 % drawn), but the city's push / oracle reach benefit 0.95 at 1.40 /
-  // 1.37 s instead of 0.93 / 0.87 (its buildings object's errors at levels 4-8 grow to 77-150 against <= 22).
+  // 538k / 203k), motorBike -6.8 % (+6..+9 % drawn), but the city's push / oracle reach benefit 0.95 at 1.40
+  // / 1.37 s instead of 0.93 / 0.87 (its buildings object's errors at levels 4-8 grow to 77-150 against <=
+  // 22).
   size_t max_cluster_triangles = 128;  // divisible by 4, at most 512 (meshoptimizer's meshlet limit)
   size_t max_cluster_vertices = 128;   // at most 255
   size_t group_clusters = 8;           // target clusters per group
