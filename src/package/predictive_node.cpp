@@ -165,33 +165,49 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
   PredictiveResiduals r;
   std::vector<int64_t> c(n.c);
   c.insert(c.end(), std::begin(n.cmin), std::end(n.cmin));
-  // The damping j and plane prediction whose residuals take the fewest bits (ties: the larger j, no plane).
-  uint64_t fewest = UINT64_MAX;
-  std::vector<uint64_t> residuals(3 * V);
+  // The damping j and plane prediction whose residuals take the fewest bits (ties: the larger j, no plane):
+  // one pass per j counts both (the gate's plane does not depend on j), then the choice's residuals.
   const uint64_t* cu = reinterpret_cast<const uint64_t*>(c.data());
-  for (bool plane : {false, true})
-    for (uint32_t j = 4; j >= 2; --j) {
-      uint64_t bits = 0, largest = 0;
-      for (size_t v = 0; v < V; ++v) {
-        const uint32_t* o = &predictors[3 * v];
-        const uint64_t *x = cu + 3 * size_t(o[0]), *y = cu + 3 * size_t(o[1]), *z = cu + 3 * size_t(o[2]);
-        int64_t d[3];
-        for (int a = 0; a < 3; ++a) d[a] = c[3 * v + a] - int64_t(damped_parallelogram(x[a], y[a], z[a], j));
-        if (plane) {  // components (d - offset, d + 1, d + 2) of the dominant axis d
-          const PlaneGate gate(x, y, z);
-          const uint32_t g = gate.d, a = g == 2 ? 0 : g + 1, b = g == 0 ? 2 : g - 1;
-          const int64_t e = d[g] - gate.offset(d[a], d[b]), ra = d[a], rb = d[b];
-          d[0] = e, d[1] = ra, d[2] = rb;
-        }
-        for (int a = 0; a < 3; ++a) {
-          residuals[3 * v + a] = zigzag(d[a]);
-          bits += residual_bits(residuals[3 * v + a]), largest = std::max(largest, residuals[3 * v + a]);
-        }
-      }
-      if (bits < fewest)
-        fewest = bits, r.damping = j, r.plane = plane, r.position_bytes = bytes_for(largest),
-        r.positions = residuals;
+  std::vector<PlaneGate> gates;
+  gates.reserve(V);
+  for (size_t v = 0; v < V; ++v) {
+    const uint32_t* o = &predictors[3 * v];
+    gates.emplace_back(cu + 3 * size_t(o[0]), cu + 3 * size_t(o[1]), cu + 3 * size_t(o[2]));
+  }
+  // Vertex v's zigzagged residuals at damping j: plain, and on the plane (components (d - offset, d + 1,
+  // d + 2) of the gate's dominant axis d).
+  auto residuals_at = [&](size_t v, uint32_t j, uint64_t* plain, uint64_t* lifted) {
+    const uint32_t* o = &predictors[3 * v];
+    const uint64_t *x = cu + 3 * size_t(o[0]), *y = cu + 3 * size_t(o[1]), *z = cu + 3 * size_t(o[2]);
+    int64_t d[3];
+    for (int a = 0; a < 3; ++a) d[a] = c[3 * v + a] - int64_t(damped_parallelogram(x[a], y[a], z[a], j));
+    const PlaneGate& gate = gates[v];
+    const uint32_t k = gate.d, a = k == 2 ? 0 : k + 1, b = k == 0 ? 2 : k - 1;
+    const int64_t e[3] = {d[k] - gate.offset(d[a], d[b]), d[a], d[b]};
+    for (int i = 0; i < 3; ++i) plain[i] = zigzag(d[i]), lifted[i] = zigzag(e[i]);
+  };
+  uint64_t bits[2][5] = {}, largest[2][5] = {};  // [plane][j]
+  for (uint32_t j = 4; j >= 2; --j)
+    for (size_t v = 0; v < V; ++v) {
+      uint64_t z[2][3];
+      residuals_at(v, j, z[0], z[1]);
+      for (int plane = 0; plane < 2; ++plane)
+        for (int i = 0; i < 3; ++i)
+          bits[plane][j] += residual_bits(z[plane][i]),
+              largest[plane][j] = std::max(largest[plane][j], z[plane][i]);
     }
+  uint64_t fewest = UINT64_MAX;
+  for (int plane = 0; plane < 2; ++plane)
+    for (uint32_t j = 4; j >= 2; --j)
+      if (bits[plane][j] < fewest)
+        fewest = bits[plane][j], r.damping = j, r.plane = plane,
+        r.position_bytes = bytes_for(largest[plane][j]);
+  r.positions.resize(3 * V);
+  for (size_t v = 0; v < V; ++v) {
+    uint64_t z[2][3];
+    residuals_at(v, r.damping, z[0], z[1]);
+    std::copy_n(z[r.plane], 3, &r.positions[3 * v]);
+  }
   if (g.mesh->has_normals()) {
     std::vector<glm::vec3> decoded(V + 1);  // predicted_normals reads one past the last
     decode_positions(n.c, LockedStream::parse(locked_stream, V, g.position_shift, "node codec"), grid,
