@@ -216,8 +216,10 @@ void add_hlod_exchange(const package::PackageScene& scene, const NodeSource& rec
   e.secondary = std::max(e.secondary, v.weight * std::min(p_error_px, 1e300));
 }
 
-// How many levels member_gain looks below a member that keeps its parents' error.
+// How many levels member_gain looks below a member that keeps its parents' error, and what "keeps" means:
+// within 1 % (the carried error comes back a few ulps to 0.002 % apart through the levels' max of radii).
 constexpr int kLookahead = 12;
+constexpr double kKeeps = 0.99;
 
 // The projected error a member r of G leaves once refined as far as it must be to lower its error: r's own,
 // or, when r keeps its parents' error (error_g = max of its inputs' carries a fallback's error up unchanged),
@@ -229,7 +231,8 @@ constexpr int kLookahead = 12;
 double refined_error_px(const package::PackageScene& scene, const NodeSource& records, uint32_t object,
                         const package::NodeRecord& r, const View& view) {
   const package::NodeRecord* at = &r;
-  for (int depth = 0; depth < kLookahead && at->error >= at->parent_error && !at->children.empty(); ++depth) {
+  for (int depth = 0; depth < kLookahead && at->error >= kKeeps * at->parent_error && !at->children.empty();
+       ++depth) {
     const package::NodeRecord* worst = nullptr;
     for (uint32_t c : at->children) {
       const package::NodeRecord* child = records.record(c);

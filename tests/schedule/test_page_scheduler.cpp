@@ -211,11 +211,12 @@ TEST(PageScheduler, AnExchangeIsWorthWhatAllItsMembersGainWhicheverComesFirst) {
   }
 }
 
-TEST(PageScheduler, AGroupThatKeepsItsParentsErrorIsWorthWhatTheLevelBelowItGains) {
-  // Two objects as above, each a root P of error 1 (about 60 px). Object 0's G (nodes 2-4) keeps P's error
-  // (a fallback's error carried up by error_g = max of its inputs) and is refined by G' (nodes 8-10, exact);
-  // object 1's G (nodes 5-7) has error 0.13 (about 8 px). Taking object 0's G removes nothing by itself but
-  // is the only way to its exact level, so it comes first (by its own gain it came last and stalled).
+// Two objects as above, each a root P of error 1 (about 60 px). Object 0's G (nodes 2-4) keeps P's error
+// (`kept_error`: a fallback's error carried up by error_g = max of its inputs) and is refined by G' (nodes
+// 8-10, exact); object 1's G (nodes 5-7) has error 0.13 (about 8 px). Returns whether object 0's G comes
+// before object 1's.
+namespace {
+bool kept_group_comes_first(float kept_error) {
   std::vector<package::NodeRecord> records(11);
   package::PackageScene scene;
   auto node = [&](uint32_t id, uint32_t object, float error, float radius) -> package::NodeRecord& {
@@ -236,7 +237,7 @@ TEST(PageScheduler, AGroupThatKeepsItsParentsErrorIsWorthWhatTheLevelBelowItGain
   };
   for (uint32_t i = 0; i < 2; ++i) {
     node(i, i, 1.0f, 1.0f).level = 2;
-    for (uint32_t k = 0; k < 3; ++k) node(2 + 3 * i + k, i, i == 0 ? 1.0f : 0.13f, 0.6f).level = 1;
+    for (uint32_t k = 0; k < 3; ++k) node(2 + 3 * i + k, i, i == 0 ? kept_error : 0.13f, 0.6f).level = 1;
     group({i}, {2 + 3 * i, 3 + 3 * i, 4 + 3 * i});
     add_object_beside_the_axis(scene, i);
   }
@@ -247,10 +248,23 @@ TEST(PageScheduler, AGroupThatKeepsItsParentsErrorIsWorthWhatTheLevelBelowItGain
   PackageRecords all(reader);
   const WeightedView views[] = {{look({0, 0, 0}, {0, 0, -1}), 1.0, 0.0}};
   const auto order = drain(s, reader.scene(), all, views, 1.0, 1);
-  ASSERT_EQ(order.size(), 11u);
-  const size_t kept = position(order, PageKind::data, all.record(2)->page);
-  const size_t coarse = position(order, PageKind::data, all.record(5)->page);
-  EXPECT_LT(kept, coarse);
+  EXPECT_EQ(order.size(), 11u);
+  return position(order, PageKind::data, all.record(2)->page) <
+         position(order, PageKind::data, all.record(5)->page);
+}
+}  // namespace
+
+TEST(PageScheduler, AGroupThatKeepsItsParentsErrorIsWorthWhatTheLevelBelowItGains) {
+  // Taking object 0's G removes nothing by itself but is the only way to its exact level, so it comes first
+  // (by its own gain it came last and stalled).
+  EXPECT_TRUE(kept_group_comes_first(1.0f));
+}
+
+TEST(PageScheduler, AGroupWithinAPercentOfItsParentsErrorKeepsIt) {
+  // The carried error comes back a few ulps below its parents' through the levels (city at group ratio 0.4:
+  // 22.4272 under 22.4277); such a G removes nothing either (a strict comparison stalled the city's oracle
+  // at benefit 0.915 for 0.5 s).
+  EXPECT_TRUE(kept_group_comes_first(0.9999f));
 }
 
 TEST(PageScheduler, WithAMovingCameraThePagesForWhereItWillBeArriveSooner) {
