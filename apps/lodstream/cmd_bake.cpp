@@ -74,7 +74,7 @@ using namespace package;
 
 // Meshes of at most this many triangles become progressive meshes (hierarchy/progressive_steps.hpp), larger
 // ones cluster DAGs. Why 2048: as a DAG such a mesh is 16 clusters, 3-4 levels and about 2 x 2048 stored
-// triangles (1.8 x since the group ratio is 0.45; the figures below were measured at 0.5), ~20 KB encoded:
+// triangles (1.67 x since the group ratio is 0.4; the figures below were measured at 0.5), ~20 KB encoded:
 // less than one 48 KB page, so the DAG's per-cluster selection buys nothing (a page is what travels), while a
 // progressive mesh stores each triangle once and streams it in about 3 steps (base, then doubling). Measured
 // (bench stream gen:fly, 10 Mbit/s 80 ms, push time to benefit 0.95): motorBike 2.10 s all-DAG, 2.03 s at

@@ -3,7 +3,7 @@
 //   level 0: the mesh split into clusters of at most 128 triangles (clusterize.hpp);
 //   each level: the active clusters are partitioned into groups of about 8 neighbours (METIS on the cluster
 //   adjacency weighted by shared edges, group_partition.hpp); each group is merged and simplified to about
-//   group_ratio (0.45) of its triangles with its outer border locked (positions shared with clusters of other
+//   group_ratio (0.4) of its triangles with its outer border locked (positions shared with clusters of other
 //   groups, and the mesh's own open boundary), and the result is split into new clusters (once the active
 //   clusters hold at most 2 * group_clusters * max_cluster_triangles triangles, they form one group); repeat
 //   until the active clusters hold at most `root_triangles` triangles (or one cluster), or no group of a
@@ -67,11 +67,18 @@ struct DagOptions {
   // errors: elephant_5m 2.551 -> 2.269 B per input triangle and fewer drawn (1,428k / 642k / 217k -> 1,289k /
   // 538k / 203k), motorBike -6.8 % (+6..+9 % drawn), but the city's push / oracle reach benefit 0.95 at 1.40
   // / 1.37 s instead of 0.93 / 0.87 (its buildings object's errors at levels 4-8 grow to 77-150 against <=
-  // 22).
+  // 22). The stall was the scheduler's (page_scheduler.cpp: a chain of groups that keep a fallback's error,
+  // compared strictly where the carried error comes back 0.002 % lower); with that fixed, 0.4 against 0.45
+  // (format 9, bench stream as above, sse-pull / push / oracle to benefit 0.95): city 21,640,103 ->
+  // 20,080,919 B, 1.40 / 0.83 / 0.77 -> 1.43 / 0.80 / 0.73 s; motorBike 1,585,487 -> 1,475,160 B, 1.07 / 1.00
+  // / 0.93 -> 1.00 / 0.97 / 0.90 s, drawn 155k / 153k / 155k -> 170k / 169k / 170k (PSNR +0.17 / -0.19 /
+  // +1.00 dB); elephant_1m 3,600,587 -> 3,227,007 B, 1.20 / 0.90 / 0.83 -> 1.03 / 0.87 / 0.80 s, drawn 498k /
+  // 244k / 95k -> 520k / 245k / 103k (PSNR +0.33 / +0.96 / -3.35 dB, far 63.3 -> 60.0 dB); elephant_5m
+  // 2.383 -> 2.127 B per input triangle. Fewer bytes and faster streams for up to +11 % drawn: 0.4.
   size_t max_cluster_triangles = 128;  // divisible by 4, at most 512 (meshoptimizer's meshlet limit)
   size_t max_cluster_vertices = 128;   // at most 255
   size_t group_clusters = 8;           // target clusters per group
-  double group_ratio = 0.45;           // target triangles after simplifying a group, as a fraction
+  double group_ratio = 0.4;            // target triangles after simplifying a group, as a fraction
   double stuck_ratio = 0.85;           // a group above this fraction after the fallbacks is abandoned
   size_t root_triangles = 256;         // stop when the active clusters hold at most this many
   uint32_t max_levels = 48;
