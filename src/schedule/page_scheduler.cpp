@@ -226,8 +226,10 @@ constexpr double kKeeps = 0.99;
 // the largest of its children's, and so on for up to kLookahead levels while the records are known. Such a
 // member removes nothing by itself and the exchange below it cannot be ranked until it is held, so by its own
 // gain a chain of them ranked last by benefit per byte and stalled. City (bench stream gen:fly, 10 Mbit/s 80
-// ms): push / oracle to benefit 0.95 0.93 / 0.90 -> 0.83 / 0.80 s (at group ratio 0.4: 1.40 / 1.37 -> 1.30 /
-// 1.27, behind a 30 px node whose children kept its error 22.4); motorBike and elephant_1m unchanged.
+// ms): push / oracle to benefit 0.95 0.93 / 0.90 -> 0.83 / 0.80 s; motorBike and elephant_1m unchanged. At
+// group ratio 0.4 a strict "keeps" (error >= parent_error) stopped the lookahead at 22.4272 under 22.4277
+// and left a 30 px node unrefined from 0.77 to 1.25 s: push / oracle 1.30 / 1.27 -> 0.80 / 0.73 s with
+// kKeeps.
 double refined_error_px(const package::PackageScene& scene, const NodeSource& records, uint32_t object,
                         const package::NodeRecord& r, const View& view) {
   const package::NodeRecord* at = &r;
