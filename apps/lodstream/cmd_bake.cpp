@@ -260,11 +260,13 @@ Sphere float_sphere(const schedule::WorldSphere& w) {
   return {glm::vec3(w.center), std::nextafter(float(w.radius), INFINITY)};
 }
 
-// A representation's coarsest geometry as the HLOD merges it: its roots' meshes, stored errors and spheres.
+// A representation's coarsest geometry as the HLOD merges it: its roots' meshes, stored errors and spheres,
+// and their vertices' carried radii (DagCluster::vertex_error; null or empty: `error` at every vertex).
 struct RootPiece {
   const Mesh* mesh;
   float error;
   Sphere sphere;
+  const std::vector<float>* radii = nullptr;
 };
 
 // The HLOD's input: each object's roots (errors and spheres as stored) under its transform, its bounds'
@@ -297,6 +299,10 @@ std::vector<hierarchy::HlodObject> hlod_inputs(const Scene& scene,
       const uint32_t base = uint32_t(h.coarse.positions.size());
       for (const glm::vec3& p : r.mesh->positions)
         h.coarse.positions.push_back(glm::vec3(t * glm::vec4(p, 1.0f)));
+      const bool carried = r.radii && r.radii->size() == r.mesh->positions.size();
+      for (size_t v = 0; v < r.mesh->positions.size(); ++v)
+        h.coarse_error.push_back(carried ? std::nextafter(float(double((*r.radii)[v]) * scale), INFINITY)
+                                         : std::nextafter(float(double(r.error) * scale), INFINITY));
       for (const glm::vec3& n : r.mesh->normals)
         h.coarse.normals.push_back(glm::normalize(normal_matrix * n));
       for (uint32_t k : r.mesh->indices) h.coarse.indices.push_back(base + k);
@@ -441,8 +447,8 @@ int run_bake(const BakeArgs& args) {
       }
       for (uint32_t r : dags[m].roots) {
         const hierarchy::DagCluster& c = dags[m].clusters[r];
-        roots[m].push_back(
-            {&c.mesh, stored_error(c.error, grids[m]), stored_sphere(c.sphere, c.error, grids[m])});
+        roots[m].push_back({&c.mesh, stored_error(c.error, grids[m]),
+                            stored_sphere(c.sphere, c.error, grids[m]), &c.vertex_error});
       }
     }
     const std::vector<hierarchy::HlodObject> inputs = hlod_inputs(scene, roots, bounds, hlod_objects);

@@ -13,6 +13,7 @@
 #include "hierarchy/component_removal.hpp"
 #include "hierarchy/group_partition.hpp"
 #include "hierarchy/position_index.hpp"
+#include "hierarchy/radii_floor.hpp"
 #include "simplify/simplify.hpp"
 
 namespace lodstream::hierarchy {
@@ -191,15 +192,6 @@ struct GroupResult {
   uint32_t new_ids = 0;  // ids kNewId | [0, new_ids) in `clusters`
 };
 
-// A group's input radii below kRadiusFloor x its largest are raised to that before simplifying (raising a
-// radius always keeps the invariant). The vertical mapping asks r_x >= (gap + r_old(p) - rest) / mu_x at a
-// point of a new face, which grows without bound (up to the natural mapping's) where a corner of small radius
-// sits beside a large one (mu_x -> 0), and such growth compounds over levels; 1 gives the sum of per-level
-// bounds, 0 the raw radii. Triangles drawn by elephant_1m's 1 px cuts (near / mid / far) for 0 / 0.3 / 0.5 /
-// 0.65 / 0.8 / 1: 521k/278k/126k, 498k/249k/100k, 498k/244k/95k, 503k/244k/95k, 510k/246k/100k,
-// 550k/291k/121k.
-constexpr float kRadiusFloor = 0.5f;
-
 // Merges, simplifies with the border locked and re-splits one group (formula of error_g in the header); once
 // accepted, flags the locked positions of its input clusters.
 GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
@@ -243,10 +235,7 @@ GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
                           (o.lock_open_boundary && id < b.open_boundary.size() && b.open_boundary[id]));
     }
   }
-  if (carries_error) {  // the radii floor (kRadiusFloor)
-    const float floor = kRadiusFloor * *std::max_element(so.vertex_error.begin(), so.vertex_error.end());
-    for (float& e : so.vertex_error) e = std::max(e, floor);
-  }
+  floor_radii(so.vertex_error);
   const size_t input_triangles = merged.triangle_count();
   so.target_triangles = std::max<size_t>(1, size_t(double(input_triangles) * o.group_ratio));
   so.normal_weight = o.normal_weight, so.uv_weight = o.uv_weight, so.color_weight = o.color_weight;

@@ -23,7 +23,7 @@
 // monotonic, and a two-sided bound to the full-resolution surface built from per-vertex histories rather
 // than a sum of per-level bounds (max input error + g's bound against its input: elephant_1m's 1 px cuts
 // drew 10-27 % more triangles with it). sphere_g contains the input clusters' spheres and the output
-// geometry. Input radii are raised to a floor first (kRadiusFloor in cluster_dag.cpp). Each input cluster of
+// geometry. Input radii are raised to a floor first (radii_floor.hpp). Each input cluster of
 // g stores (error_g, sphere_g) as its parents' pair. Cut rule (cut.hpp): draw a cluster when its own error
 // projects to <= tau and its parents' to > tau; because border positions are locked bit for bit, the selected
 // clusters form a crack-free surface.

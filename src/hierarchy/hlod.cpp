@@ -7,6 +7,7 @@
 #include <map>
 
 #include "hierarchy/bounding_sphere.hpp"
+#include "hierarchy/radii_floor.hpp"
 #include "simplify/simplify.hpp"
 
 namespace lodstream::hierarchy {
@@ -134,11 +135,20 @@ void make_proxy(Hlod& hlod, uint32_t id, std::span<const HlodObject> objects, co
   std::vector<const Mesh*> parts;
   std::vector<Sphere> spheres;
   double replaced_error = 0.0;
+  simplify::Options so;  // default attribute weights: UVs and colours are interpolated, not dropped
+  // The parts' radii in merge order; a part without them carries its error at every vertex.
+  auto carry = [&](const Mesh& part, const std::vector<float>& radii, float error) {
+    if (radii.size() == part.positions.size())
+      so.vertex_error.insert(so.vertex_error.end(), radii.begin(), radii.end());
+    else
+      so.vertex_error.resize(so.vertex_error.size() + part.positions.size(), error);
+  };
   if (node.children.empty()) {
     for (uint32_t o : node.objects) {
       parts.push_back(&objects[o].coarse);
       spheres.push_back(objects[o].sphere);
       replaced_error = std::max(replaced_error, double(objects[o].error));
+      carry(objects[o].coarse, objects[o].coarse_error, objects[o].error);
     }
   } else {
     for (uint32_t c : node.children) {
@@ -146,13 +156,14 @@ void make_proxy(Hlod& hlod, uint32_t id, std::span<const HlodObject> objects, co
       parts.push_back(&child.mesh);
       spheres.push_back(child.sphere);
       replaced_error = std::max(replaced_error, double(child.error));
+      carry(child.mesh, child.vertex_error, child.error);
       node.level = std::max(node.level, child.level + 1);
     }
   }
+  floor_radii(so.vertex_error);
   const ProxyLook look = proxy_look(parts, options);
   Mesh merged;
   for (const Mesh* part : parts) append(merged, *part, look, options);
-  simplify::Options so;  // default attribute weights: UVs and colours are interpolated, not dropped
   so.target_triangles = std::min(options.max_proxy_triangles,
                                  size_t(std::ceil(options.ratio * double(merged.triangle_count()))));
   so.allow_topology_change = true;
@@ -160,8 +171,11 @@ void make_proxy(Hlod& hlod, uint32_t id, std::span<const HlodObject> objects, co
   node.mesh = std::move(r.mesh);
   node.mesh.material = look.material;
   node.simplification_bound = r.error_bound;
+  node.vertex_error = std::move(r.vertex_error);
   const double tolerance = double(options.position_tolerance);
-  node.error = round_up(replaced_error + r.error_bound + tolerance);
+  double radius = 0.0;
+  for (float e : node.vertex_error) radius = std::max(radius, double(e));
+  node.error = round_up(std::max(replaced_error, radius + tolerance));
   Sphere s = sphere_of_spheres(spheres, node.mesh.positions);
   s.radius = round_up(double(s.radius) + tolerance);
   node.sphere = s;

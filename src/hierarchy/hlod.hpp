@@ -13,19 +13,22 @@
 //   texture applies as on the objects) and colours. Parts of several materials make a proxy of
 //   `mixed_material` (the caller's untextured white material) whose vertex colours are each part's material
 //   base colour times its vertex colours; a textured part then shows its base colour factor only.
-// Errors are totals in world units with the cluster DAG's semantics: error(node) = max over what it replaces
-// (its children's proxies, or its objects' coarsest representations) of their error + the simplification's
-// two-sided bound + `position_tolerance` (what the package's quantization adds), rounded up to float; so
-// errors are monotonic up the tree and across HLOD -> object roots. sphere(node) contains the spheres of what
-// it replaces and its own proxy's vertices. The cut rule (draw a node when its own error projects to <= tau
-// and its parent's to > tau) then extends from the HLOD root down to each object's roots.
-// Coarse objects stay out of the HLOD (drawn from their own roots, never under a proxy): those whose coarse
-// error exceeds both `coarse_median_factor` x the median of the objects' coarse errors and
-// `coarse_scene_fraction` of the scene's diagonal. A proxy's error is at least its objects', so one such
-// object would make every proxy above it as coarse as it is, and its neighbours drawn at that error until it
-// is refined: the city's two buildings objects have root errors 91 and 75 where the median of its 806
-// objects is 0.055 and the largest of the 804 motorbike parts 1.86 (34 x the median); a layout of copies of
-// one model (all errors equal) keeps every object. A scene of at most one object (after that) has no HLOD
+// Errors are totals in world units with the cluster DAG's semantics, from carried radii as in the DAG: each
+// coarse vertex carries r_v against its object's full resolution (HlodObject::coarse_error), a proxy is
+// simplified from its parts' radii (floored, radii_floor.hpp) and its vertices carry the result's;
+// error(node) = max(errors of what it replaces (its children's proxies, or its objects' coarsest
+// representations), largest result radius + `position_tolerance` (what the package's quantization adds)),
+// rounded up to float; so errors are monotonic up the tree and across HLOD -> object roots. (The sum of the
+// largest replaced error and the proxy's own bound, used before, counts both maxima where they rarely meet.)
+// sphere(node) contains the spheres of what it replaces and its own proxy's vertices. The cut rule (draw a
+// node when its own error projects to <= tau and its parent's to > tau) then extends from the HLOD root down
+// to each object's roots. Coarse objects stay out of the HLOD (drawn from their own roots, never under a
+// proxy): those whose coarse error exceeds both `coarse_median_factor` x the median of the objects' coarse
+// errors and `coarse_scene_fraction` of the scene's diagonal. A proxy's error is at least its objects', so
+// one such object would make every proxy above it as coarse as it is, and its neighbours drawn at that error
+// until it is refined: the city's two buildings objects have root errors 91 and 75 where the median of its
+// 806 objects is 0.055 and the largest of the 804 motorbike parts 1.86 (34 x the median); a layout of copies
+// of one model (all errors equal) keeps every object. A scene of at most one object (after that) has no HLOD
 // (an empty result): a proxy would only duplicate that object.
 #pragma once
 
@@ -48,7 +51,10 @@ struct HlodObject {
   // (computed from the triangles when absent).
   Mesh coarse;
   float error = 0.0f;  // of `coarse` against the object's full resolution, world units
-  Sphere sphere;       // contains `coarse` and everything the object's own cut may draw (its roots' spheres)
+  // Per vertex of `coarse`: r_v against the object's full resolution, world units (a cluster DAG's roots'
+  // DagCluster::vertex_error scaled); empty: `error` at every vertex.
+  std::vector<float> coarse_error;
+  Sphere sphere;  // contains `coarse` and everything the object's own cut may draw (its roots' spheres)
 };
 
 struct HlodOptions {
@@ -74,6 +80,7 @@ struct HlodNode {
   std::vector<uint32_t> children;     // HLOD nodes; empty for a leaf
   std::vector<uint32_t> objects;      // every object below, sorted (a leaf: the objects it replaces)
   double simplification_bound = 0.0;  // this proxy's own simplification bound
+  std::vector<float> vertex_error;    // per proxy vertex: r_v against the full resolution, world units
 };
 
 struct Hlod {

@@ -13,6 +13,7 @@
 #include "hierarchy/bounding_sphere.hpp"
 #include "hierarchy/cluster_dag.hpp"
 #include "hierarchy/cut.hpp"
+#include "support/brute_distance.hpp"
 #include "support/shapes.hpp"
 
 namespace lodstream::hierarchy {
@@ -100,50 +101,6 @@ CutVariety check_cuts(const ClusterDag& dag, const Mesh& input, int cuts) {
   return variety;
 }
 
-// Distance from p to triangle abc (Ericson, Real-Time Collision Detection, 5.1.5).
-double point_triangle_distance(glm::dvec3 p, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
-  const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
-  if (d1 <= 0 && d2 <= 0) return glm::length(p - a);
-  const glm::dvec3 bp = p - b;
-  const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return glm::length(p - b);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return glm::length(p - (a + ab * (d1 / (d1 - d3))));
-  const glm::dvec3 cp = p - c;
-  const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return glm::length(p - c);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return glm::length(p - (a + ac * (d2 / (d2 - d6))));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0)
-    return glm::length(p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
-  const double denom = 1.0 / (va + vb + vc);
-  return glm::length(p - (a + ab * (vb * denom) + ac * (vc * denom)));
-}
-
-double distance_to(const glm::dvec3& p, const std::vector<const Mesh*>& meshes) {
-  double best = INFINITY;
-  for (const Mesh* m : meshes)
-    for (size_t t = 0; t + 2 < m->indices.size(); t += 3)
-      best = std::min(best,
-                      point_triangle_distance(p, m->positions[m->indices[t]], m->positions[m->indices[t + 1]],
-                                              m->positions[m->indices[t + 2]]));
-  return best;
-}
-
-// Points of a mesh to test distances from: vertices, triangle centroids and edge midpoints.
-std::vector<glm::dvec3> samples(const Mesh& m) {
-  std::vector<glm::dvec3> s(m.positions.begin(), m.positions.end());
-  for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
-    glm::dvec3 a = m.positions[m.indices[t]], b = m.positions[m.indices[t + 1]],
-               c = m.positions[m.indices[t + 2]];
-    s.push_back((a + b + c) / 3.0);
-    s.push_back((a + b) * 0.5);
-  }
-  return s;
-}
-
 TEST(ClusterDag, SphereIsMonotonicAndCrackFree) {
   const Mesh mesh = test::sphere(1.0f, 64, 128);
   const ClusterDag dag = build_cluster_dag(mesh);
@@ -191,8 +148,8 @@ void check_error_bound(const Mesh& mesh, const ClusterDag& dag) {
   // One-sided from every coarse cluster to the full-resolution surface.
   for (const DagCluster& c : dag.clusters) {
     if (c.level == 0) continue;
-    for (const glm::dvec3& p : samples(c.mesh))
-      EXPECT_LE(distance_to(p, full), double(c.error) * 1.0001 + 1e-6);
+    for (const glm::dvec3& p : test::samples(c.mesh))
+      EXPECT_LE(test::distance_to(p, full), double(c.error) * 1.0001 + 1e-6);
   }
   // Other side: from the full-resolution surface to the coarsest cut.
   std::vector<const Mesh*> roots;
@@ -200,8 +157,8 @@ void check_error_bound(const Mesh& mesh, const ClusterDag& dag) {
   for (uint32_t r : dag.roots)
     roots.push_back(&dag.clusters[r].mesh), root_error = std::max(root_error, dag.clusters[r].error);
   EXPECT_GT(root_error, 0.0f);
-  for (const glm::dvec3& p : samples(mesh))
-    EXPECT_LE(distance_to(p, roots), double(root_error) * 1.0001 + 1e-6);
+  for (const glm::dvec3& p : test::samples(mesh))
+    EXPECT_LE(test::distance_to(p, roots), double(root_error) * 1.0001 + 1e-6);
 }
 
 TEST(ClusterDag, ErrorBoundHoldsAgainstBruteForceDistance) {

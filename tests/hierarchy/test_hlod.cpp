@@ -9,6 +9,8 @@
 
 #include "hierarchy/bounding_sphere.hpp"
 #include "hierarchy/hlod.hpp"
+#include "simplify/simplify.hpp"
+#include "support/brute_distance.hpp"
 #include "support/shapes.hpp"
 
 using namespace lodstream;
@@ -64,8 +66,8 @@ TEST(Hlod, ErrorsMonotonicSpheresContainingObjectsPartitioned) {
       EXPECT_LE(n.objects.size(), options.leaf_objects);
       for (uint32_t o : n.objects) {
         ++leaf_count[o];
-        // The proxy replaces the object: at least its error plus its own bound, and a sphere around it.
-        EXPECT_GE(n.error, objects[o].error + options.position_tolerance);
+        // The proxy replaces the object: at least its error, and a sphere around it.
+        EXPECT_GE(n.error, objects[o].error);
         EXPECT_TRUE(sphere_contains(n.sphere, objects[o].sphere)) << "object " << o;
       }
       continue;
@@ -76,7 +78,7 @@ TEST(Hlod, ErrorsMonotonicSpheresContainingObjectsPartitioned) {
       const HlodNode& child = hlod.nodes[c];
       EXPECT_EQ(child.parent, id);
       EXPECT_GT(c, id) << "breadth-first: parents first";
-      EXPECT_GE(n.error, child.error + options.position_tolerance) << "child " << c;
+      EXPECT_GE(n.error, child.error) << "child " << c;
       EXPECT_LT(child.level, n.level);
       EXPECT_TRUE(sphere_contains(n.sphere, child.sphere)) << "child " << c;
       below.insert(below.end(), child.objects.begin(), child.objects.end());
@@ -184,6 +186,52 @@ TEST(Hlod, ACoarseObjectStaysOutOfTheHlod) {
   EXPECT_EQ(covered.size(), 15u);
   EXPECT_EQ(std::count(covered.begin(), covered.end(), 5u), 0);
   EXPECT_LT(hlod.nodes[hlod.root].error, 2.0f) << "no proxy is as coarse as the object left out";
+}
+
+TEST(Hlod, ProxyErrorsFromCarriedRadiiBoundTheDistanceToTheFullResolution) {
+  // 16 spheres of 528 triangles, each simplified to 64 as its coarse mesh carrying the simplifier's radii.
+  std::vector<Mesh> full;
+  std::vector<HlodObject> objects;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {
+      Mesh m = test::sphere(1.0f, 12, 24);
+      for (glm::vec3& p : m.positions) p += glm::vec3(3.0f * float(i), 0.4f * float(j), 3.0f * float(j));
+      simplify::Options so;
+      so.target_triangles = 64;
+      simplify::Result r = simplify::simplify_mesh(m, so);
+      HlodObject o;
+      o.coarse = std::move(r.mesh);
+      o.coarse_error = std::move(r.vertex_error);
+      o.error = float(r.error_bound);
+      o.bounds = m.bounds();
+      o.sphere = sphere_of_points(m.positions);
+      full.push_back(std::move(m));
+      objects.push_back(std::move(o));
+    }
+  HlodOptions options;
+  options.position_tolerance = 1e-4f;
+  const Hlod hlod = build_hlod(objects, options);
+  ASSERT_NE(hlod.root, kNoHlodNode);
+  size_t tighter = 0;
+  for (uint32_t id = 0; id < hlod.nodes.size(); ++id) {
+    const HlodNode& n = hlod.nodes[id];
+    SCOPED_TRACE("node " + std::to_string(id));
+    std::vector<const Mesh*> below;
+    for (uint32_t o : n.objects) below.push_back(&full[o]);
+    const std::vector<const Mesh*> proxy{&n.mesh};
+    // Both sides of the bound: the proxy to its objects' full resolution, and those to the proxy.
+    for (const glm::dvec3& p : test::samples(n.mesh))
+      ASSERT_LE(test::distance_to(p, below), double(n.error) * 1.0001);
+    for (const Mesh* m : below)
+      for (const glm::dvec3& p : test::samples(*m))
+        ASSERT_LE(test::distance_to(p, proxy), double(n.error) * 1.0001);
+    // Tighter than the largest replaced error plus the proxy's own bound (what the errors were before).
+    double replaced = 0.0;
+    for (uint32_t o : n.objects) replaced = std::max(replaced, double(objects[o].error));
+    for (uint32_t c : n.children) replaced = std::max(replaced, double(hlod.nodes[c].error));
+    tighter += double(n.error) < 0.9 * (replaced + n.simplification_bound);
+  }
+  EXPECT_GE(tighter, hlod.nodes.size() / 2);
 }
 
 }  // namespace
