@@ -184,14 +184,20 @@ int run_inspect(const InspectArgs& args) {
     float min_error = INFINITY, max_error = 0.0f;
   };
   std::map<uint32_t, Level> per_level;
+  std::map<uint32_t, Level> hlod_levels;  // the HLOD's proxies alone (also counted in per_level)
   size_t stored_triangles = 0;
   for (uint32_t id = 0; id < nodes.size(); ++id) {
     const NodeRecord& n = nodes[id];
-    Level& l = per_level[n.level];
-    ++l.nodes, l.triangles += n.triangles, stored_triangles += n.triangles;
-    // A record's bytes once (its clusters are consecutive ids sharing them).
-    if (id == 0 || n.page != nodes[id - 1].page || n.offset != nodes[id - 1].offset) l.raw_bytes += n.size;
-    l.min_error = std::min(l.min_error, n.error), l.max_error = std::max(l.max_error, n.error);
+    const bool proxy = n.representation < root.scene.representations.size() &&
+                       root.scene.representations[n.representation].kind == RepresentationKind::hlod;
+    for (Level* l : {&per_level[n.level], proxy ? &hlod_levels[n.level] : nullptr}) {
+      if (!l) continue;
+      ++l->nodes, l->triangles += n.triangles;
+      // A record's bytes once (its clusters are consecutive ids sharing them).
+      if (id == 0 || n.page != nodes[id - 1].page || n.offset != nodes[id - 1].offset) l->raw_bytes += n.size;
+      l->min_error = std::min(l->min_error, n.error), l->max_error = std::max(l->max_error, n.error);
+    }
+    stored_triangles += n.triangles;
   }
   const uint64_t bytes = reader.header().file_size;
   uint64_t texture_bytes = 0;
@@ -308,14 +314,18 @@ int run_inspect(const InspectArgs& args) {
   }
 
   if (args.json) {
-    nlohmann::json level_json = nlohmann::json::array();
-    for (const auto& [l, s] : per_level)
-      level_json.push_back({{"level", l},
-                            {"nodes", s.nodes},
-                            {"triangles", s.triangles},
-                            {"raw_bytes", s.raw_bytes},
-                            {"min_error", s.min_error},
-                            {"max_error", s.max_error}});
+    auto levels_json = [](const std::map<uint32_t, Level>& levels) {
+      nlohmann::json out = nlohmann::json::array();
+      for (const auto& [l, s] : levels)
+        out.push_back({{"level", l},
+                       {"nodes", s.nodes},
+                       {"triangles", s.triangles},
+                       {"raw_bytes", s.raw_bytes},
+                       {"min_error", s.min_error},
+                       {"max_error", s.max_error}});
+      return out;
+    };
+    const nlohmann::json level_json = levels_json(per_level);
     nlohmann::json out = {{"nodes", nodes.size()},
                           {"pages", root.pages.size()},
                           {"levels", levels},
@@ -328,7 +338,8 @@ int run_inspect(const InspectArgs& args) {
                           {"index_pages", root.index_pages.size()},
                           {"textures", root.blobs.size()},
                           {"texture_bytes", texture_bytes},
-                          {"per_level", level_json}};
+                          {"per_level", level_json},
+                          {"hlod_levels", levels_json(hlod_levels)}};
     if (args.parts) {
       nlohmann::json parts = nlohmann::json::array();
       for (const LevelAccount& a : account) {
@@ -372,6 +383,10 @@ int run_inspect(const InspectArgs& args) {
                   (unsigned long long)texture_bytes);
     for (const auto& [l, s] : per_level)
       std::printf("  level %2u: %7zu nodes %10zu triangles  error %.4g .. %.4g\n", l, s.nodes, s.triangles,
+                  s.min_error, s.max_error);
+    if (!hlod_levels.empty()) std::printf("  of which HLOD proxies (world units):\n");
+    for (const auto& [l, s] : hlod_levels)
+      std::printf("  level %2u: %7zu proxies %8zu triangles  error %.4g .. %.4g\n", l, s.nodes, s.triangles,
                   s.min_error, s.max_error);
     if (args.parts) {
       std::printf(
@@ -419,9 +434,10 @@ const bool registered = register_command(
            "and the stored page bytes per level (JSON key parts); and the index's bytes per record field "
            "(JSON key index_parts)");
        sub.add_option("--cuts", args->cuts, "random cuts checked per cluster DAG with --verify (default 32)");
-       sub.add_flag(
-           "--json", args->json,
-           "print one JSON object: nodes, pages, levels, bytes, input_triangles, per_level, verified");
+       sub.add_flag("--json", args->json,
+                    "print one JSON object: nodes, pages, levels, bytes, input_triangles, per_level, "
+                    "hlod_levels (the HLOD's "
+                    "proxies alone), verified");
        return [args] { return run_inspect(*args); };
      }});
 

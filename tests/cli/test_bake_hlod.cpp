@@ -56,6 +56,12 @@ TEST(CliBakeHlod, ALayoutOfManyObjectsVerifiesAndIsFewNodesFromAfar) {
   auto inspect = run_lodstream({"inspect", with.string(), "--verify", "--json"});
   EXPECT_EQ(inspect.status, 0) << inspect.err;
   EXPECT_EQ(inspect.json()["verified"], true) << inspect.out;
+  // inspect lists the proxies by HLOD level: as many as the bake made, over as many levels.
+  const nlohmann::json hlod_levels = inspect.json()["hlod_levels"];
+  size_t proxies = 0;
+  for (const auto& level : hlod_levels) proxies += level["nodes"].get<size_t>();
+  EXPECT_EQ(proxies, j["hlod"]["nodes"].get<size_t>());
+  EXPECT_EQ(hlod_levels.size(), j["hlod"]["levels"].get<size_t>());
 
   auto info = run_lodstream({"info", layout.string(), "--json"});
   ASSERT_EQ(info.status, 0) << info.err;
