@@ -152,7 +152,7 @@ ResidualDecoder::ResidualDecoder(std::span<const uint8_t> stream, const std::str
     const uint64_t f = r.varint();
     if (f > kScale - sum) r.fail("residual frequencies add up past the scale");
     const uint32_t entry = uint32_t(f) | s << 25;
-    for (uint32_t j = 0; j < f; ++j) slot_[sum + j] = entry | j << 13;
+    rans::fill_slots(slot_.data() + sum, entry, uint32_t(f), 13);
     sum += uint32_t(f);
   }
   if (sum != kScale) r.fail("residual frequencies do not add up to the scale");

@@ -120,7 +120,7 @@ SymbolDecoder::SymbolDecoder(std::span<const uint8_t> stream, const std::string&
         if (f == 0 || f >= kScale - sum) r.fail("symbol frequencies add up past the scale");
       }
       const uint32_t entry = uint32_t(f) | s << 21;
-      for (uint32_t j = 0; j < f; ++j) slots[sum + j] = entry | j << 11;
+      rans::fill_slots(slots + sum, entry, uint32_t(f), 11);
       sum += uint32_t(f);
     }
   }
