@@ -103,14 +103,17 @@ std::optional<std::vector<uint8_t>> encode_symbols(std::span<const uint8_t> symb
 SymbolDecoder::SymbolDecoder(std::span<const uint8_t> stream, const std::string& where) : where_(where) {
   if (stream.empty()) return;  // no symbols
   ByteReader r(stream, where);
-  slot_.assign(size_t(kTables) * kScale, 0);
+  slot_ = std::make_unique_for_overwrite<uint32_t[]>(size_t(kTables) * kScale);
   for (uint32_t t = 0; t < kTables; ++t) {
     const uint32_t A = alphabet(t);
     const uint32_t mask = t == kCodeTable ? r.u32() : r.u16();
     if (mask >> A) r.fail("symbol table of an unknown symbol");
-    if (!mask) continue;
+    uint32_t* slots = slot_.get() + size_t(t) * kScale;
+    if (!mask) {
+      std::fill_n(slots, kScale, 0);
+      continue;
+    }
     const uint32_t last = 31 - uint32_t(__builtin_clz(mask));
-    uint32_t* slots = slot_.data() + size_t(t) * kScale;
     uint32_t sum = 0;
     for (uint32_t s = 0; s <= last; ++s) {
       if (!(mask >> s & 1)) continue;
@@ -143,8 +146,8 @@ void SymbolDecoder::fail(const char* what) const {
 
 void SymbolDecoder::symbols(size_t count, uint8_t* out) {
   if (count == 0) return;
-  if (slot_.empty()) fail("symbols past the symbol stream's end");
-  const uint32_t* slots = slot_.data();
+  if (!slot_) fail("symbols past the symbol stream's end");
+  const uint32_t* slots = slot_.get();
   const uint8_t* bytes = bytes_.data();
   size_t at = rans_at_;
   const size_t rans_end = rans_end_;
@@ -179,7 +182,7 @@ void SymbolDecoder::symbols(size_t count, uint8_t* out) {
 }
 
 void SymbolDecoder::finish() const {
-  if (slot_.empty()) return;
+  if (!slot_) return;
   if (rans_at_ != rans_end_ || state_[0] != rans::kLow || state_[1] != rans::kLow)
     fail("symbol stream holds bytes of no symbol");
 }
