@@ -156,25 +156,38 @@ void SymbolDecoder::symbols(size_t count, uint8_t* out) {
   // One step (rANS, Duda 2013, eq. 9: D(x) = (s, f_s floor(x / 2^8) + x mod 2^8 - start_s), s the symbol
   // of slot x mod 2^8 of `table`), then x read back up to kLow from the next 2 rANS bytes; the states
   // alternate.
-  const auto step = [&](uint32_t table) __attribute__((always_inline)) {
-    const uint32_t e = slots[table * kScale + (x0 & (kScale - 1))];
-    uint32_t x = (e & 0x7ff) * (x0 >> kScaleBits) + ((e >> 11) & 0x3ff);
+  const auto step = [&](uint32_t & x, uint32_t table) __attribute__((always_inline)) {
+    const uint32_t e = slots[table * kScale + (x & (kScale - 1))];
+    x = (e & 0x7ff) * (x >> kScaleBits) + ((e >> 11) & 0x3ff);
     uint16_t next;
     std::memcpy(&next, bytes + at, 2);
     rans::renormalize(x, at, next);
-    x0 = x1, x1 = x;
     return e >> 21;
   };
-  // A symbol reads at most 4 bytes: started only while at is within the rANS bytes, so that no read leaves
-  // the padding. A class of a table that never occurs decodes as class 0 (its slots are 0).
-  for (size_t i = 0; i < count; ++i) {
-    if (at > rans_end) fail("symbol rANS stream ends early");
-    const uint32_t s = step(context);
-    uint32_t symbol = s;
-    if (s >= kKinds) [[unlikely]]
-      symbol = (s - kKinds) | to_front(recent, step(kCodeTable)) << 3;
-    out[i] = uint8_t(symbol);
+  // A symbol whose class steps state x (the next step's); a tagged symbol's rank steps y, then the two swap
+  // names, so that x names the next step's state again. A class of a table that never occurs decodes as
+  // class 0 (its slots are 0).
+  const auto symbol = [&](uint32_t & x, uint32_t & y) __attribute__((always_inline)) {
+    const uint32_t s = step(x, context);
+    uint32_t byte = s;
+    if (s >= kKinds) [[unlikely]] {
+      byte = (s - kKinds) | to_front(recent, step(y, kCodeTable)) << 3;
+      std::swap(x, y);
+    }
     context = s;  // below kClasses: the tables hold no other classes
+    return uint8_t(byte);
+  };
+  // Two symbols a step, the first on x0, the second on x1 (no moves between the states): they read at most
+  // 8 bytes, so a pair starts only while at is within the rANS bytes, and no read leaves the padding.
+  size_t i = 0;
+  for (; i + 2 <= count; i += 2) {
+    if (at > rans_end) fail("symbol rANS stream ends early");
+    out[i] = symbol(x0, x1), out[i + 1] = symbol(x1, x0);
+  }
+  if (i < count) {
+    if (at > rans_end) fail("symbol rANS stream ends early");
+    out[i] = symbol(x0, x1);
+    std::swap(x0, x1);  // x1 steps next
   }
   if (at > rans_end) fail("symbol rANS stream ends early");
   state_[0] = x0, state_[1] = x1, context_ = context, recent_ = recent;
