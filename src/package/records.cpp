@@ -93,25 +93,29 @@ DecodedNode extract_cluster(const DecodedNode& record, uint32_t cluster, const s
                    in.indices.begin() + std::ptrdiff_t(3 * (first + count)));  // < V: the codec checked them
   uint32_t* const map = compact.data();
   uint32_t* const first_use = used.data();
-  uint32_t n = 0;
+  size_t n = 0;
   // Without a branch (which mispredicted at about every first use, a fifth of the corners): first_use[n] is
-  // written every time and kept only when v is new.
-  for (uint32_t& v : m.indices) {
-    const uint32_t seen = map[v];
-    const uint32_t fresh = seen >> 31;  // 1 for UINT32_MAX (not used yet): cluster vertices are below 2^31
+  // written every time and kept only when v is new. A triangle a step, the count in 64 bits (no zero
+  // extension before it indexes): ~15 -> ~12.5 instructions a corner.
+  auto renumber = [&](uint32_t& v) {
+    const size_t seen = map[v];
+    const size_t fresh = seen >> 31;  // 1 for UINT32_MAX (not used yet): cluster vertices are below 2^31
     first_use[n] = v;
-    const uint32_t c = fresh ? n : seen;
+    const uint32_t c = uint32_t(fresh ? n : seen);
     map[v] = c, n += fresh;
     v = c;
-  }
-  for (uint32_t k = 0; k < n; ++k) map[first_use[k]] = UINT32_MAX;  // before anything may throw
+  };
+  uint32_t* const corners = m.indices.data();
+  for (size_t i = 0; i < 3 * count; i += 3)
+    renumber(corners[i]), renumber(corners[i + 1]), renumber(corners[i + 2]);
+  for (size_t k = 0; k < n; ++k) map[first_use[k]] = UINT32_MAX;  // before anything may throw
   const std::span<const uint32_t> order(first_use, n);
   gather(in.positions, order, m.positions);
   if (in.has_normals()) gather(in.normals, order, m.normals);
   if (in.has_uvs()) gather(in.uvs, order, m.uvs);
   if (in.has_colors()) gather(in.colors, order, m.colors);
   if (!record.vertex_data.empty()) gather(record.vertex_data, order, out.vertex_data);
-  out.index_end = n;
+  out.index_end = uint32_t(n);
   return out;
 }
 

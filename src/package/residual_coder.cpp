@@ -146,13 +146,14 @@ ResidualDecoder::ResidualDecoder(std::span<const uint8_t> stream, const std::str
   if (D < kMinDirect || D > kMaxDirect) r.fail("residual direct bits out of range");
   direct_bits_ = D;
   if (A == 0 || A > symbols_for(D)) r.fail("residual table of an invalid size");
-  slot_.resize(kScale);
+  slot_ = std::make_unique_for_overwrite<uint32_t[]>(kScale);
+  symbol_ = std::make_unique_for_overwrite<uint8_t[]>(kScale);
   uint32_t sum = 0;
   for (uint32_t s = 0; s < A; ++s) {
     const uint64_t f = r.varint();
     if (f > kScale - sum) r.fail("residual frequencies add up past the scale");
-    const uint32_t entry = uint32_t(f) | s << 25;
-    for (uint32_t j = 0; j < f; ++j) slot_[sum + j] = entry | j << 13;
+    rans::fill_slots(slot_.get() + sum, uint32_t(f), uint32_t(f), 16);
+    std::memset(symbol_.get() + sum, int(s), f);
     sum += uint32_t(f);
   }
   if (sum != kScale) r.fail("residual frequencies do not add up to the scale");
@@ -178,13 +179,14 @@ void ResidualDecoder::fail(const char* what) const {
 void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, uint8_t* planes,
                              uint32_t first, uint32_t taken) {
   if (count == 0) return;
-  if (slot_.empty()) fail("residuals past the residual stream's end");
+  if (!slot_) fail("residuals past the residual stream's end");
   const size_t values = taken * count, stride = components * count;  // stride: from one plane to the next
   planes += first * count;
   // The higher planes are zero but for values of raw bits, which write their higher bytes themselves.
   for (uint32_t b = 1; b < width; ++b) std::memset(planes + b * stride, 0, values);
   // The decoder's state in locals (registers) for the loop, written back after it; x0 decodes next.
-  const uint32_t* slots = slot_.data();
+  const uint32_t* slots = slot_.get();
+  const uint8_t* symbols = symbol_.get();
   const uint8_t* bytes = bytes_.data();
   size_t at = rans_at_;
   uint64_t raw_at = raw_bit_at_;
@@ -197,8 +199,8 @@ void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, 
   // symbol of slot x mod 2^12), then x read back up to kLow from the next 2 rANS bytes; a value's raw
   // bits, rare (residual_coder.hpp), take a branch too.
   const auto step = [&](uint32_t & x, size_t i) __attribute__((always_inline)) {
-    const uint32_t e = slots[x & (kScale - 1)], s = e >> 25;
-    x = (e & 0x1fff) * (x >> kScaleBits) + ((e >> 13) & 0xfff);
+    const uint32_t slot = x & (kScale - 1), e = slots[slot], s = symbols[slot];
+    x = (e & 0xffff) * (x >> kScaleBits) + (e >> 16);
     uint16_t next;
     std::memcpy(&next, bytes + at, 2);
     rans::renormalize(x, at, next);
@@ -233,7 +235,7 @@ void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, 
 }
 
 void ResidualDecoder::finish() const {
-  if (slot_.empty()) return;
+  if (!slot_) return;
   bool states_back = true;
   for (uint32_t x : state_) states_back = states_back && x == kLow;
   // Raw bits: up to the last byte, and none set beyond the last one read.

@@ -35,6 +35,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -69,9 +70,12 @@ class ResidualDecoder {
   [[noreturn]] void fail(const char* what) const;
 
   std::string where_;
-  // Per slot of 2^12 (empty for no stream): bits 0-12 its symbol's frequency, 13-24 the slot minus the
-  // symbol's start, 25-31 the symbol.
-  std::vector<uint32_t> slot_;
+  // Per slot of 2^12 (null for no stream): bits 0-15 its symbol's frequency, 16-31 the slot minus the
+  // symbol's start; and apart, its symbol (a step takes each with one instruction: 3 fewer a value than with
+  // the symbol in the same word). Allocated without zero-filling: the constructor writes every slot or throws
+  // (zero-filling 2^12 slots for every page part took ~0.9 % of elephant_1m's decode instructions).
+  std::unique_ptr<uint32_t[]> slot_;
+  std::unique_ptr<uint8_t[]> symbol_;
   uint32_t direct_bits_ = 0;  // D
   // The rANS bytes then the raw bits, followed by 8 zero bytes, so that reads a few bytes past the rANS
   // bytes' end stay in the buffer (the decoder checks after each block of 4 values that they were not used)

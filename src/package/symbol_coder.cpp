@@ -103,14 +103,17 @@ std::optional<std::vector<uint8_t>> encode_symbols(std::span<const uint8_t> symb
 SymbolDecoder::SymbolDecoder(std::span<const uint8_t> stream, const std::string& where) : where_(where) {
   if (stream.empty()) return;  // no symbols
   ByteReader r(stream, where);
-  slot_.assign(size_t(kTables) * kScale, 0);
+  slot_ = std::make_unique_for_overwrite<uint32_t[]>(size_t(kTables) * kScale);
   for (uint32_t t = 0; t < kTables; ++t) {
     const uint32_t A = alphabet(t);
     const uint32_t mask = t == kCodeTable ? r.u32() : r.u16();
     if (mask >> A) r.fail("symbol table of an unknown symbol");
-    if (!mask) continue;
+    uint32_t* slots = slot_.get() + size_t(t) * kScale;
+    if (!mask) {
+      std::fill_n(slots, kScale, 0);
+      continue;
+    }
     const uint32_t last = 31 - uint32_t(__builtin_clz(mask));
-    uint32_t* slots = slot_.data() + size_t(t) * kScale;
     uint32_t sum = 0;
     for (uint32_t s = 0; s <= last; ++s) {
       if (!(mask >> s & 1)) continue;
@@ -120,7 +123,7 @@ SymbolDecoder::SymbolDecoder(std::span<const uint8_t> stream, const std::string&
         if (f == 0 || f >= kScale - sum) r.fail("symbol frequencies add up past the scale");
       }
       const uint32_t entry = uint32_t(f) | s << 21;
-      for (uint32_t j = 0; j < f; ++j) slots[sum + j] = entry | j << 11;
+      rans::fill_slots(slots + sum, entry, uint32_t(f), 11);
       sum += uint32_t(f);
     }
   }
@@ -143,8 +146,8 @@ void SymbolDecoder::fail(const char* what) const {
 
 void SymbolDecoder::symbols(size_t count, uint8_t* out) {
   if (count == 0) return;
-  if (slot_.empty()) fail("symbols past the symbol stream's end");
-  const uint32_t* slots = slot_.data();
+  if (!slot_) fail("symbols past the symbol stream's end");
+  const uint32_t* slots = slot_.get();
   const uint8_t* bytes = bytes_.data();
   size_t at = rans_at_;
   const size_t rans_end = rans_end_;
@@ -153,25 +156,38 @@ void SymbolDecoder::symbols(size_t count, uint8_t* out) {
   // One step (rANS, Duda 2013, eq. 9: D(x) = (s, f_s floor(x / 2^8) + x mod 2^8 - start_s), s the symbol
   // of slot x mod 2^8 of `table`), then x read back up to kLow from the next 2 rANS bytes; the states
   // alternate.
-  const auto step = [&](uint32_t table) __attribute__((always_inline)) {
-    const uint32_t e = slots[table * kScale + (x0 & (kScale - 1))];
-    uint32_t x = (e & 0x7ff) * (x0 >> kScaleBits) + ((e >> 11) & 0x3ff);
+  const auto step = [&](uint32_t & x, uint32_t table) __attribute__((always_inline)) {
+    const uint32_t e = slots[table * kScale + (x & (kScale - 1))];
+    x = (e & 0x7ff) * (x >> kScaleBits) + ((e >> 11) & 0x3ff);
     uint16_t next;
     std::memcpy(&next, bytes + at, 2);
     rans::renormalize(x, at, next);
-    x0 = x1, x1 = x;
     return e >> 21;
   };
-  // A symbol reads at most 4 bytes: started only while at is within the rANS bytes, so that no read leaves
-  // the padding. A class of a table that never occurs decodes as class 0 (its slots are 0).
-  for (size_t i = 0; i < count; ++i) {
-    if (at > rans_end) fail("symbol rANS stream ends early");
-    const uint32_t s = step(context);
-    uint32_t symbol = s;
-    if (s >= kKinds) [[unlikely]]
-      symbol = (s - kKinds) | to_front(recent, step(kCodeTable)) << 3;
-    out[i] = uint8_t(symbol);
+  // A symbol whose class steps state x (the next step's); a tagged symbol's rank steps y, then the two swap
+  // names, so that x names the next step's state again. A class of a table that never occurs decodes as
+  // class 0 (its slots are 0).
+  const auto symbol = [&](uint32_t & x, uint32_t & y) __attribute__((always_inline)) {
+    const uint32_t s = step(x, context);
+    uint32_t byte = s;
+    if (s >= kKinds) [[unlikely]] {
+      byte = (s - kKinds) | to_front(recent, step(y, kCodeTable)) << 3;
+      std::swap(x, y);
+    }
     context = s;  // below kClasses: the tables hold no other classes
+    return uint8_t(byte);
+  };
+  // Two symbols a step, the first on x0, the second on x1 (no moves between the states): they read at most
+  // 8 bytes, so a pair starts only while at is within the rANS bytes, and no read leaves the padding.
+  size_t i = 0;
+  for (; i + 2 <= count; i += 2) {
+    if (at > rans_end) fail("symbol rANS stream ends early");
+    out[i] = symbol(x0, x1), out[i + 1] = symbol(x1, x0);
+  }
+  if (i < count) {
+    if (at > rans_end) fail("symbol rANS stream ends early");
+    out[i] = symbol(x0, x1);
+    std::swap(x0, x1);  // x1 steps next
   }
   if (at > rans_end) fail("symbol rANS stream ends early");
   state_[0] = x0, state_[1] = x1, context_ = context, recent_ = recent;
@@ -179,7 +195,7 @@ void SymbolDecoder::symbols(size_t count, uint8_t* out) {
 }
 
 void SymbolDecoder::finish() const {
-  if (slot_.empty()) return;
+  if (!slot_) return;
   if (rans_at_ != rans_end_ || state_[0] != rans::kLow || state_[1] != rans::kLow)
     fail("symbol stream holds bytes of no symbol");
 }

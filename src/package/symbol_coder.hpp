@@ -46,6 +46,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -81,10 +82,10 @@ class SymbolDecoder {
   [[noreturn]] void fail(const char* what) const;
 
   std::string where_;
-  // 13 tables of 2^8 slots (12 contexts, then the cluster codes' ranks; empty for no stream), each slot: bits
+  // 13 tables of 2^8 slots (12 contexts, then the cluster codes' ranks; null for no stream), each slot: bits
   // 0-10 its symbol's frequency (0 in a table that never occurs), 11-20 the slot minus the symbol's start,
-  // 21-25 the symbol.
-  std::vector<uint32_t> slot_;
+  // 21-25 the symbol. Allocated without zero-filling: the constructor writes every slot or throws.
+  std::unique_ptr<uint32_t[]> slot_;
   std::vector<uint8_t> bytes_;  // the rANS bytes, followed by 8 zero bytes (reads past the end stay inside)
   size_t rans_end_ = 0, rans_at_ = 0;
   uint32_t state_[2] = {0, 0};  // the next step's first
