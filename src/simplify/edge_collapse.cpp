@@ -88,9 +88,7 @@ struct Corners {
   int last_moving;  // the last moving corner (every face has one: it holds a or b); a face that stays has one
   bool dies;
 };
-// Two doubles in vector lanes (GCC's generic vectors: SSE2 on x86-64, plain code elsewhere) for
-// vertical_bound's crossing tests, and what their comparisons give (-1 where true, per lane).
-using Lanes = double __attribute__((vector_size(16)));
+// What comparisons of Lanes (quadric.hpp) give in vertical_bound's crossing tests: -1 where true, per lane.
 using LaneMask = int64_t __attribute__((vector_size(16)));
 // A projected edge for vertical_bound: origin + t direction, heights and radii at its ends.
 struct Segment {
