@@ -824,10 +824,7 @@ class Simplifier {
       if (!(ww > 0)) continue;
       ChannelSums sums;
       const AttributeTerm *ta = &attr_[a * size_t(channels_)], *tb = &attr_[b * size_t(channels_)];
-      for (int j = 0; j < channels_; ++j) {
-        const glm::dvec3 ga(ta[j].g);
-        sums.add(ga + glm::dvec3(tb[j].g), double(ta[j].d) + glm::dot(ga, shift) + tb[j].d);
-      }
+      for (int j = 0; j < channels_; ++j) sums.add(ta[j], tb[j], shift);
       r.eliminate(sums, ww);
     }
     const glm::dvec3 pa = glm::dvec3(pos_[p.a]) - o, pb = glm::dvec3(pos_[p.b]) - o;

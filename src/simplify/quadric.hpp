@@ -49,6 +49,14 @@ using Lanes = double __attribute__((vector_size(16)));
 using FloatLanes = float __attribute__((vector_size(16)));
 using WideLanes = double __attribute__((vector_size(32)));
 
+// The four floats at `at` as two pairs of doubles (cvtps2pd twice).
+inline void widen(const void* at, Lanes& lo, Lanes& hi) {
+  FloatLanes f;
+  std::memcpy(&f, at, sizeof f);
+  const WideLanes d = __builtin_convertvector(f, WideLanes);
+  lo = __builtin_shufflevector(d, d, 0, 1), hi = __builtin_shufflevector(d, d, 2, 3);
+}
+
 // The ten terms (a00, a01, a02, a11, a12, a22, b0, b1, b2, c) as five pairs of lanes, in that order (a
 // Quadric's first ten floats), so that sums and scalings take five vector operations instead of ten.
 struct Terms {
@@ -60,22 +68,13 @@ struct Terms {
     Terms t;
     Lanes unused;
     const char* at = reinterpret_cast<const char*>(&q);
-    halves(at, t.p[0], t.p[1]), halves(at + 16, t.p[2], t.p[3]), halves(at + 24, unused, t.p[4]);
+    widen(at, t.p[0], t.p[1]), widen(at + 16, t.p[2], t.p[3]), widen(at + 24, unused, t.p[4]);
     return t;
   }
   void add(const Terms& t) { p[0] += t.p[0], p[1] += t.p[1], p[2] += t.p[2], p[3] += t.p[3], p[4] += t.p[4]; }
   // this -= t * s.
   void subtract_scaled(const Terms& t, double s) {
     p[0] -= t.p[0] * s, p[1] -= t.p[1] * s, p[2] -= t.p[2] * s, p[3] -= t.p[3] * s, p[4] -= t.p[4] * s;
-  }
-
- private:
-  // The four floats at `at` as two pairs of doubles.
-  static void halves(const char* at, Lanes& lo, Lanes& hi) {
-    FloatLanes f;
-    std::memcpy(&f, at, sizeof f);
-    const WideLanes d = __builtin_convertvector(f, WideLanes);
-    lo = __builtin_shufflevector(d, d, 0, 1), hi = __builtin_shufflevector(d, d, 2, 3);
   }
 };
 static_assert(sizeof(Quadric) == 11 * sizeof(float));  // ten terms and w, in that order, unpadded
@@ -85,13 +84,26 @@ static_assert(sizeof(Quadric) == 11 * sizeof(float));  // ten terms and w, in th
 struct ChannelSums {
   Terms t;
 
-  void add(const glm::dvec3& g, double d) {
-    const Lanes xy{g.x, g.y}, zd{g.z, d};
-    t.p[0] += Lanes{g.x, g.x} * xy;   // xx, xy
-    t.p[1] += xy * Lanes{g.z, g.y};   // xz, yy
-    t.p[2] += Lanes{g.y, g.z} * g.z;  // yz, zz
-    t.p[3] += xy * d;                 // xd, yd
-    t.p[4] += zd * d;                 // zd, dd
+  // Adds one channel of a merged pair of wedges: G = G_a + G_b, D = D_a + G_a.shift + D_b (a's term moved
+  // to b's origin, `shift` further; Reduced::add).
+  void add(const AttributeTerm& a, const AttributeTerm& b, const glm::dvec3& shift) {
+    static_assert(sizeof(AttributeTerm) == 4 * sizeof(float));  // g, then d
+    Lanes a_xy, a_zd, b_xy, b_zd;
+    widen(&a, a_xy, a_zd), widen(&b, b_xy, b_zd);
+    const Lanes xy = a_xy + b_xy, shifted = a_xy * Lanes{shift.x, shift.y};
+    const double z = a_zd[0] + b_zd[0], d = a_zd[1] + (shifted[0] + shifted[1] + a_zd[0] * shift.z) + b_zd[1];
+    add(xy, z, d);
+  }
+
+ private:
+  // Adds G G^T, G D and D^2 for G = (xy, z).
+  void add(const Lanes& xy, double z, double d) {
+    const Lanes zd{z, d};
+    t.p[0] += xy[0] * xy;            // xx, xy
+    t.p[1] += xy * Lanes{z, xy[1]};  // xz, yy
+    t.p[2] += Lanes{xy[1], z} * z;   // yz, zz
+    t.p[3] += xy * d;                // xd, yd
+    t.p[4] += zd * d;                // zd, dd
   }
 };
 
