@@ -84,7 +84,7 @@ struct Corners {
   glm::dvec2 y[3], ny[3];  // projected before and after (ny: x for the moving corners; faces that stay)
   double h[3], r[3];
   double area, new_area;  // twice the projected areas, before and after
-  bool moving[3];
+  uint8_t moving;         // bit k: corner k is at a or b (StarFace::at_a | at_b)
   int last_moving;  // the last moving corner (every face has one: it holds a or b); a face that stays has one
   bool dies;
 };
@@ -1292,10 +1292,10 @@ class Simplifier {
     const double db = glm::length(glm::dvec3(pos_[p.b]) - glm::dvec3(x));
     const double r_natural = std::max(radius_[p.a] + da, radius_[p.b] + db);
 
-    // Normal change of every face that stays and moves.
+    // Normal change of every face that stays and moves (inlined into both loops: GCC 12 left it a call).
     const float cos_max = std::cos(glm::radians(opt_.max_normal_change_deg));
     bool ok = true;
-    auto check = [&](const StarFace& star) {
+    auto check = [&](const StarFace& star) __attribute__((always_inline)) {
       if (!ok || (star.at_a && star.at_b)) return;
       const uint32_t* t = &indices_[3 * size_t(star.face)];
       glm::vec3 p0 = pos_[t[0]], p1 = pos_[t[1]], p2 = pos_[t[2]];
@@ -1384,15 +1384,10 @@ class Simplifier {
       if (i >= na && star.at_a) continue;
       const uint32_t* t = &indices_[3 * size_t(star.face)];
       Corners& c = sc.old.emplace_back();
-      int moving = 0;
-      for (int k = 0; k < 3; ++k) {
-        c.p[k] = glm::dvec3(pos_[t[k]]);
-        c.r[k] = radius_[t[k]];
-        c.moving[k] = (star.at_a | star.at_b) >> k & 1;
-        moving += c.moving[k];
-        if (c.moving[k]) c.last_moving = k;
-      }
-      c.dies = moving > 1;
+      for (int k = 0; k < 3; ++k) c.p[k] = glm::dvec3(pos_[t[k]]), c.r[k] = radius_[t[k]];
+      c.moving = star.at_a | star.at_b;
+      c.last_moving = std::bit_width(c.moving) - 1;
+      c.dies = (c.moving & (c.moving - 1)) != 0;  // two moving corners or more
       nsum += glm::cross(c.p[1] - c.p[0], c.p[2] - c.p[0]);
     }
     const double len = glm::length(nsum);
@@ -1454,8 +1449,8 @@ class Simplifier {
         if (!inside(c.ny, c.new_area, yv, l)) continue;
         double h = 0, rest = 0, mu_x = 0;
         for (int k = 0; k < 3; ++k) {
-          h += l[k] * (c.moving[k] ? hx : c.h[k]);
-          if (c.moving[k])
+          h += l[k] * (c.moving >> k & 1 ? hx : c.h[k]);
+          if (c.moving >> k & 1)
             mu_x += l[k];
           else
             rest += l[k] * c.r[k];
@@ -1479,7 +1474,7 @@ class Simplifier {
       };
       if (c.dies) {
         for (int i = 0; i < 3; ++i)
-          if (c.moving[i]) old_edge(i);
+          if (c.moving >> i & 1) old_edge(i);
         continue;
       }
       const int i = c.last_moving, j = kNext[i];
