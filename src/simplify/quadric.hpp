@@ -43,8 +43,9 @@ struct AttributeTerm {
 };
 
 // Two doubles in vector lanes (GCC's generic vectors: SSE2 on x86-64, plain code elsewhere); four floats,
-// four doubles (two SSE registers). Each lane computes what the scalar expression would, bit for bit (no
-// contraction into fused multiply-adds: the build is ISO C++, -ffp-contract=off).
+// four doubles (two SSE registers). Each lane computes what the scalar expression would, bit for bit: the
+// same operations in the same order, and nothing fused into multiply-adds (x86-64's baseline has no FMA; a
+// build with -mfma or for another target may contract the two differently, which test_quadric would show).
 using Lanes = double __attribute__((vector_size(16)));
 using FloatLanes = float __attribute__((vector_size(16)));
 using WideLanes = double __attribute__((vector_size(32)));
