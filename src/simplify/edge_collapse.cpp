@@ -84,13 +84,11 @@ struct Corners {
   glm::dvec2 y[3], ny[3];  // projected before and after (ny: x for the moving corners; faces that stay)
   double h[3], r[3];
   double area, new_area;  // twice the projected areas, before and after
-  bool moving[3];
+  uint8_t moving;         // bit k: corner k is at a or b (StarFace::at_a | at_b)
   int last_moving;  // the last moving corner (every face has one: it holds a or b); a face that stays has one
   bool dies;
 };
-// Two doubles in vector lanes (GCC's generic vectors: SSE2 on x86-64, plain code elsewhere) for
-// vertical_bound's crossing tests, and what their comparisons give (-1 where true, per lane).
-using Lanes = double __attribute__((vector_size(16)));
+// What comparisons of Lanes (quadric.hpp) give in vertical_bound's crossing tests: -1 where true, per lane.
 using LaneMask = int64_t __attribute__((vector_size(16)));
 // A projected edge for vertical_bound: origin + t direction, heights and radii at its ends.
 struct Segment {
@@ -826,10 +824,7 @@ class Simplifier {
       if (!(ww > 0)) continue;
       ChannelSums sums;
       const AttributeTerm *ta = &attr_[a * size_t(channels_)], *tb = &attr_[b * size_t(channels_)];
-      for (int j = 0; j < channels_; ++j) {
-        const glm::dvec3 ga(ta[j].g);
-        sums.add(ga + glm::dvec3(tb[j].g), double(ta[j].d) + glm::dot(ga, shift) + tb[j].d);
-      }
+      for (int j = 0; j < channels_; ++j) sums.add(ta[j], tb[j], shift);
       r.eliminate(sums, ww);
     }
     const glm::dvec3 pa = glm::dvec3(pos_[p.a]) - o, pb = glm::dvec3(pos_[p.b]) - o;
@@ -890,7 +885,9 @@ class Simplifier {
   // quadrics, positions and faces keeps its cost and allowed direction (open edges and seam twins only
   // change at touched vertices). Every vertex is visited in parallel and reads its neighbours' touched_
   // (O(T / cores) per pass; listing the neighbours of touched vertices first was a serial O(V) scan per pass,
-  // 3 % of the wall time on elephant_1m). An edge with a twin is evaluated once, from its smaller end.
+  // 3 % of the wall time on elephant_1m). An edge with a twin is evaluated once, from its smaller end. Every
+  // edge at a manifold vertex has a twin (its fan is a closed disc, and collapses keep it one: the link
+  // condition), so only other vertices walk their faces to find out (has_edge: 1 % of the instructions).
   // Every touched edge is evaluated: elephant_1m 0.1 makes 8.3 evaluations per collapse (3.3 of them the
   // first pass's, 1 the try's) in 6 passes, and nearly all touched edges fall under the next pass's limit, so
   // evaluating them lazily (only once the limit reaches their old cost) saved 1.9 % of them, took 10 passes
@@ -906,7 +903,7 @@ class Simplifier {
           const uint32_t k = t[0] == i ? 0 : (t[1] == i ? 1 : 2), j = t[(k + 1) % 3];
           if (!all && !touched_[i] && !touched_[j]) continue;
           Slot& slot = slots_[3 * size_t(faces_[s]) + k];
-          if (i > j && has_edge(j, i)) {
+          if (i > j && (kind_[i] == kManifold || has_edge(j, i))) {
             slot = Slot::none();
           } else {
             const Candidate c = evaluate(i, j);
@@ -1297,10 +1294,10 @@ class Simplifier {
     const double db = glm::length(glm::dvec3(pos_[p.b]) - glm::dvec3(x));
     const double r_natural = std::max(radius_[p.a] + da, radius_[p.b] + db);
 
-    // Normal change of every face that stays and moves.
+    // Normal change of every face that stays and moves (inlined into both loops: GCC 12 left it a call).
     const float cos_max = std::cos(glm::radians(opt_.max_normal_change_deg));
     bool ok = true;
-    auto check = [&](const StarFace& star) {
+    auto check = [&](const StarFace& star) __attribute__((always_inline)) {
       if (!ok || (star.at_a && star.at_b)) return;
       const uint32_t* t = &indices_[3 * size_t(star.face)];
       glm::vec3 p0 = pos_[t[0]], p1 = pos_[t[1]], p2 = pos_[t[2]];
@@ -1389,15 +1386,10 @@ class Simplifier {
       if (i >= na && star.at_a) continue;
       const uint32_t* t = &indices_[3 * size_t(star.face)];
       Corners& c = sc.old.emplace_back();
-      int moving = 0;
-      for (int k = 0; k < 3; ++k) {
-        c.p[k] = glm::dvec3(pos_[t[k]]);
-        c.r[k] = radius_[t[k]];
-        c.moving[k] = (star.at_a | star.at_b) >> k & 1;
-        moving += c.moving[k];
-        if (c.moving[k]) c.last_moving = k;
-      }
-      c.dies = moving > 1;
+      for (int k = 0; k < 3; ++k) c.p[k] = glm::dvec3(pos_[t[k]]), c.r[k] = radius_[t[k]];
+      c.moving = star.at_a | star.at_b;
+      c.last_moving = std::bit_width(c.moving) - 1;
+      c.dies = (c.moving & (c.moving - 1)) != 0;  // two moving corners or more
       nsum += glm::cross(c.p[1] - c.p[0], c.p[2] - c.p[0]);
     }
     const double len = glm::length(nsum);
@@ -1459,8 +1451,8 @@ class Simplifier {
         if (!inside(c.ny, c.new_area, yv, l)) continue;
         double h = 0, rest = 0, mu_x = 0;
         for (int k = 0; k < 3; ++k) {
-          h += l[k] * (c.moving[k] ? hx : c.h[k]);
-          if (c.moving[k])
+          h += l[k] * (c.moving >> k & 1 ? hx : c.h[k]);
+          if (c.moving >> k & 1)
             mu_x += l[k];
           else
             rest += l[k] * c.r[k];
@@ -1484,7 +1476,7 @@ class Simplifier {
       };
       if (c.dies) {
         for (int i = 0; i < 3; ++i)
-          if (c.moving[i]) old_edge(i);
+          if (c.moving >> i & 1) old_edge(i);
         continue;
       }
       const int i = c.last_moving, j = kNext[i];
@@ -1506,26 +1498,32 @@ class Simplifier {
       const double sign = cross2(rel, o.direction) > 0 ? 1.0 : -1.0;
       const double sn = sign * cross2(rel, o.direction), dx = sign * o.direction.x, dy = sign * o.direction.y;
       if (sn == 0) continue;
+      // tn = sign cross2(rel, nd) = cross2(sign rel, nd): negation commutes with rounding (a zero may change
+      // sign, which no test below tells apart).
+      const double rx = sign * rel.x, ry = sign * rel.y;
       // The tests for up to 64 spokes at a time, two per step in vector lanes without branches (about 40 %
       // of pairs pass the first, at random: as branches they were mostly mispredictions; one lane per step
-      // cost three times the instructions), then the crossings among them in order. The lanes compute what
-      // the scalar expressions would, bit for bit.
+      // cost three times the instructions), each lane's outcome kept as its spoke's bit in the lanes (bit
+      // k - k0 of lane (k - k0) % 2; moving the bits to a scalar every step took 12 of its 36 instructions,
+      // now 24), then the crossings among them in order. The lanes compute what the scalar expressions would,
+      // bit for bit.
       const double threshold = std::max(sn, tiny);  // den > sn and den >= 1e-30
       for (size_t k0 = 0; k0 < spokes; k0 += 64) {
         const size_t k1 = std::min(spokes, k0 + 64);
-        uint64_t crossing = 0;
-        for (size_t k = k0; k < k1; k += 2) {
+        LaneMask passed{0, 0}, bit{1, 2};
+        for (size_t k = k0; k < k1; k += 2, bit <<= 2) {
           Lanes x, y;
           std::memcpy(&x, &sc.spoke_x[k], sizeof x), std::memcpy(&y, &sc.spoke_y[k], sizeof y);
-          const Lanes den = x * dy - y * dx, tn = sign * (rel.x * y - rel.y * x);  // tn: sign cross2(rel, nd)
-          const LaneMask pass = (den > threshold) & (tn > 0) & (tn < den);
-          crossing |= uint64_t((pass[0] & 1) | (pass[1] & 2)) << (k - k0);
+          const Lanes den = x * dy - y * dx, tn = rx * y - ry * x;
+          // Each test selects the spokes' bits (as `cmp ? bit : 0`, GCC 12 keeps the masks in the vector
+          // registers; `(cmp) & (cmp) & bit` moved each lane out and back).
+          passed |= (den > threshold ? bit : 0) & (tn > 0 ? bit : 0) & (tn < den ? bit : 0);
         }
-        for (; crossing != 0; crossing &= crossing - 1) {
+        for (uint64_t crossing = uint64_t(passed[0] | passed[1]); crossing != 0; crossing &= crossing - 1) {
           const size_t k = k0 + size_t(__builtin_ctzll(crossing));
           const Segment& e = sc.spokes[k];
           const double den = sc.spoke_x[k] * dy - sc.spoke_y[k] * dx;
-          const double tn = sign * (rel.x * sc.spoke_y[k] - rel.y * sc.spoke_x[k]);
+          const double tn = rx * sc.spoke_y[k] - ry * sc.spoke_x[k];
           const double s = sn / den, t = tn / den;
           if (!(s > 0 && s < 1 && t > 0 && t < 1)) continue;
           const double gap = std::abs((1 - s) * hx + s * e.h0 - ((1 - t) * o.h0 + t * o.h1));

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstring>
 #include <glm/glm.hpp>
 
 namespace lodstream::simplify {
@@ -41,60 +42,119 @@ struct AttributeTerm {
   float d = 0.0f;
 };
 
-// Sums over attribute channels of G G^T, G D and D^2 (the terms Reduced::eliminate subtracts).
-struct ChannelSums {
-  double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
-  double xd = 0, yd = 0, zd = 0;
-  double dd = 0;
+// Two doubles in vector lanes (GCC's generic vectors: SSE2 on x86-64, plain code elsewhere); four floats,
+// four doubles (two SSE registers). Each lane computes what the scalar expression would, bit for bit: the
+// same operations in the same order, and nothing fused into multiply-adds (x86-64's baseline has no FMA; a
+// build with -mfma or for another target may contract the two differently, which test_quadric would show).
+using Lanes = double __attribute__((vector_size(16)));
+using FloatLanes = float __attribute__((vector_size(16)));
+using WideLanes = double __attribute__((vector_size(32)));
 
-  void add(const glm::dvec3& g, double d) {
-    xx += g.x * g.x, xy += g.x * g.y, xz += g.x * g.z, yy += g.y * g.y, yz += g.y * g.z, zz += g.z * g.z;
-    xd += g.x * d, yd += g.y * d, zd += g.z * d;
-    dd += d * d;
+// The four floats at `at` as two pairs of doubles (cvtps2pd twice).
+inline void widen(const void* at, Lanes& lo, Lanes& hi) {
+  FloatLanes f;
+  std::memcpy(&f, at, sizeof f);
+  const WideLanes d = __builtin_convertvector(f, WideLanes);
+  lo = __builtin_shufflevector(d, d, 0, 1), hi = __builtin_shufflevector(d, d, 2, 3);
+}
+
+// The ten terms (a00, a01, a02, a11, a12, a22, b0, b1, b2, c) as five pairs of lanes, in that order (a
+// Quadric's first ten floats), so that sums and scalings take five vector operations instead of ten.
+struct Terms {
+  Lanes p[5] = {};
+
+  // A Quadric's ten terms, converted to double: three loads of four floats (the last one at b0, so that it
+  // stays inside the Quadric), each converted in two instructions.
+  static Terms of(const Quadric& q) {
+    Terms t;
+    Lanes unused;
+    const char* at = reinterpret_cast<const char*>(&q);
+    widen(at, t.p[0], t.p[1]), widen(at + 16, t.p[2], t.p[3]), widen(at + 24, unused, t.p[4]);
+    return t;
+  }
+  void add(const Terms& t) { p[0] += t.p[0], p[1] += t.p[1], p[2] += t.p[2], p[3] += t.p[3], p[4] += t.p[4]; }
+  // this -= t * s.
+  void subtract_scaled(const Terms& t, double s) {
+    p[0] -= t.p[0] * s, p[1] -= t.p[1] * s, p[2] -= t.p[2] * s, p[3] -= t.p[3] * s, p[4] -= t.p[4] * s;
+  }
+};
+static_assert(sizeof(Quadric) == 11 * sizeof(float));  // ten terms and w, in that order, unpadded
+
+// Sums over attribute channels of G G^T, G D and D^2 (the terms Reduced::eliminate subtracts), as Terms:
+// (xx, xy, xz, yy, yz, zz, xd, yd, zd, dd).
+struct ChannelSums {
+  Terms t;
+
+  // Adds one channel of a merged pair of wedges: G = G_a + G_b, D = D_a + G_a.shift + D_b (a's term moved
+  // to b's origin, `shift` further; Reduced::add).
+  void add(const AttributeTerm& a, const AttributeTerm& b, const glm::dvec3& shift) {
+    static_assert(sizeof(AttributeTerm) == 4 * sizeof(float));  // g, then d
+    Lanes a_xy, a_zd, b_xy, b_zd;
+    widen(&a, a_xy, a_zd), widen(&b, b_xy, b_zd);
+    const Lanes xy = a_xy + b_xy, shifted = a_xy * Lanes{shift.x, shift.y};
+    const double z = a_zd[0] + b_zd[0], d = a_zd[1] + (shifted[0] + shifted[1] + a_zd[0] * shift.z) + b_zd[1];
+    add(xy, z, d);
+  }
+
+ private:
+  // Adds G G^T, G D and D^2 for G = (xy, z).
+  void add(const Lanes& xy, double z, double d) {
+    const Lanes zd{z, d};
+    t.p[0] += xy[0] * xy;            // xx, xy
+    t.p[1] += xy * Lanes{z, xy[1]};  // xz, yy
+    t.p[2] += Lanes{xy[1], z} * z;   // yz, zz
+    t.p[3] += xy * d;                // xd, yd
+    t.p[4] += zd * d;                // zd, dd
   }
 };
 
-// Symmetric 3x3 system in double precision, accumulated from quadrics and attribute reductions.
+// Symmetric 3x3 system in double precision, accumulated from quadrics and attribute reductions: the terms
+// (a00, a01, a02, a11, a12, a22, b0, b1, b2, c) in pairs of lanes (Terms).
 struct Reduced {
-  double a00 = 0, a01 = 0, a02 = 0, a11 = 0, a12 = 0, a22 = 0;
-  double b0 = 0, b1 = 0, b2 = 0;
-  double c = 0;
+  Terms t;
 
-  // Adds a Quadric or a Reduced (same origin).
-  template <class Q>
-  void add(const Q& q) {
-    a00 += q.a00, a01 += q.a01, a02 += q.a02, a11 += q.a11, a12 += q.a12, a22 += q.a22;
-    b0 += q.b0, b1 += q.b1, b2 += q.b2, c += q.c;
-  }
+  double a00() const { return t.p[0][0]; }
+  double a01() const { return t.p[0][1]; }
+  double a02() const { return t.p[1][0]; }
+  double a11() const { return t.p[1][1]; }
+  double a12() const { return t.p[2][0]; }
+  double a22() const { return t.p[2][1]; }
+  double b0() const { return t.p[3][0]; }
+  double b1() const { return t.p[3][1]; }
+  double b2() const { return t.p[4][0]; }
+  double c() const { return t.p[4][1]; }
+
+  void add(const Quadric& q) { t.add(Terms::of(q)); }
+  void add(const Reduced& r) { t.add(r.t); }
   // Adds q stored relative to origin o_q, this one being relative to o = o_q + d: with y = p - o_q = y' + d,
-  // Q = y'^T A y' + 2 (b + A d).y' + (c + 2 b.d + d^T A d).
+  // Q = y'^T A y' + 2 (b + A d).y' + (c + 2 b.d + d^T A d). In lanes: (A d)_0, (A d)_1 in one pair,
+  // (A d)_2 with b.d in another.
   void add(const Quadric& q, const glm::dvec3& d) {
-    const double ad0 = q.a00 * d.x + q.a01 * d.y + q.a02 * d.z, ad1 = q.a01 * d.x + q.a11 * d.y + q.a12 * d.z,
-                 ad2 = q.a02 * d.x + q.a12 * d.y + q.a22 * d.z;
-    a00 += q.a00, a01 += q.a01, a02 += q.a02, a11 += q.a11, a12 += q.a12, a22 += q.a22;
-    b0 += q.b0 + ad0, b1 += q.b1 + ad1, b2 += q.b2 + ad2;
-    c += q.c + 2 * (double(q.b0) * d.x + double(q.b1) * d.y + double(q.b2) * d.z) + ad0 * d.x + ad1 * d.y +
-         ad2 * d.z;
+    const Terms s = Terms::of(q);
+    const Lanes &q0 = s.p[0], &q1 = s.p[1], &q2 = s.p[2], &q3 = s.p[3], &q4 = s.p[4];
+    // (a00, a01) dx + (a01, a11) dy + (a02, a12) dz; (a02, b0) dx + (a12, b1) dy + (a22, b2) dz.
+    const Lanes ad01 = q0 * d.x + Lanes{q0[1], q1[1]} * d.y + Lanes{q1[0], q2[0]} * d.z;
+    const Lanes ad2_bd = Lanes{q1[0], q3[0]} * d.x + Lanes{q2[0], q3[1]} * d.y + Lanes{q2[1], q4[0]} * d.z;
+    const double ad0 = ad01[0], ad1 = ad01[1], ad2 = ad2_bd[0], bd = ad2_bd[1];
+    t.p[0] += q0, t.p[1] += q1, t.p[2] += q2;
+    t.p[3] += q3 + ad01;
+    t.p[4] += Lanes{q4[0] + ad2, q4[1] + 2 * bd + ad0 * d.x + ad1 * d.y + ad2 * d.z};
   }
   // Subtracts sum_j (G_j G_j^T, G_j D_j, D_j^2) / W over the attribute channels summed in `s` (the
   // closed-form minimum over each s_j): one division and one scaling for all channels.
-  void eliminate(const ChannelSums& s, double w) {
-    const double iw = 1.0 / w;
-    a00 -= s.xx * iw, a01 -= s.xy * iw, a02 -= s.xz * iw, a11 -= s.yy * iw, a12 -= s.yz * iw,
-        a22 -= s.zz * iw;
-    b0 -= s.xd * iw, b1 -= s.yd * iw, b2 -= s.zd * iw;
-    c -= s.dd * iw;
-  }
+  void eliminate(const ChannelSums& s, double w) { t.subtract_scaled(s.t, 1.0 / w); }
   // Q(p) = p^T A p + 2 b.p + c, clamped at 0 (rounding).
   double eval(const glm::dvec3& p) const {
-    double r = a00 * p.x * p.x + a11 * p.y * p.y + a22 * p.z * p.z +
-               2 * (a01 * p.x * p.y + a02 * p.x * p.z + a12 * p.y * p.z) +
-               2 * (b0 * p.x + b1 * p.y + b2 * p.z) + c;
+    double r = a00() * p.x * p.x + a11() * p.y * p.y + a22() * p.z * p.z +
+               2 * (a01() * p.x * p.y + a02() * p.x * p.z + a12() * p.y * p.z) +
+               2 * (b0() * p.x + b1() * p.y + b2() * p.z) + c();
     return r > 0 ? r : 0;
   }
   // Optimal placement: solves A x = -b by Cramer's rule; false when A is ill-conditioned
   // (|det| below 1e-6 of the cube of its mean diagonal).
   bool solve(glm::dvec3& x) const {
+    const double a00 = this->a00(), a01 = this->a01(), a02 = this->a02(), a11 = this->a11(),
+                 a12 = this->a12(), a22 = this->a22(), b0 = this->b0(), b1 = this->b1(), b2 = this->b2();
     double c00 = a11 * a22 - a12 * a12, c01 = a02 * a12 - a01 * a22, c02 = a01 * a12 - a02 * a11;
     double det = a00 * c00 + a01 * c01 + a02 * c02;
     double s = (a00 + a11 + a22) / 3.0;
@@ -108,11 +168,11 @@ struct Reduced {
   }
   // Minimum along the segment p + t e, t in [0,1] (digest §7.6.2: t* = -(e^T A p + b.e) / (e^T A e)).
   double segment_parameter(const glm::dvec3& p, const glm::dvec3& e) const {
-    glm::dvec3 ae{a00 * e.x + a01 * e.y + a02 * e.z, a01 * e.x + a11 * e.y + a12 * e.z,
-                  a02 * e.x + a12 * e.y + a22 * e.z};
+    glm::dvec3 ae{a00() * e.x + a01() * e.y + a02() * e.z, a01() * e.x + a11() * e.y + a12() * e.z,
+                  a02() * e.x + a12() * e.y + a22() * e.z};
     double den = glm::dot(e, ae);
     if (!(den > 0)) return 0.5;
-    double t = -(glm::dot(p, ae) + b0 * e.x + b1 * e.y + b2 * e.z) / den;
+    double t = -(glm::dot(p, ae) + b0() * e.x + b1() * e.y + b2() * e.z) / den;
     return t < 0 ? 0 : (t > 1 ? 1 : t);
   }
 };
@@ -120,8 +180,16 @@ struct Reduced {
 void Quadric::add_shifted(const Quadric& q, const glm::dvec3& d) {
   Reduced r;
   r.add(q, d);
-  a00 += float(r.a00), a01 += float(r.a01), a02 += float(r.a02), a11 += float(r.a11), a12 += float(r.a12);
-  a22 += float(r.a22), b0 += float(r.b0), b1 += float(r.b1), b2 += float(r.b2), c += float(r.c), w += q.w;
+  // Each term rounded to float, then added in float: four at a time, then b2 and c.
+  const Lanes* t = r.t.p;
+  for (int k = 0; k < 2; ++k) {
+    char* at = reinterpret_cast<char*>(this) + 16 * k;
+    FloatLanes f;
+    std::memcpy(&f, at, sizeof f);
+    f += __builtin_convertvector(__builtin_shufflevector(t[2 * k], t[2 * k + 1], 0, 1, 2, 3), FloatLanes);
+    std::memcpy(at, &f, sizeof f);
+  }
+  b2 += float(t[4][0]), c += float(t[4][1]), w += q.w;
 }
 
 }  // namespace lodstream::simplify
