@@ -14,7 +14,9 @@
 
 namespace lodstream::package {
 
-// The locked stream of a quantized node stored at shift k (empty when k = 0). Cost: O(V).
+// The locked stream of a quantized node stored at shift k (empty when k = 0); a locked vertex whose k low
+// bits are all 0 is flagged as free (it decodes alike and stores no low bits: elephant_1m 1.3 KB less, the
+// ~1/8 of locked vertices at shift 1 that lie on even grid points). Cost: O(V).
 std::vector<uint8_t> encode_locked_stream(const QuantizedNode& node, uint32_t k);
 
 // A validated locked stream: its size matches V, k and the number of locked vertices, and no flag lies past

@@ -214,6 +214,40 @@ TEST_P(NodeCodecTest, PositionsDecodeExactlyOnTheGrid) {
     }
 }
 
+TEST_P(NodeCodecTest, LockedVerticesOnTheCoarseGridStoreNoLowBits) {
+  // Every vertex locked at shift 3, half of them on grid points that are multiples of 8 (no low bits): the
+  // node is stored as if only the others were locked (coarse_positions.hpp), and all decode exactly.
+  Mesh m = uv_sphere(1.0f, 9, 14);
+  const uint32_t shift = 3;
+  const PositionGrid pg = PositionGrid::for_bounds(m.bounds(), 14);
+  std::vector<uint8_t> all(m.vertex_count(), 1), unaligned(m.vertex_count(), 0);
+  std::vector<uint32_t> id(m.vertex_count());
+  for (size_t v = 0; v < m.vertex_count(); ++v) {
+    id[v] = uint32_t(v);
+    for (int a = 0; a < 3; ++a) {
+      double q = std::round((double(m.positions[v][a]) - double(pg.origin[a])) / double(pg.step));
+      if (v % 2 == 0) q = 8.0 * std::round(q / 8.0);
+      m.positions[v][a] = pg.origin[a] + float(q) * pg.step;
+      unaligned[v] |= std::fmod(q, 8.0) != 0.0;
+    }
+  }
+  ASSERT_GT(std::count(unaligned.begin(), unaligned.end(), 0), ptrdiff_t(m.vertex_count() / 2 - 1));
+  NodeGeometry g;
+  g.mesh = &m;
+  g.position_shift = shift;
+  g.normal_bits = 10;
+  g.vertex_data = id;
+  const NodeCodec& codec = node_codec(GetParam());
+  g.locked = all;
+  const std::vector<uint8_t> bytes = codec.encode(g, pg);
+  g.locked = unaligned;
+  EXPECT_EQ(bytes, codec.encode(g, pg));
+  const DecodedNode d = codec.decode(bytes, pg, "locked");
+  ASSERT_EQ(d.mesh.vertex_count(), m.vertex_count());
+  for (size_t v = 0; v < d.mesh.vertex_count(); ++v)
+    EXPECT_EQ(d.mesh.positions[v], m.positions[d.vertex_data[v]]);
+}
+
 TEST_P(NodeCodecTest, AttributesAndLockedVerticesRoundTrip) {
   // A node at shift 3 with every attribute; vertex_data numbers the input vertices, so that each decoded
   // vertex (the codec reorders them) is compared with its own input.
