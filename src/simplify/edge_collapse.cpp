@@ -479,16 +479,21 @@ class Simplifier {
     offsets_[m] = uint32_t(corners);
   }
 
-  // Out- and in-neighbours of v over its alive faces: face (v, out, in) in counter-clockwise order.
-  void fan(uint32_t v, std::vector<uint32_t>& outs, std::vector<uint32_t>& ins) const {
-    outs.clear(), ins.clear();
+  // f(out, in) for each alive face (v, out, in) of v (counter-clockwise order), in face order.
+  template <class F>
+  void for_fan(uint32_t v, F&& f) const {
     for (uint32_t s = offsets_[v]; s < offsets_[v + 1]; ++s) {
       const uint32_t* t = &indices_[3 * size_t(faces_[s])];
       if (t[0] == kNone) continue;
       int k = t[0] == v ? 0 : (t[1] == v ? 1 : 2);
-      outs.push_back(t[(k + 1) % 3]);
-      ins.push_back(t[(k + 2) % 3]);
+      f(t[(k + 1) % 3], t[(k + 2) % 3]);
     }
+  }
+
+  // Out- and in-neighbours of v over its alive faces (for_fan).
+  void fan(uint32_t v, std::vector<uint32_t>& outs, std::vector<uint32_t>& ins) const {
+    outs.clear(), ins.clear();
+    for_fan(v, [&](uint32_t out, uint32_t in) { outs.push_back(out), ins.push_back(in); });
   }
 
   // Whether a face holds the directed edge j -> i, i.e. edge i -> j has a twin: one walk over i's faces
@@ -508,8 +513,7 @@ class Simplifier {
     open_out_.assign(m, kNone), open_in_.assign(m, kNone);
     std::vector<uint8_t> open_count(m, 0), complex(m, 0);
     for_blocks(uint32_t(m), 4096, [&](const auto& r) {
-      thread_local std::vector<uint32_t> outs, ins;
-      for (uint32_t v = r.begin(); v < r.end(); ++v) classify_fan(v, outs, ins, open_count, complex);
+      for (uint32_t v = r.begin(); v < r.end(); ++v) classify_fan(v, open_count, complex);
     });
     for (uint32_t v = 0; v < m; ++v) {
       if (kind_[v] == kLocked || complex[v]) {
@@ -534,17 +538,18 @@ class Simplifier {
   // classify's first step for one vertex: its open edges (open_out_, open_in_, open_count) and whether its
   // fan is complex (a directed edge twice, more than one open edge, or faces not forming one disc or fan).
   // A complex vertex is locked, so its open edges are not needed: a repeated edge ends the scan. Writes
-  // only v's entries, so vertices run in parallel. O(degree^2) compares: the repeats, then one scan of all
-  // (in, out) pairs, which also links the faces for the walk.
-  void classify_fan(uint32_t v, std::vector<uint32_t>& outs, std::vector<uint32_t>& ins,
-                    std::vector<uint8_t>& open_count, std::vector<uint8_t>& complex) {
-    fan(v, outs, ins);
-    const size_t deg = outs.size();
-    if (deg == 0) return;
-    if (deg > 256) {
+  // only v's entries, so vertices run in parallel. Its faces are all alive (classify runs before the first
+  // collapse), so its degree is its count of faces and its fan goes into arrays on the stack. O(degree^2)
+  // compares: the repeats, then one scan of all (in, out) pairs, which also links the faces for the walk.
+  void classify_fan(uint32_t v, std::vector<uint8_t>& open_count, std::vector<uint8_t>& complex) {
+    if (offsets_[v + 1] - offsets_[v] > 256) {
       complex[v] = 1;
       return;
     }
+    std::array<uint32_t, 256> outs, ins;
+    size_t deg = 0;
+    for_fan(v, [&](uint32_t out, uint32_t in) { outs[deg] = out, ins[deg++] = in; });
+    if (deg == 0) return;
     for (size_t i = 0; i < deg; ++i)
       for (size_t j = i + 1; j < deg; ++j)
         if (outs[j] == outs[i]) {
@@ -561,7 +566,10 @@ class Simplifier {
     for (size_t i = 0; i < deg; ++i) next[i] = kNoFace, out_closed[i] = 0;
     for (size_t i = 0; i < deg; ++i)
       for (size_t j = 0; j < deg; ++j)
-        if (outs[j] == ins[i]) next[i] = uint16_t(j), out_closed[j] = 1;
+        if (outs[j] == ins[i]) {
+          next[i] = uint16_t(j), out_closed[j] = 1;
+          break;
+        }
     uint32_t n_open_out = 0, n_open_in = 0, start = 0;
     for (size_t i = 0; i < deg; ++i) {
       if (!out_closed[i]) ++n_open_out, open_out_[v] = outs[i], start = uint32_t(i);
