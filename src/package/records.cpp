@@ -39,9 +39,14 @@ RecordMesh weld_record(std::span<const Mesh* const> clusters,
       if (m.has_normals()) std::memcpy(&key[3], &m.normals[v], 12);
       if (m.has_uvs()) std::memcpy(&key[6], &m.uvs[v], 8);
       if (m.has_colors()) std::memcpy(&key[8], &m.colors[v], 16);
-      uint64_t h = 0x9e3779b97f4a7c15ull;
-      for (uint32_t x : key) h = (h ^ x) * 0xff51afd7ed558ccdull;
-      hashes[i] = h ^ (h >> 32);
+      // The key as six 64-bit words, each multiplied by its own odd constant (independent products, not
+      // one chain of twelve), summed, then mixed so that the low bits depend on all of them.
+      uint64_t words[6];
+      std::memcpy(words, key.data(), sizeof words);
+      uint64_t h = 0;
+      for (int w = 0; w < 6; ++w) h += words[w] * (0x9e3779b97f4a7c15ull + 2 * uint64_t(w));
+      h ^= h >> 32, h *= 0xff51afd7ed558ccdull;
+      hashes[i] = h ^ (h >> 29);
     }
   }
   const std::vector<uint32_t> first = representatives(
