@@ -548,9 +548,18 @@ class Simplifier {
       complex[v] = 1;
       return;
     }
+    // next[i]: the face g with g.out == face i's in (one at most once out-neighbours do not repeat; kNoFace
+    // when face i's in edge is open); out_closed[i]: whether face i's out edge has a twin. Set below, cleared
+    // here with the fan (set in a loop of their own, they were two calls of memset per vertex).
+    constexpr uint16_t kNoFace = UINT16_MAX;
     std::array<uint32_t, 256> outs, ins;
+    std::array<uint16_t, 256> next;
+    std::array<uint8_t, 256> out_closed;
     size_t deg = 0;
-    for_fan(v, [&](uint32_t out, uint32_t in) { outs[deg] = out, ins[deg++] = in; });
+    for_fan(v, [&](uint32_t out, uint32_t in) {
+      outs[deg] = out, ins[deg] = in, next[deg] = kNoFace, out_closed[deg] = 0;
+      ++deg;
+    });
     if (deg == 0) return;
     for (size_t i = 0; i < deg; ++i)
       for (size_t j = i + 1; j < deg; ++j)
@@ -559,13 +568,7 @@ class Simplifier {
           return;
         }
 
-    // One scan of all (in, out) pairs: next[i], the face g with g.out == face i's in (one at most: no
-    // out-neighbour repeats; kNoFace when face i's in edge is open), and whether face i's out edge has a
-    // twin.
-    constexpr uint16_t kNoFace = UINT16_MAX;
-    std::array<uint16_t, 256> next;
-    std::array<uint8_t, 256> out_closed;
-    for (size_t i = 0; i < deg; ++i) next[i] = kNoFace, out_closed[i] = 0;
+    // One scan of all (in, out) pairs: next and out_closed.
     for (size_t i = 0; i < deg; ++i)
       for (size_t j = 0; j < deg; ++j)
         if (outs[j] == ins[i]) {
