@@ -5,6 +5,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include "core/error.hpp"
@@ -422,14 +423,20 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
         owner.reserve(b.next_position_id * 3 / 2), border.reserve(b.next_position_id * 3 / 2);
       owner.resize(b.next_position_id, UINT32_MAX), border.resize(b.next_position_id, 0);
     }
-    for (uint32_t g = 0; g < groups.size(); ++g)
+    // Groups on every core (these scattered reads of every active position, on one core, left the other
+    // idle): the first group to claim a position owns it, and a claim by any other marks it a border, so
+    // the borders do not depend on the order of the claims.
+    tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
       for (uint32_t c : groups[g])
         for (uint32_t id : b.position_ids[c]) {
-          if (owner[id] == UINT32_MAX)
-            owner[id] = g;
-          else if (owner[id] != g)
-            border[id] = 1;
+          std::atomic_ref<uint32_t> own(owner[id]);
+          uint32_t claimed = own.load(std::memory_order_relaxed);
+          if (claimed == UINT32_MAX &&
+              own.compare_exchange_strong(claimed, uint32_t(g), std::memory_order_relaxed))
+            continue;
+          if (claimed != g) std::atomic_ref<uint8_t>(border[id]).store(1, std::memory_order_relaxed);
         }
+    });
 
     std::vector<GroupResult> results(groups.size());
     tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
@@ -437,9 +444,13 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
       if (groups[g].size() > 1 || groups.size() == 1)
         results[g] = simplify_group(b, groups[g], border, level);
     });
-    for (const std::vector<uint32_t>& group : groups)
-      for (uint32_t c : group)
-        for (uint32_t id : b.position_ids[c]) owner[id] = UINT32_MAX, border[id] = 0;
+    tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
+      for (uint32_t c : groups[g])
+        for (uint32_t id : b.position_ids[c]) {
+          std::atomic_ref<uint32_t>(owner[id]).store(UINT32_MAX, std::memory_order_relaxed);
+          std::atomic_ref<uint8_t>(border[id]).store(0, std::memory_order_relaxed);
+        }
+    });
 
     std::vector<uint32_t> next, completed_groups;
     bool any = false;

@@ -41,29 +41,31 @@ void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indice
       for (int k = 0; k < 3; ++k)
         if (distinct(t, k)) adjacent[fill[indices[3 * t + k]]++] = uint32_t(t);
   }
-  // Per triangle: used, its distinct corners, corners already in the current cluster (valid while listed in
-  // its frontier), and flags: it is the last unused triangle of one of its vertices; it is listed in `near`
-  // (valid while listed in the frontier).
+  // Per triangle, in one record (a step reads several fields of each triangle it touches; in separate
+  // arrays each was a cache miss of its own on a level-0 chunk): used, its distinct corners, corners already
+  // in the current cluster (valid while listed in its frontier), flags (it is the last unused triangle of one
+  // of its vertices; it is listed in `near`, valid while listed in the frontier), the cluster that listed it
+  // in its frontier, its place in the order of listing (which breaks ties as one list would), its centroid.
   constexpr uint8_t kLast = 1, kNear = 2;
+  constexpr uint32_t kUnset = UINT32_MAX;
   struct State {
     uint8_t used = 0, corners = 0, shared = 0, flags = 0;
+    uint32_t in_frontier = UINT32_MAX, listed = 0;  // kUnset
+    glm::vec3 centroid{0.0f};
   };
   std::vector<State> state(triangles);
-  std::vector<glm::vec3> centroid(triangles);
   for (size_t t = 0; t < triangles; ++t) {
     const uint32_t* c = &indices[3 * t];
-    centroid[t] = (positions[c[0]] + positions[c[1]] + positions[c[2]]) * (1.0f / 3.0f);
+    state[t].centroid = (positions[c[0]] + positions[c[1]] + positions[c[2]]) * (1.0f / 3.0f);
     for (int k = 0; k < 3; ++k)
       if (distinct(t, k)) ++state[t].corners, state[t].flags |= remaining[c[k]] == 1 ? kLast : 0;
   }
 
-  constexpr uint32_t kUnset = UINT32_MAX;
   std::vector<uint32_t> local(vertices, kUnset);  // vertex -> cluster vertex number, current cluster only
-  std::vector<uint32_t> in_frontier(triangles, kUnset);  // the cluster that listed it
   // The frontier, by priority (below): ready, adding no vertex; near, the last unused triangle of one of its
   // vertices or adding one; far, the rest (adding two; an entry that moves to near stays behind in far, which
-  // skips it). listed: each triangle's place in the order of listing, which breaks ties as one list would.
-  std::vector<uint32_t> ready, near, far, listed(triangles);
+  // skips it).
+  std::vector<uint32_t> ready, near, far;
   uint32_t listings = 0;
   size_t cursor = 0;  // every triangle before it is used
   for (uint32_t cluster = 0;; ++cluster) {
@@ -76,7 +78,7 @@ void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indice
     glm::vec3 sum(0.0f);
     auto add = [&](uint32_t t) {
       state[t].used = 1;
-      sum += centroid[t];
+      sum += state[t].centroid;
       for (int k = 0; k < 3; ++k) {
         const uint32_t v = indices[3 * size_t(t) + k];
         if (distinct(t, k)) {
@@ -84,7 +86,7 @@ void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indice
             for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) {
               State& st = state[adjacent[s]];
               st.flags |= kLast;
-              if (!st.used && in_frontier[adjacent[s]] == cluster && !(st.flags & kNear))
+              if (!st.used && st.in_frontier == cluster && !(st.flags & kNear))
                 st.flags |= kNear, near.push_back(adjacent[s]);
             }
           if (local[v] == kUnset) {
@@ -94,8 +96,8 @@ void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indice
               const uint32_t n = adjacent[s];
               State& st = state[n];
               if (st.used) continue;
-              const bool first = in_frontier[n] != cluster;
-              if (first) in_frontier[n] = cluster, st.shared = 0, st.flags &= ~kNear, listed[n] = listings++;
+              const bool first = st.in_frontier != cluster;
+              if (first) st.in_frontier = cluster, st.shared = 0, st.flags &= ~kNear, st.listed = listings++;
               if (++st.shared == st.corners)
                 ready.push_back(n);
               else if (!(st.flags & kNear) && ((st.flags & kLast) || st.corners - st.shared == 1))
@@ -128,17 +130,17 @@ void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indice
         for (size_t i = 0; i < list.size();
              ++i) {  // drops used (and, from far, moved) entries while scanning
           const uint32_t t = list[i];
-          const State st = state[t];
+          const State& st = state[t];
           if (st.used || (is_far && (st.flags & kNear))) continue;
           list[kept++] = t;
           const size_t added = size_t(st.corners - st.shared);
           if (part.vertices.size() + added > max_vertices) continue;
           const uint32_t priority = (st.flags & kLast) ? 1 : uint32_t(added) + 1;
           if (priority > best_priority) continue;
-          const glm::vec3 d = centroid[t] - center;
+          const glm::vec3 d = st.centroid - center;
           const float distance = glm::dot(d, d);
           if (priority < best_priority || distance < best_distance ||
-              (distance == best_distance && listed[t] < listed[best]))
+              (distance == best_distance && st.listed < state[best].listed))
             best = t, best_priority = priority, best_distance = distance;
         }
         list.resize(kept);
@@ -154,7 +156,7 @@ void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indice
         for (size_t t = cursor, seen = 0; t < triangles && seen < kJumpWindow; ++t) {
           if (state[t].used) continue;
           ++seen;
-          const glm::vec3 d = centroid[t] - center;
+          const glm::vec3 d = state[t].centroid - center;
           if (best == kUnset || glm::dot(d, d) < best_distance)
             best = uint32_t(t), best_distance = glm::dot(d, d);
         }

@@ -336,15 +336,17 @@ class Simplifier {
       r = std::max(r, std::nextafter(float(e / double(scale_) * (1 + 1e-6)), INFINITY));
     }
 
-    indices_.clear();
-    indices_.reserve(in_.indices.size());
+    indices_.resize(in_.indices.size() / 3 * 3);  // written in place below (an insert per face cost ~60
+                                                  // instructions), then cut to the faces kept
+    size_t kept = 0;
     for (size_t t = 0; t + 2 < in_.indices.size(); t += 3) {
       uint32_t a = in_.indices[t], b = in_.indices[t + 1], c = in_.indices[t + 2];
       if (a >= n || b >= n || c >= n) continue;
       a = weld_remap_[a], b = weld_remap_[b], c = weld_remap_[c];
       if (a == b || b == c || a == c) continue;
-      indices_.insert(indices_.end(), {a, b, c});
+      indices_[kept] = a, indices_[kept + 1] = b, indices_[kept + 2] = c, kept += 3;
     }
+    indices_.resize(kept);
     alive_triangles_ = welded_triangles_ = indices_.size() / 3;
     sort_faces();
   }
@@ -477,16 +479,21 @@ class Simplifier {
     offsets_[m] = uint32_t(corners);
   }
 
-  // Out- and in-neighbours of v over its alive faces: face (v, out, in) in counter-clockwise order.
-  void fan(uint32_t v, std::vector<uint32_t>& outs, std::vector<uint32_t>& ins) const {
-    outs.clear(), ins.clear();
+  // f(out, in) for each alive face (v, out, in) of v (counter-clockwise order), in face order.
+  template <class F>
+  void for_fan(uint32_t v, F&& f) const {
     for (uint32_t s = offsets_[v]; s < offsets_[v + 1]; ++s) {
       const uint32_t* t = &indices_[3 * size_t(faces_[s])];
       if (t[0] == kNone) continue;
       int k = t[0] == v ? 0 : (t[1] == v ? 1 : 2);
-      outs.push_back(t[(k + 1) % 3]);
-      ins.push_back(t[(k + 2) % 3]);
+      f(t[(k + 1) % 3], t[(k + 2) % 3]);
     }
+  }
+
+  // Out- and in-neighbours of v over its alive faces (for_fan).
+  void fan(uint32_t v, std::vector<uint32_t>& outs, std::vector<uint32_t>& ins) const {
+    outs.clear(), ins.clear();
+    for_fan(v, [&](uint32_t out, uint32_t in) { outs.push_back(out), ins.push_back(in); });
   }
 
   // Whether a face holds the directed edge j -> i, i.e. edge i -> j has a twin: one walk over i's faces
@@ -506,8 +513,7 @@ class Simplifier {
     open_out_.assign(m, kNone), open_in_.assign(m, kNone);
     std::vector<uint8_t> open_count(m, 0), complex(m, 0);
     for_blocks(uint32_t(m), 4096, [&](const auto& r) {
-      thread_local std::vector<uint32_t> outs, ins;
-      for (uint32_t v = r.begin(); v < r.end(); ++v) classify_fan(v, outs, ins, open_count, complex);
+      for (uint32_t v = r.begin(); v < r.end(); ++v) classify_fan(v, open_count, complex);
     });
     for (uint32_t v = 0; v < m; ++v) {
       if (kind_[v] == kLocked || complex[v]) {
@@ -532,17 +538,27 @@ class Simplifier {
   // classify's first step for one vertex: its open edges (open_out_, open_in_, open_count) and whether its
   // fan is complex (a directed edge twice, more than one open edge, or faces not forming one disc or fan).
   // A complex vertex is locked, so its open edges are not needed: a repeated edge ends the scan. Writes
-  // only v's entries, so vertices run in parallel. O(degree^2) compares: the repeats, then one scan of all
-  // (in, out) pairs, which also links the faces for the walk.
-  void classify_fan(uint32_t v, std::vector<uint32_t>& outs, std::vector<uint32_t>& ins,
-                    std::vector<uint8_t>& open_count, std::vector<uint8_t>& complex) {
-    fan(v, outs, ins);
-    const size_t deg = outs.size();
-    if (deg == 0) return;
-    if (deg > 256) {
+  // only v's entries, so vertices run in parallel. Its faces are all alive (classify runs before the first
+  // collapse), so its degree is its count of faces and its fan goes into arrays on the stack. O(degree^2)
+  // compares: the repeats, then one scan of all (in, out) pairs, which also links the faces for the walk.
+  void classify_fan(uint32_t v, std::vector<uint8_t>& open_count, std::vector<uint8_t>& complex) {
+    if (offsets_[v + 1] - offsets_[v] > 256) {
       complex[v] = 1;
       return;
     }
+    // next[i]: the face g with g.out == face i's in (one at most once out-neighbours do not repeat; kNoFace
+    // when face i's in edge is open); out_closed[i]: whether face i's out edge has a twin. Set below, cleared
+    // here with the fan (set in a loop of their own, they were two calls of memset per vertex).
+    constexpr uint16_t kNoFace = UINT16_MAX;
+    std::array<uint32_t, 256> outs, ins;
+    std::array<uint16_t, 256> next;
+    std::array<uint8_t, 256> out_closed;
+    size_t deg = 0;
+    for_fan(v, [&](uint32_t out, uint32_t in) {
+      outs[deg] = out, ins[deg] = in, next[deg] = kNoFace, out_closed[deg] = 0;
+      ++deg;
+    });
+    if (deg == 0) return;
     for (size_t i = 0; i < deg; ++i)
       for (size_t j = i + 1; j < deg; ++j)
         if (outs[j] == outs[i]) {
@@ -550,16 +566,13 @@ class Simplifier {
           return;
         }
 
-    // One scan of all (in, out) pairs: next[i], the face g with g.out == face i's in (one at most: no
-    // out-neighbour repeats; kNoFace when face i's in edge is open), and whether face i's out edge has a
-    // twin.
-    constexpr uint16_t kNoFace = UINT16_MAX;
-    std::array<uint16_t, 256> next;
-    std::array<uint8_t, 256> out_closed;
-    for (size_t i = 0; i < deg; ++i) next[i] = kNoFace, out_closed[i] = 0;
+    // One scan of all (in, out) pairs: next and out_closed.
     for (size_t i = 0; i < deg; ++i)
       for (size_t j = 0; j < deg; ++j)
-        if (outs[j] == ins[i]) next[i] = uint16_t(j), out_closed[j] = 1;
+        if (outs[j] == ins[i]) {
+          next[i] = uint16_t(j), out_closed[j] = 1;
+          break;
+        }
     uint32_t n_open_out = 0, n_open_in = 0, start = 0;
     for (size_t i = 0; i < deg; ++i) {
       if (!out_closed[i]) ++n_open_out, open_out_[v] = outs[i], start = uint32_t(i);
@@ -596,9 +609,12 @@ class Simplifier {
   // Adds face f's plane quadric and attribute gradients to its corners in [lo, hi) (build_quadrics);
   // `weighted`: channels_ weighted values per vertex (s_j = weight_j x component_j); gradient: room for
   // channels_ gradients. kChannels: channels_ when known at compile time (the loops over the channels
-  // unrolled: positions only, or normals only), else -1.
+  // unrolled: positions only, or normals only), else -1. Flattened: GCC 12 left Quadric::add_shifted a call
+  // here, with the face's quadric spilled for it (inlined, a refined_elephant bake's add_face calls take
+  // 170.3 -> 156.3 M instructions; the same operations, so the same bits).
   template <int kChannels>
-  void add_face(uint32_t f, uint32_t lo, uint32_t hi, const float* weighted, AttributeTerm* gradient) {
+  [[gnu::flatten]] void add_face(uint32_t f, uint32_t lo, uint32_t hi, const float* weighted,
+                                 AttributeTerm* gradient) {
     const int channels = kChannels >= 0 ? kChannels : channels_;
     const uint32_t v0 = indices_[3 * size_t(f)], v1 = indices_[3 * size_t(f) + 1],
                    v2 = indices_[3 * size_t(f) + 2];
