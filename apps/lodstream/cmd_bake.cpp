@@ -301,8 +301,8 @@ std::vector<hierarchy::HlodObject> hlod_inputs(const Scene& scene,
         h.coarse.positions.push_back(glm::vec3(t * glm::vec4(p, 1.0f)));
       const bool carried = r.radii && r.radii->size() == r.mesh->positions.size();
       for (size_t v = 0; v < r.mesh->positions.size(); ++v)
-        h.coarse_error.push_back(carried ? std::nextafter(float(double((*r.radii)[v]) * scale), INFINITY)
-                                         : std::nextafter(float(double(r.error) * scale), INFINITY));
+        h.coarse_error.push_back(
+            std::nextafter(float(double(carried ? (*r.radii)[v] : r.error) * scale), INFINITY));
       for (const glm::vec3& n : r.mesh->normals)
         h.coarse.normals.push_back(glm::normalize(normal_matrix * n));
       for (uint32_t k : r.mesh->indices) h.coarse.indices.push_back(base + k);

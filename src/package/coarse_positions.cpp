@@ -14,10 +14,10 @@ std::vector<uint8_t> encode_locked_stream(const QuantizedNode& node, uint32_t k)
   // A locked vertex whose k low bits are all 0 is not flagged: its c (floor and rounding agree) decodes to
   // q as a free vertex's does.
   std::vector<uint8_t> flagged(V, 0);
-  for (size_t v = 0; v < V; ++v)
+  for (size_t v = 0; v < V; ++v) {
     for (int a = 0; a < 3; ++a) flagged[v] |= node.locked[v] && node.q[3 * v + a] != node.c[3 * v + a] << k;
-  for (size_t v = 0; v < V; ++v)
     if (flagged[v]) out[v / 8] |= static_cast<uint8_t>(1u << (v % 8));
+  }
   size_t bit = 0;
   for (size_t v = 0; v < V; ++v) {
     if (!flagged[v]) continue;
