@@ -41,6 +41,19 @@ TEST(Quality, ProjectedAreaOfADiscInsideAtAnEdgeAndInACorner) {
   EXPECT_DOUBLE_EQ(projected_area({{-100, 0, -10}, 1.0}, v), 0.0);
 }
 
+TEST(Quality, ProjectedAreaClipsTheDiscExactly) {
+  View v = test_view();  // focal 50 px, centre (100, 50)
+  // Centre 2 px right of the left edge (x / z = (2 - 100) / 50): the part of the disc right of a chord at
+  // distance 2 from its centre on the other side, rho^2 (pi - acos(2 / rho)) + 2 sqrt(rho^2 - 4).
+  const double x = (2.0 - 100.0) / 5.0;
+  const double rho = 50.0 / std::sqrt(x * x + 100.0 - 1.0);
+  const double chord =
+      rho * rho * (std::acos(-1.0) - std::acos(2.0 / rho)) + 2.0 * std::sqrt(rho * rho - 4.0);
+  EXPECT_NEAR(projected_area({{x, 0, -10}, 1.0}, v), chord, 1e-12 * chord);
+  // A disc of radius 189 px about the viewport's centre covers all of it (the corners are 112 px away).
+  EXPECT_NEAR(projected_area({{0, 0, -3}, 2.9}, v), 200.0 * 100.0, 1e-9);
+}
+
 TEST(Quality, BenefitRatioAndPixelErrorOfHandMadeCuts) {
   // Two objects, each one node with its own sphere equal to the object's bounding sphere.
   package::NodeRecord a, b;
