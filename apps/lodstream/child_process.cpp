@@ -4,11 +4,15 @@
 #include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <chrono>
+#include <cmath>
+#include <fstream>
+#include <sstream>
 #include <thread>
 
 #include "core/error.hpp"
@@ -96,7 +100,8 @@ std::string ChildProcess::read_line(double timeout_s) {
 std::optional<int> ChildProcess::poll() {
   if (!status_ && pid_ > 0) {
     int status = 0;
-    if (waitpid(pid_, &status, WNOHANG) == pid_) status_ = exit_status(status);
+    rusage usage{};
+    if (wait4(pid_, &status, WNOHANG, &usage) == pid_) ended(status, usage);
   }
   return status_;
 }
@@ -104,11 +109,32 @@ std::optional<int> ChildProcess::poll() {
 int ChildProcess::wait() {
   if (!status_ && pid_ > 0) {
     int status = 0;
-    while (waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+    rusage usage{};
+    while (wait4(pid_, &status, 0, &usage) < 0 && errno == EINTR) {
     }
-    status_ = exit_status(status);
+    ended(status, usage);
   }
   return status_.value_or(-1);
+}
+
+void ChildProcess::ended(int status, const rusage& usage) {
+  status_ = exit_status(status);
+  auto seconds = [](const timeval& t) { return double(t.tv_sec) + 1e-6 * double(t.tv_usec); };
+  cpu_s_ = seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
+double ChildProcess::cpu_s() {
+  if (pid_ <= 0 || poll()) return cpu_s_;
+  // /proc/PID/stat: fields 14 and 15 (user and system time in clock ticks) after the parenthesized name.
+  std::ifstream in("/proc/" + std::to_string(pid_) + "/stat");
+  std::string line;
+  if (!std::getline(in, line) || line.rfind(')') == std::string::npos) return NAN;
+  std::istringstream fields(line.substr(line.rfind(')') + 2));
+  std::string skip;
+  for (int field = 3; field < 14; ++field) fields >> skip;
+  double user = 0, system = 0;
+  if (!(fields >> user >> system)) return NAN;
+  return (user + system) / double(sysconf(_SC_CLK_TCK));
 }
 
 int ChildProcess::stop(double grace_s) {

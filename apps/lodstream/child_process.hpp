@@ -4,8 +4,10 @@
 // kernel sends it SIGTERM if this process dies first (PR_SET_PDEATHSIG), so no exit path leaves one running.
 #pragma once
 
+#include <sys/resource.h>
 #include <sys/types.h>
 
+#include <cmath>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -34,11 +36,17 @@ class ChildProcess {
   int wait();
   // Sends SIGTERM, waits up to `grace_s`, then SIGKILL; returns its exit status. Nothing when it has ended.
   int stop(double grace_s = 5.0);
+  // The CPU time (user + system, all its threads) it has used so far, in seconds, from /proc while it runs
+  // (clock-tick resolution) and from wait4's accounting once it has ended; NaN when it cannot be read.
+  double cpu_s();
 
  private:
+  void ended(int status, const rusage& usage);
+
   pid_t pid_ = -1;
   int out_ = -1;  // read end of the stdout pipe, or -1
   std::optional<int> status_;
+  double cpu_s_ = NAN;
   std::string pending_;
 };
 

@@ -260,6 +260,7 @@ struct Run {
   std::vector<FrameRow> frames;
   ImageMetrics metrics;
   PolicySummary summary;
+  std::optional<double> server_cpu_s, client_cpu_s;  // --real: CPU seconds of the server and the view
 };
 
 std::string table_row(const std::string& name, const PolicySummary& p) {
@@ -365,7 +366,9 @@ nlohmann::json policy_json(const Run& r) {
           {"frame_ms_p99", s.frame_ms_p99},
           {"time_to_095_after_teleport_s", after},
           {"converged_s", maybe(s.converged_s)},
-          {"frames", r.frames.size()}};
+          {"frames", r.frames.size()},
+          {"server_cpu_s", maybe(r.server_cpu_s)},
+          {"client_cpu_s", maybe(r.client_cpu_s)}};
 }
 
 int run_bench_stream(const StreamArgs& args) {
@@ -404,7 +407,7 @@ int run_bench_stream(const StreamArgs& args) {
   std::fprintf(stderr, "\n");
   std::vector<Run> simulated;
   for (const SimResult& r : results) {
-    Run run{policy_name(r.policy), r.frames, {}, {}};
+    Run run{policy_name(r.policy), r.frames, {}, {}, {}, {}};
     run.metrics.psnr.assign(r.frames.size(), NAN);
     run.metrics.ssim.assign(r.frames.size(), NAN);
     simulated.push_back(std::move(run));
@@ -463,7 +466,8 @@ int run_bench_stream(const StreamArgs& args) {
       if (p == Policy::oracle) continue;
       const std::string label = "(" + std::to_string(real.size() + 1) + "/" + std::to_string(count) + ")";
       RealRun r = stream.run(p, label);
-      Run run{policy_name(p), r.frames, {}, {}};
+      auto known = [](double v) { return std::isfinite(v) ? std::optional<double>(v) : std::nullopt; };
+      Run run{policy_name(p), r.frames, {}, {}, known(r.server_cpu_s), known(r.client_cpu_s)};
       run.metrics.psnr.assign(r.frames.size(), NAN);
       run.metrics.ssim.assign(r.frames.size(), NAN);
       for (const auto& [k, drawn] : r.cuts) {
@@ -530,8 +534,11 @@ int run_bench_stream(const StreamArgs& args) {
         "drawn afterwards, against the package's finest cut from the same camera. MB: page bytes the "
         "client installed (the simulation also counts HTTP and WebSocket headers). Logs and CSVs under "
         "real/; "
-        "the simulated runs under simulated/.\n\n## How far the two modes agree\n\n" +
-        agreement_table(real, simulated);
+        "the simulated runs under simulated/.\n\nCPU seconds (user + system) during each run: ";
+    for (const Run& r : real)
+      md += r.name + " server " + fixed(r.server_cpu_s, "%.2f") + ", client " +
+            fixed(r.client_cpu_s, "%.2f") + (&r == &real.back() ? ".\n" : "; ");
+    md += "\n## How far the two modes agree\n\n" + agreement_table(real, simulated);
   } else {
     md +=
         "\nBenefit AUC: mean benefit ratio over the window (path + settle). PSNR against the package's "

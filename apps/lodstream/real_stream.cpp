@@ -82,6 +82,7 @@ RealRun RealStream::run(Policy policy, const std::string& label) {
                number(options_.tau, ""), "--settle", number(options_.settle_s, ""), "--cuts-every",
                std::to_string(options_.cuts_every), "--json"});
   const fs::path view_log = dir / "view.log";
+  const double server_cpu_before = server_->cpu_s();
   ChildProcess view(args, dir / "view.json", view_log);
   using Clock = std::chrono::steady_clock;
   const Clock::time_point start = Clock::now();
@@ -104,6 +105,8 @@ RealRun RealStream::run(Policy policy, const std::string& label) {
                 " (" + view_log.string() + ": " + last_line(view_log) + ")");
 
   RealRun run;
+  run.server_cpu_s = server_->cpu_s() - server_cpu_before;
+  run.client_cpu_s = view.cpu_s();
   run.frames = read_frames_csv(dir / "frames.csv");
   std::ifstream summary(dir / "view.json");
   const nlohmann::json j = nlohmann::json::parse(summary, nullptr, false);

@@ -34,10 +34,12 @@ struct RealOptions {
   int cuts_every = 0;            // record the drawn cut every N frames (0: none)
 };
 
-// One policy's run: its frames (the view's CSV) and the cuts it recorded, by frame (row) index.
+// One policy's run: its frames (the view's CSV) and the cuts it recorded, by frame (row) index, and the CPU
+// seconds (user + system) that the server spent during the run and that the view spent in all.
 struct RealRun {
   std::vector<FrameRow> frames;
   std::map<size_t, std::vector<schedule::DrawnNode>> cuts;
+  double server_cpu_s = 0.0, client_cpu_s = 0.0;
 };
 
 class RealStream {

@@ -174,8 +174,8 @@ TEST(BenchStream, OutputsFollowTheContract) {
 
 // --real: lodstream serve, a lodstream link per policy and a headless lodstream view per policy on loopback.
 // A fixed camera and a fast link keep it to a few seconds: every real policy converges (benefit 1 at the last
-// row), the summary sets the simulated figures beside the real ones (oracle simulated only), and every child
-// process was stopped (serve and link log their stop signal).
+// row), the summary sets the simulated figures beside the real ones (oracle simulated only) and the CPU time
+// of the server and the view, and every child process was stopped (serve and link log their stop signal).
 TEST(BenchStream, RealModeRunsEveryPolicyThroughServeLinkAndView) {
   const fs::path dir = test::temp_dir() / "real";
   const fs::path path = static_path(dir);
@@ -188,6 +188,7 @@ TEST(BenchStream, RealModeRunsEveryPolicyThroughServeLinkAndView) {
   EXPECT_EQ(summary, nlohmann::json::parse(slurp(dir / "summary.json")));
   const std::string md = slurp(dir / "summary.md");
   EXPECT_NE(md.find("How far the two modes agree"), std::string::npos) << md;
+  EXPECT_NE(md.find("CPU seconds (user + system) during each run: full server "), std::string::npos) << md;
   for (const std::string p : {"full", "sse-pull", "sse-pull-3", "push"}) {
     SCOPED_TRACE(p);
     const auto& s = summary["policies"][p];
@@ -202,6 +203,11 @@ TEST(BenchStream, RealModeRunsEveryPolicyThroughServeLinkAndView) {
     EXPECT_FALSE(s["simulated"]["time_to_095_s"].is_null());
     EXPECT_FALSE(s["psnr_at_5s"].is_null());  // the view's last frame was drawn and compared
     EXPECT_GT(s["psnr_at_5s"].get<double>(), 30.0);
+    // The processes' CPU time during the run: the view decodes and selects cuts for 5 s and more.
+    ASSERT_TRUE(s["server_cpu_s"].is_number());
+    EXPECT_GE(s["server_cpu_s"].get<double>(), 0.0);
+    ASSERT_TRUE(s["client_cpu_s"].is_number());
+    EXPECT_GT(s["client_cpu_s"].get<double>(), 0.0);
     const std::vector<Row> f = rows(dir / (p + ".csv"));
     ASSERT_FALSE(f.empty());
     EXPECT_EQ(f.back().benefit, 1.0);
