@@ -121,6 +121,14 @@ bool PackageReader::has_node(uint32_t id) const {
   return page == kNone || !index_pages_[page].empty();
 }
 
+const NodeRecord* PackageReader::held_node(uint32_t id) const {
+  if (id >= root_.node_count) return nullptr;
+  const uint32_t page = index_page_of(id);
+  if (page == kNone) return &root_.root_nodes[id];
+  const std::vector<NodeRecord>& records = index_pages_[page];
+  return records.empty() ? nullptr : &records[id - root_.index_pages[page].first_node];
+}
+
 void PackageReader::add_index_page(uint32_t page, std::span<const uint8_t> stored) {
   if (page >= root_.index_pages.size())
     throw Error(where("index page " + std::to_string(page) + " does not exist"));

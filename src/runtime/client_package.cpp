@@ -56,10 +56,11 @@ Frame ClientPackage::frame(const View& view, std::span<const View> predicted,
   const auto hash = reader_.header().content_hash;
   const std::vector<uint32_t> cached_pages = cache_.pages(hash);
   std::vector<uint32_t> cached_nodes;
-  std::unordered_set<uint32_t> cached(cached_pages.begin(), cached_pages.end());
+  std::vector<uint8_t> cached(reader_.root().pages.size(), 0);
+  for (uint32_t page : cached_pages)
+    if (page < cached.size()) cached[page] = 1;
   for (uint32_t id = 0; id < reader_.node_count(); ++id)
-    if (const package::NodeRecord* r = nodes_.record(id); r && cached.count(r->page))
-      cached_nodes.push_back(id);
+    if (const package::NodeRecord* r = nodes_.record(id); r && cached[r->page]) cached_nodes.push_back(id);
   std::vector<View> views{view};
   views.insert(views.end(), predicted.begin(), predicted.end());
   const PageUsefulness u = page_usefulness(reader_.scene(), nodes_, f.cut, views, cached_nodes);

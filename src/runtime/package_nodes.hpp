@@ -15,9 +15,7 @@ class PackageNodes final : public NodeSource {
   PackageNodes(package::PackageReader& reader, const PageCache& cache)
       : reader_(&reader), cache_(&cache), package_(reader.header().content_hash) {}
 
-  const package::NodeRecord* record(uint32_t id) const override {
-    return id < reader_->node_count() && reader_->has_node(id) ? &reader_->node(id) : nullptr;
-  }
+  const package::NodeRecord* record(uint32_t id) const override { return reader_->held_node(id); }
   bool available(uint32_t id) const override {
     const package::NodeRecord* r = record(id);
     return r && cache_->contains(package_, r->page);
