@@ -846,30 +846,35 @@ class Simplifier {
     const glm::dvec3 pa = glm::dvec3(pos_[p.a]) - o, pb = glm::dvec3(pos_[p.b]) - o;
     const uint8_t ka = kind_[p.a], kb = kind_[p.b];
     p.move = !opt_.half_edge && ka == kb && ka != kLocked;
+    // Q(x), kept from the choice of x where it was evaluated there (the same call on the same point).
+    double q_x;
     if (!p.move) {
       p.x = pb;
+      q_x = r.eval(pb);
     } else {
       glm::dvec3 x, e = pa - pb, mid = 0.5 * (pa + pb);
       // Border and seam vertices stay on their polyline: x on the edge (the minimum along it).
       // An end is preferred unless the interior point halves the cost (keeps corners exactly).
       if (ka != kManifold) {
         double ca = r.eval(pa), cb = r.eval(pb);
-        x = ca < cb ? pa : pb;
+        x = ca < cb ? pa : pb, q_x = ca < cb ? ca : cb;
         glm::dvec3 opt = pb + r.segment_parameter(pb, e) * e;
-        if (r.eval(opt) < 0.5 * std::min(ca, cb)) x = opt;
+        if (const double q_opt = r.eval(opt); q_opt < 0.5 * std::min(ca, cb)) x = opt, q_x = q_opt;
       } else if (!r.solve(x) || glm::dot(x - mid, x - mid) > glm::dot(e, e)) {
         // Ill-conditioned (or far away): the best of both ends, the midpoint and the minimum along the edge.
         x = pb;
-        double best = r.eval(pb);
+        q_x = r.eval(pb);
         glm::dvec3 cands[3] = {pa, mid, pb + r.segment_parameter(pb, e) * e};
         for (const auto& c : cands)
-          if (double v = r.eval(c); v < best) best = v, x = c;
+          if (double v = r.eval(c); v < q_x) q_x = v, x = c;
+      } else {
+        q_x = r.eval(x);
       }
       p.x = x;
     }
     const glm::dvec3 y = p.x;
     p.x += o;
-    p.cost = r.eval(y) / (w + 1e-20);
+    p.cost = q_x / (w + 1e-20);
     if (channels_ > 0) return;
     // An end's own term can exceed the sum's only when W_side < k W (Q_side(x) <= Q(x), rounding aside:
     // both are sums of squares), so only the smaller end of an unbalanced edge is evaluated.

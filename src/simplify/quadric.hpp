@@ -144,7 +144,7 @@ struct Reduced {
   // closed-form minimum over each s_j): one division and one scaling for all channels.
   void eliminate(const ChannelSums& s, double w) { t.subtract_scaled(s.t, 1.0 / w); }
   // Q(p) = p^T A p + 2 b.p + c, clamped at 0 (rounding).
-  double eval(const glm::dvec3& p) const {
+  [[gnu::always_inline]] double eval(const glm::dvec3& p) const {
     double r = a00() * p.x * p.x + a11() * p.y * p.y + a22() * p.z * p.z +
                2 * (a01() * p.x * p.y + a02() * p.x * p.z + a12() * p.y * p.z) +
                2 * (b0() * p.x + b1() * p.y + b2() * p.z) + c();
