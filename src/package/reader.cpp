@@ -39,6 +39,7 @@ PackageReader::PackageReader(std::shared_ptr<const ByteSource> source) : source_
     raw_root = unpack(root_range, read_range(root_range, "root index"), "root index");
   }
   root_ = parse_root(raw_root, where("root index"));
+  index_map_ = IndexPageMap(root_);
   codec_ = &node_codec(root_.codec);
   check_layout();
   index_pages_.resize(root_.index_pages.size());
@@ -110,10 +111,7 @@ uint32_t PackageReader::index_page_of(uint32_t id) const {
     throw Error(where("node " + std::to_string(id) + " does not exist (" + std::to_string(root_.node_count) +
                       " nodes)"));
   }
-  if (id < root_.root_nodes.size()) return kNone;
-  auto it = std::upper_bound(root_.index_pages.begin(), root_.index_pages.end(), id,
-                             [](uint32_t v, const IndexPage& p) { return v < p.first_node; });
-  return uint32_t(it - root_.index_pages.begin()) - 1;
+  return index_map_.page_of(id);
 }
 
 bool PackageReader::has_node(uint32_t id) const {
@@ -123,7 +121,7 @@ bool PackageReader::has_node(uint32_t id) const {
 
 const NodeRecord* PackageReader::held_node(uint32_t id) const {
   if (id >= root_.node_count) return nullptr;
-  const uint32_t page = index_page_of(id);
+  const uint32_t page = index_map_.page_of(id);
   if (page == kNone) return &root_.root_nodes[id];
   const std::vector<NodeRecord>& records = index_pages_[page];
   return records.empty() ? nullptr : &records[id - root_.index_pages[page].first_node];

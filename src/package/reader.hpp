@@ -17,6 +17,7 @@
 #include "package/byte_source.hpp"
 #include "package/format.hpp"
 #include "package/index.hpp"
+#include "package/index_page_map.hpp"
 
 namespace lodstream::package {
 
@@ -82,6 +83,7 @@ class PackageReader {
   std::array<uint8_t, kHeaderSize> trailer_{};
   Header header_;
   RootIndex root_;
+  IndexPageMap index_map_{RootIndex{}};
   const NodeCodec* codec_ = nullptr;
   std::vector<std::vector<NodeRecord>> index_pages_;  // loaded records, by index page (empty until loaded)
   struct LastRecord {

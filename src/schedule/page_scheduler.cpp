@@ -342,7 +342,10 @@ void collect(const package::PackageScene& scene, const NodeSource& records, cons
 }  // namespace
 
 PageScheduler::PageScheduler(const package::RootIndex& root)
-    : root_(&root), data_held_(root.pages.size(), false), index_held_(root.index_pages.size(), false) {
+    : root_(&root),
+      index_map_(root),
+      data_held_(root.pages.size(), false),
+      index_held_(root.index_pages.size(), false) {
   for (const package::Range& page : root.pages) data_cost_.push_back(page.size);
 }
 
@@ -376,10 +379,10 @@ PageRef PageScheduler::page(PageKind kind, uint32_t id) const {
 }
 
 uint32_t PageScheduler::index_page_of(uint32_t id) const {
-  if (id < root_->root_nodes.size()) return package::kNone;
-  auto it = std::upper_bound(root_->index_pages.begin(), root_->index_pages.end(), id,
-                             [](uint32_t v, const package::IndexPage& p) { return v < p.first_node; });
-  return uint32_t(it - root_->index_pages.begin()) - 1;
+  if (id >= root_->node_count)
+    throw Error("node " + std::to_string(id) + " does not exist (" + std::to_string(root_->node_count) +
+                " nodes)");
+  return index_map_.page_of(id);
 }
 
 std::vector<PageRef> PageScheduler::next(const package::PackageScene& scene, const NodeSource& records,

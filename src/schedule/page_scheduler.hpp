@@ -46,6 +46,7 @@
 #include <vector>
 
 #include "package/index.hpp"
+#include "package/index_page_map.hpp"
 #include "schedule/cut.hpp"
 #include "schedule/motion.hpp"
 
@@ -89,7 +90,8 @@ class PageScheduler {
   // max_bytes with): a push server prices a page the client keeps on disk at the message that restores it.
   // Throws lodstream::Error for a page the package does not have. Cost: O(1).
   void set_cost(uint32_t id, uint32_t bytes);
-  // The index page that holds node `id`'s record, or package::kNone for the root index.
+  // The index page that holds node `id`'s record, or package::kNone for the root index. Throws
+  // lodstream::Error for a node the package does not have. Cost: O(1) (package::IndexPageMap).
   uint32_t index_page_of(uint32_t id) const;
 
   // The next pages to transfer in benefit-per-byte order for `views` (their weights as given), never a held
@@ -108,6 +110,7 @@ class PageScheduler {
 
  private:
   const package::RootIndex* root_;
+  package::IndexPageMap index_map_;
   std::vector<bool> data_held_, index_held_;
   std::vector<uint32_t> data_cost_;
 };
