@@ -174,27 +174,29 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
     const uint32_t* o = &predictors[3 * v];
     gates.emplace_back(cu + 3 * size_t(o[0]), cu + 3 * size_t(o[1]), cu + 3 * size_t(o[2]));
   }
-  // Vertex v's zigzagged residuals at damping j: plain, and on the plane (components (d - offset, d + 1,
-  // d + 2) of the gate's dominant axis d).
-  auto residuals_at = [&](size_t v, uint32_t j, uint64_t* plain, uint64_t* lifted) {
+  // Vertex v's residuals at damping j, plain (d), and on the plane (e: components (d - offset, d + 1, d + 2)
+  // of the gate's dominant axis d).
+  auto plain_at = [&](size_t v, uint32_t j, int64_t(&d)[3]) {
     const uint32_t* o = &predictors[3 * v];
     const uint64_t *x = cu + 3 * size_t(o[0]), *y = cu + 3 * size_t(o[1]), *z = cu + 3 * size_t(o[2]);
-    int64_t d[3];
     for (int a = 0; a < 3; ++a) d[a] = c[3 * v + a] - int64_t(damped_parallelogram(x[a], y[a], z[a], j));
+  };
+  auto lifted_at = [&](size_t v, const int64_t(&d)[3], int64_t(&e)[3]) {
     const PlaneGate& gate = gates[v];
     const uint32_t k = gate.d, a = k == 2 ? 0 : k + 1, b = k == 0 ? 2 : k - 1;
-    const int64_t e[3] = {d[k] - gate.offset(d[a], d[b]), d[a], d[b]};
-    for (int i = 0; i < 3; ++i) plain[i] = zigzag(d[i]), lifted[i] = zigzag(e[i]);
+    e[0] = d[k] - gate.offset(d[a], d[b]), e[1] = d[a], e[2] = d[b];
   };
   uint64_t bits[2][5] = {}, largest[2][5] = {};  // [plane][j]
   for (uint32_t j = 4; j >= 2; --j)
     for (size_t v = 0; v < V; ++v) {
-      uint64_t z[2][3];
-      residuals_at(v, j, z[0], z[1]);
+      int64_t d[2][3];
+      plain_at(v, j, d[0]);
+      lifted_at(v, d[0], d[1]);
       for (int plane = 0; plane < 2; ++plane)
-        for (int i = 0; i < 3; ++i)
-          bits[plane][j] += residual_bits(z[plane][i]),
-              largest[plane][j] = std::max(largest[plane][j], z[plane][i]);
+        for (int i = 0; i < 3; ++i) {
+          const uint64_t z = zigzag(d[plane][i]);
+          bits[plane][j] += residual_bits(z), largest[plane][j] = std::max(largest[plane][j], z);
+        }
     }
   uint64_t fewest = UINT64_MAX;
   for (int plane = 0; plane < 2; ++plane)
@@ -202,11 +204,13 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
       if (bits[plane][j] < fewest)
         fewest = bits[plane][j], r.damping = j, r.plane = plane,
         r.position_bytes = bytes_for(largest[plane][j]);
+  // The choice's residuals (the plane's offset, a division, only when it is chosen).
   r.positions.resize(3 * V);
   for (size_t v = 0; v < V; ++v) {
-    uint64_t z[2][3];
-    residuals_at(v, r.damping, z[0], z[1]);
-    std::copy_n(z[r.plane], 3, &r.positions[3 * v]);
+    int64_t d[2][3];
+    plain_at(v, r.damping, d[0]);
+    if (r.plane) lifted_at(v, d[0], d[1]);
+    for (int i = 0; i < 3; ++i) r.positions[3 * v + i] = zigzag(d[r.plane][i]);
   }
   if (g.mesh->has_normals()) {
     std::vector<glm::vec3> decoded(V + 1);  // predicted_normals reads one past the last
