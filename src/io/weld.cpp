@@ -185,13 +185,19 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
   });
   start[nv] = uint32_t(nc);
 
-  // Face normals, unnormalized: their length is twice the area, which weights the sums.
-  auto face = std::make_unique_for_overwrite<glm::vec3[]>(nt);
+  // Face normals, unnormalized (their length is twice the area, which weights the sums), and their unit
+  // vectors (zero for a zero normal), each computed once per face rather than at each of its three corners.
+  struct Face {
+    glm::vec3 normal, unit;
+  };
+  auto face = std::make_unique_for_overwrite<Face[]>(nt);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nt, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t t = r.begin(); t < r.end(); ++t) {
       const uint32_t* v = &mesh.indices[3 * t];
-      face[t] = glm::cross(mesh.positions[v[1]] - mesh.positions[v[0]],
-                           mesh.positions[v[2]] - mesh.positions[v[0]]);
+      const glm::vec3 n = glm::cross(mesh.positions[v[1]] - mesh.positions[v[0]],
+                                     mesh.positions[v[2]] - mesh.positions[v[0]]);
+      const float len = glm::length(n);
+      face[t] = {n, len > 0 ? n / len : glm::vec3(0.0f)};
     }
   });
   constexpr uint32_t kAhead = 16;  // prefetch distance where corners are gathered in random order
@@ -231,9 +237,7 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
           __builtin_prefetch(&face[corners[k + kAhead] / 3]);
           __builtin_prefetch(&mesh.indices[corners[k + kAhead]]);
         }
-        const glm::vec3& n = face[corners[k] / 3];
-        const float len = glm::length(n);
-        const glm::vec3 unit = len > 0 ? n / len : glm::vec3(0.0f);
+        const glm::vec3 &n = face[corners[k] / 3].normal, &unit = face[corners[k] / 3].unit;
         size_t g = 0;
         while (g < groups.size() && glm::dot(groups[g].seed, unit) < cos_crease) ++g;
         if (g == groups.size()) groups.push_back({unit, glm::vec3(0.0f)});
