@@ -226,8 +226,12 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
     std::vector<uint32_t> corner_group;
     std::vector<Output> outputs;
     Run& run = runs[r];
-    const uint32_t run_end = start[std::min(nv, (r + 1) * kRunPositions)];
-    for (size_t p = r * kRunPositions; p < std::min(nv, (r + 1) * kRunPositions); ++p) {
+    const size_t run_begin = r * kRunPositions,
+                 positions = std::min(nv, run_begin + kRunPositions) - run_begin;
+    const uint32_t run_end = start[run_begin + positions];
+    // About one output a position (more at creases and seams): reserved, not regrown.
+    run.keep.reserve(positions), run.normals.reserve(positions);
+    for (size_t p = run_begin; p < run_begin + positions; ++p) {
       const uint32_t begin = start[p], end = start[p + 1];
       if (begin == end) continue;
       groups.clear();
@@ -248,17 +252,16 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
       for (uint32_t k = begin; k < end; ++k) {
         const uint32_t c = corners[k], w = mesh.indices[c], g = corner_group[k - begin];
         // Distinct (vertex, group) pairs at one position are few (seams, creases): a linear search is enough.
-        auto it = std::find_if(outputs.begin(), outputs.end(),
-                               [w, g](const Output& o) { return o.vertex == w && o.group == g; });
-        if (it == outputs.end()) {
+        size_t o = 0;
+        while (o < outputs.size() && (outputs[o].vertex != w || outputs[o].group != g)) ++o;
+        if (o == outputs.size()) {
           const uint32_t out = static_cast<uint32_t>(run.keep.size());
           run.keep.push_back(w);
           const float len = glm::length(groups[g].sum);
           run.normals.push_back(len > 0 ? groups[g].sum / len : glm::vec3(0.0f, 0.0f, 1.0f));
           outputs.push_back({w, g, out});
-          it = outputs.end() - 1;
         }
-        mesh.indices[c] = it->out;
+        mesh.indices[c] = outputs[o].out;
       }
     }
   });
