@@ -87,9 +87,16 @@ std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<co
         const Planes& s = *shape[p];
         signed_residuals.resize(s.count * s.components);
         if (s.count) read_planes(node.data() + from, s.count, s.components, s.width, signed_residuals.data());
-        for (int64_t r : signed_residuals) residuals[p].push_back(zigzag(r));
-        for (size_t i = 0; p == kPositions && i < signed_residuals.size(); ++i)
-          split[i >= s.count].push_back(zigzag(signed_residuals[i]));
+        // Appended by size and index (one resize each, not a push_back per value); the values are
+        // component-major, so the split form's component 0 is the first s.count.
+        std::vector<uint64_t>& all = residuals[p];
+        const size_t at = all.size();
+        all.resize(at + signed_residuals.size());
+        for (size_t i = 0; i < signed_residuals.size(); ++i) all[at + i] = zigzag(signed_residuals[i]);
+        if (p == kPositions) {
+          split[0].insert(split[0].end(), all.begin() + at, all.begin() + at + s.count);
+          split[1].insert(split[1].end(), all.begin() + at + s.count, all.end());
+        }
       }
       out[1 + p].insert(out[1 + p].end(), node.begin() + from, node.begin() + from + n[p]);
       from += n[p];
