@@ -163,7 +163,9 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
                                          std::span<const uint8_t> locked_stream, const PositionGrid& grid) {
   const size_t V = n.order.size();
   PredictiveResiduals r;
-  std::vector<int64_t> c(n.c);
+  // The coordinates with entry V holding cmin (what a predictor V stands for), in a buffer kept across nodes.
+  thread_local std::vector<int64_t> c;
+  c.assign(n.c.begin(), n.c.end());
   c.insert(c.end(), std::begin(n.cmin), std::end(n.cmin));
   // The damping j and plane prediction whose residuals take the fewest bits (ties: the larger j, no plane):
   // one pass counts all six (per vertex its predictors and gate are read once; the gate's plane does not
@@ -214,7 +216,10 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
     for (int i = 0; i < 3; ++i) r.positions[3 * v + i] = zigzag(d[r.plane][i]);
   }
   if (g.mesh->has_normals()) {
-    std::vector<glm::vec3> decoded(V + 1);  // predicted_normals reads one past the last
+    // Kept across nodes: decode_positions overwrites the first V; predicted_normals reads one past them
+    // (lanes it never uses).
+    thread_local std::vector<glm::vec3> decoded;
+    decoded.resize(V + 1);
     decode_positions(n.c, LockedStream::parse(locked_stream, V, g.position_shift, "node codec"), grid,
                      decoded.data());
     NormalCodes codes = code_normals(g.mesh->normals, n.order, indices, g.first_vertex, n.index_end,
