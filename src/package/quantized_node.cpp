@@ -83,11 +83,13 @@ void quantize_positions(const NodeGeometry& g, const PositionGrid& grid, Quantiz
   // Quantization: q = round((p - origin) / step); c = round(q / 2^k) for free vertices, floor(q / 2^k) for
   // locked ones (whose k low bits the codec stores apart).
   const uint32_t k = g.position_shift;
-  n.q.resize(3 * V), n.c.resize(3 * V), n.locked.resize(V);
+  // Appended (a resize would zero-fill q and c first).
+  n.q.clear(), n.c.clear(), n.locked.clear();
+  n.q.reserve(3 * V), n.c.reserve(3 * V), n.locked.reserve(V);
   for (size_t v = 0; v < V; ++v) {
     const uint32_t old = n.order[v];
     const bool locked = !g.locked.empty() && g.locked[old];
-    n.locked[v] = locked;
+    n.locked.push_back(locked);
     for (int a = 0; a < 3; ++a) {
       // round(x) <= kMaxGridCoordinate exactly when |x| < kMaxGridCoordinate + 1/2 (false for NaN).
       const double x = (double(m.positions[old][a]) - double(grid.origin[a])) / double(grid.step);
@@ -95,8 +97,8 @@ void quantize_positions(const NodeGeometry& g, const PositionGrid& grid, Quantiz
         invalid("position outside the range of the grid");
       const int64_t qa = round_half_away(x);
       int64_t ca = (k == 0 || locked) ? (qa >> k) : ((qa + (int64_t(1) << (k - 1))) >> k);
-      n.q[3 * v + a] = qa;
-      n.c[3 * v + a] = ca;
+      n.q.push_back(qa);
+      n.c.push_back(ca);
       n.cmin[a] = v == 0 ? ca : std::min(n.cmin[a], ca);
       n.cmax[a] = v == 0 ? ca : std::max(n.cmax[a], ca);
     }
