@@ -76,26 +76,24 @@ std::vector<uint64_t> cluster_boundary(const Mesh& mesh, const std::vector<uint3
   }
   thread_local std::vector<uint8_t> count;
   if (count.size() < nv * nv) count.assign(nv * nv, 0);
-  auto cell = [&](uint32_t a, uint32_t b) -> uint8_t& {
-    return a < b ? count[a * nv + b] : count[b * nv + a];
-  };
+  // Each corner's edge (to the next corner) as its cell's index, kept for the second pass.
   const size_t corners = mesh.indices.size() / 3 * 3;
+  thread_local std::vector<uint32_t> cell;
+  cell.resize(corners);
   for (size_t t = 0; t < corners; t += 3) {
-    const uint32_t m0 = merged[mesh.indices[t]], m1 = merged[mesh.indices[t + 1]],
-                   m2 = merged[mesh.indices[t + 2]];
-    for (uint8_t* c : {&cell(m0, m1), &cell(m1, m2), &cell(m2, m0)}) *c = uint8_t(std::min(*c + 1, 2));
-  }
-  std::vector<uint64_t> once;
-  for (size_t t = 0; t < corners; t += 3) {
-    const uint32_t* i = &mesh.indices[t];
-    const uint32_t m0 = merged[i[0]], m1 = merged[i[1]], m2 = merged[i[2]];
-    const std::pair<uint8_t*, uint64_t> edges[] = {{&cell(m0, m1), edge_key(ids[i[0]], ids[i[1]])},
-                                                   {&cell(m1, m2), edge_key(ids[i[1]], ids[i[2]])},
-                                                   {&cell(m2, m0), edge_key(ids[i[2]], ids[i[0]])}};
-    for (const auto& [c, key] : edges) {
-      if (*c == 1) once.push_back(key);
-      *c = 0;
+    const uint32_t m[3] = {merged[mesh.indices[t]], merged[mesh.indices[t + 1]], merged[mesh.indices[t + 2]]};
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = m[k], b = m[k == 2 ? 0 : k + 1];
+      cell[t + k] = uint32_t(std::min(a, b) * nv + std::max(a, b));
+      count[cell[t + k]] = uint8_t(std::min(count[cell[t + k]] + 1, 2));
     }
+  }
+  // The key is built only for the edges used once.
+  std::vector<uint64_t> once;
+  for (size_t c = 0; c < corners; ++c) {
+    if (count[cell[c]] == 1)
+      once.push_back(edge_key(ids[mesh.indices[c]], ids[mesh.indices[c % 3 == 2 ? c - 2 : c + 1]]));
+    count[cell[c]] = 0;
   }
   return once;
 }

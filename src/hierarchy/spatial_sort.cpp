@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cfloat>
+#include <memory>
 #include <span>
 #include <utility>
 
@@ -46,7 +47,7 @@ std::vector<uint32_t> spatial_sort_triangles(std::span<const glm::vec3> position
   std::vector<uint32_t> sorted(n * 3);
   if (n == 0) return sorted;
   // Centroids, with the same operations in the same order as meshoptimizer, and their bounding box.
-  std::vector<glm::vec3> centroid(n);
+  auto centroid = std::make_unique_for_overwrite<glm::vec3[]>(n);  // every entry written below
   struct Box {
     glm::vec3 lo{FLT_MAX}, hi{-FLT_MAX};
   };
@@ -91,7 +92,7 @@ std::vector<uint32_t> spatial_sort_triangles(std::span<const glm::vec3> position
     constexpr size_t kRuns = size_t(1) << kRunBits;
     std::vector<uint32_t> code(n);
     tbb::parallel_for(size_t(0), n, [&](size_t t) { code[t] = code_of(t); });
-    centroid = {};
+    centroid.reset();
     std::vector<uint32_t> run_begin;
     order.resize(n);
     counting_sort(

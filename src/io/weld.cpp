@@ -185,13 +185,19 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
   });
   start[nv] = uint32_t(nc);
 
-  // Face normals, unnormalized: their length is twice the area, which weights the sums.
-  auto face = std::make_unique_for_overwrite<glm::vec3[]>(nt);
+  // Face normals, unnormalized (their length is twice the area, which weights the sums), and their unit
+  // vectors (zero for a zero normal), each computed once per face rather than at each of its three corners.
+  struct Face {
+    glm::vec3 normal, unit;
+  };
+  auto face = std::make_unique_for_overwrite<Face[]>(nt);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nt, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t t = r.begin(); t < r.end(); ++t) {
       const uint32_t* v = &mesh.indices[3 * t];
-      face[t] = glm::cross(mesh.positions[v[1]] - mesh.positions[v[0]],
-                           mesh.positions[v[2]] - mesh.positions[v[0]]);
+      const glm::vec3 n = glm::cross(mesh.positions[v[1]] - mesh.positions[v[0]],
+                                     mesh.positions[v[2]] - mesh.positions[v[0]]);
+      const float len = glm::length(n);
+      face[t] = {n, len > 0 ? n / len : glm::vec3(0.0f)};
     }
   });
   constexpr uint32_t kAhead = 16;  // prefetch distance where corners are gathered in random order
@@ -220,8 +226,12 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
     std::vector<uint32_t> corner_group;
     std::vector<Output> outputs;
     Run& run = runs[r];
-    const uint32_t run_end = start[std::min(nv, (r + 1) * kRunPositions)];
-    for (size_t p = r * kRunPositions; p < std::min(nv, (r + 1) * kRunPositions); ++p) {
+    const size_t run_begin = r * kRunPositions,
+                 positions = std::min(nv, run_begin + kRunPositions) - run_begin;
+    const uint32_t run_end = start[run_begin + positions];
+    // About one output a position (more at creases and seams): reserved, not regrown.
+    run.keep.reserve(positions), run.normals.reserve(positions);
+    for (size_t p = run_begin; p < run_begin + positions; ++p) {
       const uint32_t begin = start[p], end = start[p + 1];
       if (begin == end) continue;
       groups.clear();
@@ -231,9 +241,7 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
           __builtin_prefetch(&face[corners[k + kAhead] / 3]);
           __builtin_prefetch(&mesh.indices[corners[k + kAhead]]);
         }
-        const glm::vec3& n = face[corners[k] / 3];
-        const float len = glm::length(n);
-        const glm::vec3 unit = len > 0 ? n / len : glm::vec3(0.0f);
+        const glm::vec3 &n = face[corners[k] / 3].normal, &unit = face[corners[k] / 3].unit;
         size_t g = 0;
         while (g < groups.size() && glm::dot(groups[g].seed, unit) < cos_crease) ++g;
         if (g == groups.size()) groups.push_back({unit, glm::vec3(0.0f)});
@@ -244,17 +252,16 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
       for (uint32_t k = begin; k < end; ++k) {
         const uint32_t c = corners[k], w = mesh.indices[c], g = corner_group[k - begin];
         // Distinct (vertex, group) pairs at one position are few (seams, creases): a linear search is enough.
-        auto it = std::find_if(outputs.begin(), outputs.end(),
-                               [w, g](const Output& o) { return o.vertex == w && o.group == g; });
-        if (it == outputs.end()) {
+        size_t o = 0;
+        while (o < outputs.size() && (outputs[o].vertex != w || outputs[o].group != g)) ++o;
+        if (o == outputs.size()) {
           const uint32_t out = static_cast<uint32_t>(run.keep.size());
           run.keep.push_back(w);
           const float len = glm::length(groups[g].sum);
           run.normals.push_back(len > 0 ? groups[g].sum / len : glm::vec3(0.0f, 0.0f, 1.0f));
           outputs.push_back({w, g, out});
-          it = outputs.end() - 1;
         }
-        mesh.indices[c] = it->out;
+        mesh.indices[c] = outputs[o].out;
       }
     }
   });

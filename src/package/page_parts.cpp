@@ -67,15 +67,29 @@ std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<co
   std::vector<uint64_t> residuals[kParts];  // of kPositions and kNormals, coded
   std::vector<uint64_t> split[2];           // the positions' component 0, and components 1 and 2
   std::vector<int64_t> signed_residuals;
-  size_t at = 0;
+  // The nodes' layouts first, so that the residual arrays are allocated once at their size (grown value by
+  // value, each doubling copied them: more than the values themselves).
+  std::vector<NodeSizeBreakdown> layouts;
+  layouts.reserve(node_sizes.size());
+  size_t at = 0, position_values = 0, normal_values = 0;  // a residual per low byte
   for (uint32_t size : node_sizes) {
-    const std::span<const uint8_t> node = page.subspan(at, size);
-    NodeSizeBreakdown b;
     try {
-      b = codec.breakdown(node, "page node");
+      layouts.push_back(codec.breakdown(page.subspan(at, size), "page node"));
     } catch (const Error&) {
       return std::nullopt;  // not a codec node (NodeEncoding::raw)
     }
+    position_values += layouts.back().position_low, normal_values += layouts.back().normal_low;
+    at += size;
+  }
+  if (coded) {
+    residuals[kPositions].reserve(position_values), residuals[kNormals].reserve(normal_values);
+    split[0].reserve(position_values / 3), split[1].reserve(position_values - position_values / 3);
+  }
+  at = 0;
+  for (size_t k = 0; k < node_sizes.size(); ++k) {
+    const uint32_t size = node_sizes[k];
+    const std::span<const uint8_t> node = page.subspan(at, size);
+    const NodeSizeBreakdown& b = layouts[k];
     put_varint(out[1], size);
     const std::array<size_t, kParts> n = part_sizes(b);
     const std::optional<Planes> shape[kParts] = {
@@ -87,9 +101,16 @@ std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<co
         const Planes& s = *shape[p];
         signed_residuals.resize(s.count * s.components);
         if (s.count) read_planes(node.data() + from, s.count, s.components, s.width, signed_residuals.data());
-        for (int64_t r : signed_residuals) residuals[p].push_back(zigzag(r));
-        for (size_t i = 0; p == kPositions && i < signed_residuals.size(); ++i)
-          split[i >= s.count].push_back(zigzag(signed_residuals[i]));
+        // Appended by size and index (one resize each, not a push_back per value); the values are
+        // component-major, so the split form's component 0 is the first s.count.
+        std::vector<uint64_t>& all = residuals[p];
+        const size_t at = all.size();
+        all.resize(at + signed_residuals.size());
+        for (size_t i = 0; i < signed_residuals.size(); ++i) all[at + i] = zigzag(signed_residuals[i]);
+        if (p == kPositions) {
+          split[0].insert(split[0].end(), all.begin() + at, all.begin() + at + s.count);
+          split[1].insert(split[1].end(), all.begin() + at + s.count, all.end());
+        }
       }
       out[1 + p].insert(out[1 + p].end(), node.begin() + from, node.begin() + from + n[p]);
       from += n[p];

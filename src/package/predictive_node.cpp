@@ -163,53 +163,63 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
                                          std::span<const uint8_t> locked_stream, const PositionGrid& grid) {
   const size_t V = n.order.size();
   PredictiveResiduals r;
-  std::vector<int64_t> c(n.c);
+  // The coordinates with entry V holding cmin (what a predictor V stands for), in a buffer kept across nodes.
+  thread_local std::vector<int64_t> c;
+  c.assign(n.c.begin(), n.c.end());
   c.insert(c.end(), std::begin(n.cmin), std::end(n.cmin));
   // The damping j and plane prediction whose residuals take the fewest bits (ties: the larger j, no plane):
-  // one pass per j counts both (the gate's plane does not depend on j), then the choice's residuals.
+  // one pass counts all six (per vertex its predictors and gate are read once; the gate's plane does not
+  // depend on j), then the choice's residuals.
   const uint64_t* cu = reinterpret_cast<const uint64_t*>(c.data());
-  std::vector<PlaneGate> gates;
-  gates.reserve(V);
-  for (size_t v = 0; v < V; ++v) {
-    const uint32_t* o = &predictors[3 * v];
-    gates.emplace_back(cu + 3 * size_t(o[0]), cu + 3 * size_t(o[1]), cu + 3 * size_t(o[2]));
-  }
-  // Vertex v's zigzagged residuals at damping j: plain, and on the plane (components (d - offset, d + 1,
-  // d + 2) of the gate's dominant axis d).
-  auto residuals_at = [&](size_t v, uint32_t j, uint64_t* plain, uint64_t* lifted) {
+  // Vertex v's residuals at damping j, plain (d), and on the plane of `gate` (e: components (d - offset,
+  // d + 1, d + 2) of its dominant axis d).
+  auto plain_at = [&](size_t v, uint32_t j, int64_t(&d)[3]) {
     const uint32_t* o = &predictors[3 * v];
     const uint64_t *x = cu + 3 * size_t(o[0]), *y = cu + 3 * size_t(o[1]), *z = cu + 3 * size_t(o[2]);
-    int64_t d[3];
     for (int a = 0; a < 3; ++a) d[a] = c[3 * v + a] - int64_t(damped_parallelogram(x[a], y[a], z[a], j));
-    const PlaneGate& gate = gates[v];
-    const uint32_t k = gate.d, a = k == 2 ? 0 : k + 1, b = k == 0 ? 2 : k - 1;
-    const int64_t e[3] = {d[k] - gate.offset(d[a], d[b]), d[a], d[b]};
-    for (int i = 0; i < 3; ++i) plain[i] = zigzag(d[i]), lifted[i] = zigzag(e[i]);
   };
-  uint64_t bits[2][5] = {}, largest[2][5] = {};  // [plane][j]
-  for (uint32_t j = 4; j >= 2; --j)
-    for (size_t v = 0; v < V; ++v) {
-      uint64_t z[2][3];
-      residuals_at(v, j, z[0], z[1]);
+  auto lifted = [](const PlaneGate& gate, const int64_t(&d)[3], int64_t(&e)[3]) {
+    const uint32_t k = gate.d, a = k == 2 ? 0 : k + 1, b = k == 0 ? 2 : k - 1;
+    e[0] = d[k] - gate.offset(d[a], d[b]), e[1] = d[a], e[2] = d[b];
+  };
+  auto gate_of = [&](size_t v) {
+    const uint32_t* o = &predictors[3 * v];
+    return PlaneGate(cu + 3 * size_t(o[0]), cu + 3 * size_t(o[1]), cu + 3 * size_t(o[2]));
+  };
+  // [plane][j]: the residuals' bit lengths summed, and OR-ed (bytes_for needs only the highest bit).
+  uint64_t bits[2][5] = {}, high[2][5] = {};
+  for (size_t v = 0; v < V; ++v) {
+    const PlaneGate gate = gate_of(v);
+    auto count = [&](uint32_t j) {  // called with constants: inlined, each damping's arithmetic its own
+      int64_t d[2][3];
+      plain_at(v, j, d[0]);
+      lifted(gate, d[0], d[1]);
       for (int plane = 0; plane < 2; ++plane)
-        for (int i = 0; i < 3; ++i)
-          bits[plane][j] += residual_bits(z[plane][i]),
-              largest[plane][j] = std::max(largest[plane][j], z[plane][i]);
-    }
+        for (int i = 0; i < 3; ++i) {
+          const uint64_t z = zigzag(d[plane][i]);
+          bits[plane][j] += residual_bits(z), high[plane][j] |= z;
+        }
+    };
+    count(4), count(3), count(2);
+  }
   uint64_t fewest = UINT64_MAX;
   for (int plane = 0; plane < 2; ++plane)
     for (uint32_t j = 4; j >= 2; --j)
       if (bits[plane][j] < fewest)
-        fewest = bits[plane][j], r.damping = j, r.plane = plane,
-        r.position_bytes = bytes_for(largest[plane][j]);
+        fewest = bits[plane][j], r.damping = j, r.plane = plane, r.position_bytes = bytes_for(high[plane][j]);
+  // The choice's residuals (the plane's offset, a division, only when it is chosen).
   r.positions.resize(3 * V);
   for (size_t v = 0; v < V; ++v) {
-    uint64_t z[2][3];
-    residuals_at(v, r.damping, z[0], z[1]);
-    std::copy_n(z[r.plane], 3, &r.positions[3 * v]);
+    int64_t d[2][3];
+    plain_at(v, r.damping, d[0]);
+    if (r.plane) lifted(gate_of(v), d[0], d[1]);
+    for (int i = 0; i < 3; ++i) r.positions[3 * v + i] = zigzag(d[r.plane][i]);
   }
   if (g.mesh->has_normals()) {
-    std::vector<glm::vec3> decoded(V + 1);  // predicted_normals reads one past the last
+    // Kept across nodes: decode_positions overwrites the first V; predicted_normals reads one past them
+    // (lanes it never uses).
+    thread_local std::vector<glm::vec3> decoded;
+    decoded.resize(V + 1);
     decode_positions(n.c, LockedStream::parse(locked_stream, V, g.position_shift, "node codec"), grid,
                      decoded.data());
     NormalCodes codes = code_normals(g.mesh->normals, n.order, indices, g.first_vertex, n.index_end,

@@ -9,7 +9,6 @@
 #pragma once
 
 #include <cstdint>
-#include <span>
 #include <vector>
 
 #include "package/node_codec.hpp"
@@ -40,8 +39,13 @@ struct QuantizedNode {
 // first_vertex > 0 or preserve_order, and quantizes. Cost: O(V + T) plus meshopt's reordering.
 QuantizedNode quantize_node(const NodeGeometry& geometry, const PositionGrid& grid);
 
-// Renumbers the node's vertices: new vertex i is current vertex order[i] (order, q, c and locked follow;
-// the caller renumbers the indices). Cost: O(V).
-void reorder_vertices(QuantizedNode& node, std::span<const uint32_t> order);
+// quantize_node in two steps, for a codec that chooses its own vertex order between them: order_node
+// validates (the same errors, but for positions outside the grid's range) and sets order, indices and
+// index_end; the codec may then replace order and indices (order[new] = the geometry's vertex);
+// quantize_positions quantizes the vertices `order` lists (q, c, locked, cmin, cmax; throws lodstream::Error
+// for one outside the grid's range: vertices left out are not stored, so not checked) and sets the UV box.
+// Costs: O(V + T) plus meshopt's reordering, and O(V).
+QuantizedNode order_node(const NodeGeometry& geometry, const PositionGrid& grid);
+void quantize_positions(const NodeGeometry& geometry, const PositionGrid& grid, QuantizedNode& node);
 
 }  // namespace lodstream::package

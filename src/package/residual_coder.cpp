@@ -26,9 +26,11 @@ inline uint32_t bit_length(uint64_t z) {
 }
 // The symbol of value z with D direct bits (residual_coder.hpp); its raw bits are the k - 1 below the
 // leading one when z >= 2^D.
-inline uint32_t symbol_of(uint64_t z, uint32_t D) {
-  const uint32_t k = bit_length(z);
+inline uint32_t symbol_of(uint64_t z, uint32_t k, uint32_t D) {  // k = bit_length(z)
   return k <= D ? uint32_t(z) : (1u << D) + k - D - 1;
+}
+inline uint32_t symbol_of(uint64_t z, uint32_t D) {
+  return symbol_of(z, bit_length(z), D);
 }
 // The raw bits of symbol s >= 2^D: k - 1.
 inline uint32_t raw_bits_of(uint32_t s, uint32_t D) {
@@ -80,9 +82,13 @@ std::vector<uint8_t> encode_residuals(std::span<const uint64_t> values) {
   if (values.empty()) return {};
   std::array<uint32_t, 1u << kMaxDirect> low{};
   std::array<uint32_t, kMaxBits + 1> lengths{};
-  for (const uint64_t z : values) {
+  // Each value's bit length, kept for the symbol pass (becomes its symbol there).
+  std::vector<uint8_t> symbols(values.size());
+  for (size_t i = 0; i < values.size(); ++i) {
+    const uint64_t z = values[i];
     const uint32_t k = bit_length(z);
     if (k > kMaxBits) throw Error("residual coder: a residual of more than 40 bits");
+    symbols[i] = uint8_t(k);
     if (k <= kMaxDirect)
       ++low[z];
     else
@@ -103,13 +109,13 @@ std::vector<uint8_t> encode_residuals(std::span<const uint64_t> values) {
   std::array<uint32_t, kMaxSymbols> start{};
   for (uint32_t s = 1; s < A; ++s) start[s] = start[s - 1] + f[s - 1];
 
-  std::vector<uint8_t> symbols(values.size()), raw;
+  std::vector<uint8_t> raw;
   uint64_t raw_bits = 0;
   uint32_t bit_count = 0;
   for (size_t i = 0; i < values.size(); ++i) {
     const uint64_t z = values[i];
-    const uint32_t k = bit_length(z);
-    symbols[i] = uint8_t(symbol_of(z, D));
+    const uint32_t k = symbols[i];
+    symbols[i] = uint8_t(symbol_of(z, k, D));
     if (k > D) {
       raw_bits |= (z & ((uint64_t(1) << (k - 1)) - 1)) << bit_count, bit_count += k - 1;
       for (; bit_count >= 8; bit_count -= 8, raw_bits >>= 8) raw.push_back(uint8_t(raw_bits));
@@ -120,6 +126,7 @@ std::vector<uint8_t> encode_residuals(std::span<const uint64_t> values) {
   // rANS, last value first (value i in state i mod kStates); the bytes come out last first and are
   // reversed after.
   std::vector<uint8_t> reversed;
+  reversed.reserve(2 * values.size());  // a step moves out at most 16 bits: never regrown
   uint32_t state[kStates];
   std::fill(state, state + kStates, kLow);
   for (size_t i = values.size(); i-- > 0;) {

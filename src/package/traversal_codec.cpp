@@ -36,14 +36,16 @@ std::vector<uint8_t> TraversalCodec::encode(const NodeGeometry& g, const Positio
   if (g.mesh && order_is_significant(g)) return ordered_codec().encode(g, grid);
   NodeGeometry in_order = g;
   in_order.preserve_order = true;  // the traversal chooses the order
-  QuantizedNode n = quantize_node(in_order, grid);
+  QuantizedNode n = order_node(in_order, grid);
   const Mesh& m = *g.mesh;
   const uint32_t V = uint32_t(m.positions.size());
   const uint32_t flags = attribute_flags(g);
 
+  // The vertices quantized straight in traversal order (no copy of them renumbered).
   TraversalCode code = encode_traversal(n.indices, V, g.cluster_triangles);
-  reorder_vertices(n, code.order);
+  n.order = std::move(code.order);
   n.indices = std::move(code.indices);
+  quantize_positions(in_order, grid, n);
   const std::vector<uint8_t> locked_stream = encode_locked_stream(n, g.position_shift);
   return write_predictive_node(NodeHeader::of(kFormat, flags, g, n),
                                predictive_residuals(g, n, code.predictors, n.indices, locked_stream, grid),
