@@ -219,7 +219,8 @@ void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, 
   // Values in blocks of kStates, then one by one, rotating the states. A block reads at most 8 bytes:
   // started only while at is within the rANS bytes, so that no read leaves the padding.
   size_t i = 0;
-  for (; values - i >= kStates; i += kStates) {
+  const size_t blocks_end = values - values % kStates;
+  for (; i < blocks_end; i += kStates) {
     if (at > rans_end) break;
     step(x0, i), step(x1, i + 1), step(x2, i + 2), step(x3, i + 3);
   }
