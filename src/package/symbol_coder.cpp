@@ -183,14 +183,14 @@ void SymbolDecoder::symbols(size_t count, uint8_t* out) {
   };
   // Two symbols a step, the first on x0, the second on x1 (no moves between the states): they read at most
   // 8 bytes, so a pair starts only while at is within the rANS bytes, and no read leaves the padding.
-  size_t i = 0;
-  for (; i + 2 <= count; i += 2) {
+  uint8_t* const pairs_end = out + (count - count % 2);
+  for (; out != pairs_end; out += 2) {
     if (at > rans_end) fail("symbol rANS stream ends early");
-    out[i] = symbol(x0, x1), out[i + 1] = symbol(x1, x0);
+    out[0] = symbol(x0, x1), out[1] = symbol(x1, x0);
   }
-  if (i < count) {
+  if (count % 2) {
     if (at > rans_end) fail("symbol rANS stream ends early");
-    out[i] = symbol(x0, x1);
+    *out = symbol(x0, x1);
     std::swap(x0, x1);  // x1 steps next
   }
   if (at > rans_end) fail("symbol rANS stream ends early");
