@@ -325,8 +325,11 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
     if ((byte & 7) == kVertex) {
       if (next == V) fail("more vertices than the node holds");
       c = next++;
-      predictors[3 * c] = a, predictors[3 * c + 1] = b, predictors[3 * c + 2] = g.o;
+      // The front first: it reads the gate's fields that a, b were loaded from, and no store lies between.
+      const uint32_t o = g.o;
       front.attach(e, c, k);
+      uint32_t* const predictor = predictors + 3 * size_t(c);
+      predictor[0] = a, predictor[1] = b, predictor[2] = o;
     } else {
       switch (byte & 7) {
         case kLeft:
