@@ -160,8 +160,7 @@ ResidualDecoder::ResidualDecoder(std::span<const uint8_t> stream, const std::str
   const uint64_t size = r.varint();
   if (size < 4 * kStates || size > r.remaining()) r.fail("residual rANS stream past the stream's end");
   const std::span<const uint8_t> rest = r.bytes(r.remaining(), "residual rANS stream");
-  bytes_.resize(rest.size() + 8);
-  std::memcpy(bytes_.data(), rest.data(), rest.size());
+  rans::copy_padded(rest, bytes_);
   rans_end_ = size, raw_bit_at_ = 8 * size, raw_bit_end_ = 8 * uint64_t(rest.size());
   for (uint32_t k = 0; k < kStates; ++k) {
     uint32_t x;

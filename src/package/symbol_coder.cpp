@@ -133,8 +133,7 @@ SymbolDecoder::SymbolDecoder(std::span<const uint8_t> stream, const std::string&
   const uint64_t size = r.varint();
   if (size < 4 * kStates || size != r.remaining()) r.fail("symbol rANS stream not the stream's rest");
   const std::span<const uint8_t> rest = r.bytes(r.remaining(), "symbol rANS stream");
-  bytes_.resize(rest.size() + 8);
-  std::memcpy(bytes_.data(), rest.data(), rest.size());
+  rans::copy_padded(rest, bytes_);
   rans_end_ = size;
   for (uint32_t k = 0; k < kStates; ++k) {
     std::memcpy(&state_[k], bytes_.data() + 4 * k, 4);
