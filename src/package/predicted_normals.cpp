@@ -5,6 +5,7 @@
 #include <cstring>
 #include <limits>
 #include <type_traits>
+#include <utility>
 
 #include "package/byte_planes.hpp"
 #include "package/octahedral.hpp"
@@ -97,10 +98,11 @@ __attribute__((target_clones("avx2", "default"))) void predicted_normals(
   };
   sum.resize((size_t(V) + 3) & ~size_t(3));
   std::memset(sum.data(), 0, sum.size() * sizeof(NormalSum));
+  // With all_inside, first_vertex is 0 (the caller's condition below): a constant, so no subtraction.
   auto accumulate = [&](auto all_inside) {
+    const uint32_t base = all_inside ? 0 : first_vertex;
     for (size_t i = 0; i + 2 < indices.size(); i += 3) {
-      const uint32_t a = indices[i] - first_vertex, b = indices[i + 1] - first_vertex,
-                     c = indices[i + 2] - first_vertex;
+      const uint32_t a = indices[i] - base, b = indices[i + 1] - base, c = indices[i + 2] - base;
       if (!all_inside && (a >= V || b >= V || c >= V)) continue;
       // cross(e, f) = e.yzx * f.zxy - e.zxy * f.yzx, as glm::cross computes each component.
       const NormalSum pa = p(a), e = p(b) - pa, f = p(c) - pa;
@@ -110,17 +112,21 @@ __attribute__((target_clones("avx2", "default"))) void predicted_normals(
     }
   };
   // s'[v] = 2 s[v] + sum over v's triangles of the other two corners' s: with t = s[a] + s[b] + s[c], corner
-  // a gains t - s[a].
+  // a gains t - s[a]. The plain sums move to `plain` (a swap of buffers, no copy) and sum is written 2 s
+  // from them.
   thread_local std::vector<NormalSum> plain;
   auto smoothen = [&](auto all_inside) {
-    plain = sum;
-    for (NormalSum& s : sum) s += s;
+    const uint32_t base = all_inside ? 0 : first_vertex;
+    std::swap(plain, sum);
+    sum.resize(plain.size());
+    for (size_t v = 0; v < plain.size(); ++v) sum[v] = plain[v] + plain[v];
     for (size_t i = 0; i + 2 < indices.size(); i += 3) {
-      const uint32_t a = indices[i] - first_vertex, b = indices[i + 1] - first_vertex,
-                     c = indices[i + 2] - first_vertex;
+      const uint32_t a = indices[i] - base, b = indices[i + 1] - base, c = indices[i + 2] - base;
       if (!all_inside && (a >= V || b >= V || c >= V)) continue;
-      const NormalSum t = plain[a] + plain[b] + plain[c];
-      sum[a] += t - plain[a], sum[b] += t - plain[b], sum[c] += t - plain[c];
+      // Loaded once: for all the compiler knows, the stores to sum may alias them.
+      const NormalSum pa = plain[a], pb = plain[b], pc = plain[c];
+      const NormalSum t = pa + pb + pc;
+      sum[a] += t - pa, sum[b] += t - pb, sum[c] += t - pc;
     }
   };
   if (first_vertex == 0 && index_end == V) {

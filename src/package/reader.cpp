@@ -159,7 +159,11 @@ std::vector<uint8_t> PackageReader::read_page(uint32_t page) const {
 }
 
 std::span<const uint8_t> PackageReader::node_bytes(uint32_t id, std::span<const uint8_t> page) {
-  const NodeRecord& n = node(id);
+  return record_bytes(id, node(id), page);
+}
+
+std::span<const uint8_t> PackageReader::record_bytes(uint32_t id, const NodeRecord& n,
+                                                     std::span<const uint8_t> page) const {
   if (page.size() != root_.pages[n.page].raw_size) {
     throw Error(where("node " + std::to_string(id) + ": given page is not page " + std::to_string(n.page)));
   }
@@ -174,7 +178,7 @@ DecodedNode PackageReader::decode_node(uint32_t id, std::span<const uint8_t> pag
   what.assign(source_->name()).append(": node ").append(std::to_string(id));
   what.append(" (page ").append(std::to_string(n.page)).append(")");
   if (n.encoding != NodeEncoding::codec) throw Error(what + ": holds raw bytes, not codec geometry");
-  std::span<const uint8_t> bytes = node_bytes(id, page);
+  std::span<const uint8_t> bytes = record_bytes(id, n, page);
   const Representation& rep = root_.scene.representations[n.representation];
   // The last record decoded is kept (in buffers reused by the next: no allocation or clearing per record),
   // so that a record's clusters, usually decoded one after another (consecutive ids of one page group),

@@ -77,6 +77,9 @@ class PackageReader {
   std::vector<uint8_t> unpack(const Range& range, std::span<const uint8_t> stored,
                               const std::string& what) const;
   void check_layout() const;
+  // node_bytes for node `id`, whose record `n` the caller has (one look-up of the record, not two).
+  std::span<const uint8_t> record_bytes(uint32_t id, const NodeRecord& n,
+                                        std::span<const uint8_t> page) const;
   std::string where(const std::string& what) const { return source_->name() + ": " + what; }
 
   std::shared_ptr<const ByteSource> source_;

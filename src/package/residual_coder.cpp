@@ -167,8 +167,7 @@ ResidualDecoder::ResidualDecoder(std::span<const uint8_t> stream, const std::str
   const uint64_t size = r.varint();
   if (size < 4 * kStates || size > r.remaining()) r.fail("residual rANS stream past the stream's end");
   const std::span<const uint8_t> rest = r.bytes(r.remaining(), "residual rANS stream");
-  bytes_.resize(rest.size() + 8);
-  std::memcpy(bytes_.data(), rest.data(), rest.size());
+  rans::copy_padded(rest, bytes_);
   rans_end_ = size, raw_bit_at_ = 8 * size, raw_bit_end_ = 8 * uint64_t(rest.size());
   for (uint32_t k = 0; k < kStates; ++k) {
     uint32_t x;
@@ -205,13 +204,13 @@ void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, 
   // One step (rANS, Duda 2013, eq. 9: D(x) = (s, f_s floor(x / 2^12) + x mod 2^12 - start_s), s the
   // symbol of slot x mod 2^12), then x read back up to kLow from the next 2 rANS bytes; a value's raw
   // bits, rare (residual_coder.hpp), take a branch too.
-  const auto step = [&](uint32_t & x, size_t i) __attribute__((always_inline)) {
+  const auto step = [&](uint32_t & x, uint8_t * out) __attribute__((always_inline)) {
     const uint32_t slot = x & (kScale - 1), e = slots[slot], s = symbols[slot];
     x = (e & 0xffff) * (x >> kScaleBits) + (e >> 16);
     uint16_t next;
     std::memcpy(&next, bytes + at, 2);
     rans::renormalize(x, at, next);
-    planes[i] = uint8_t(s);
+    *out = uint8_t(s);
     if (s >= direct) [[unlikely]] {
       const uint32_t n = s - direct + D;  // k - 1 raw bits below the leading one
       if (raw_end - raw_at < n) fail("residual raw bits end early");
@@ -220,19 +219,20 @@ void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, 
       const uint64_t z = uint64_t(1) << n | ((word >> (raw_at & 7)) & ((uint64_t(1) << n) - 1));
       raw_at += n;
       if (z > largest) fail("residual wider than its node's planes");
-      for (uint32_t b = 0; b < width; ++b) planes[b * stride + i] = uint8_t(z >> (8 * b));
+      for (uint32_t b = 0; b < width; ++b) out[b * stride] = uint8_t(z >> (8 * b));
     }
   };
   // Values in blocks of kStates, then one by one, rotating the states. A block reads at most 8 bytes:
   // started only while at is within the rANS bytes, so that no read leaves the padding.
-  size_t i = 0;
-  for (; values - i >= kStates; i += kStates) {
+  uint8_t* out = planes;
+  uint8_t* const blocks_end = planes + (values - values % kStates);
+  for (; out != blocks_end; out += kStates) {
     if (at > rans_end) break;
-    step(x0, i), step(x1, i + 1), step(x2, i + 2), step(x3, i + 3);
+    step(x0, out), step(x1, out + 1), step(x2, out + 2), step(x3, out + 3);
   }
   if (at <= rans_end)
-    for (; i < values; ++i) {
-      step(x0, i);
+    for (; out != planes + values; ++out) {
+      step(x0, out);
       const uint32_t t = x0;
       x0 = x1, x1 = x2, x2 = x3, x3 = t;
     }

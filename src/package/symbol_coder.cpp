@@ -104,13 +104,16 @@ SymbolDecoder::SymbolDecoder(std::span<const uint8_t> stream, const std::string&
   if (stream.empty()) return;  // no symbols
   ByteReader r(stream, where);
   slot_ = std::make_unique_for_overwrite<uint32_t[]>(size_t(kTables) * kScale);
+  symbol_ = std::make_unique_for_overwrite<uint8_t[]>(size_t(kTables) * kScale);
   for (uint32_t t = 0; t < kTables; ++t) {
     const uint32_t A = alphabet(t);
     const uint32_t mask = t == kCodeTable ? r.u32() : r.u16();
     if (mask >> A) r.fail("symbol table of an unknown symbol");
     uint32_t* slots = slot_.get() + size_t(t) * kScale;
+    uint8_t* symbols = symbol_.get() + size_t(t) * kScale;
     if (!mask) {
       std::fill_n(slots, kScale, 0);
+      std::fill_n(symbols, kScale, 0);
       continue;
     }
     const uint32_t last = 31 - uint32_t(__builtin_clz(mask));
@@ -122,16 +125,15 @@ SymbolDecoder::SymbolDecoder(std::span<const uint8_t> stream, const std::string&
         f = r.varint();
         if (f == 0 || f >= kScale - sum) r.fail("symbol frequencies add up past the scale");
       }
-      const uint32_t entry = uint32_t(f) | s << 21;
-      rans::fill_slots(slots + sum, entry, uint32_t(f), 11);
+      rans::fill_slots(slots + sum, uint32_t(f), uint32_t(f), 16);
+      std::memset(symbols + sum, int(s), f);
       sum += uint32_t(f);
     }
   }
   const uint64_t size = r.varint();
   if (size < 4 * kStates || size != r.remaining()) r.fail("symbol rANS stream not the stream's rest");
   const std::span<const uint8_t> rest = r.bytes(r.remaining(), "symbol rANS stream");
-  bytes_.resize(rest.size() + 8);
-  std::memcpy(bytes_.data(), rest.data(), rest.size());
+  rans::copy_padded(rest, bytes_);
   rans_end_ = size;
   for (uint32_t k = 0; k < kStates; ++k) {
     std::memcpy(&state_[k], bytes_.data() + 4 * k, 4);
@@ -148,6 +150,7 @@ void SymbolDecoder::symbols(size_t count, uint8_t* out) {
   if (count == 0) return;
   if (!slot_) fail("symbols past the symbol stream's end");
   const uint32_t* slots = slot_.get();
+  const uint8_t* symbol_of = symbol_.get();
   const uint8_t* bytes = bytes_.data();
   size_t at = rans_at_;
   const size_t rans_end = rans_end_;
@@ -157,12 +160,12 @@ void SymbolDecoder::symbols(size_t count, uint8_t* out) {
   // of slot x mod 2^8 of `table`), then x read back up to kLow from the next 2 rANS bytes; the states
   // alternate.
   const auto step = [&](uint32_t & x, uint32_t table) __attribute__((always_inline)) {
-    const uint32_t e = slots[table * kScale + (x & (kScale - 1))];
-    x = (e & 0x7ff) * (x >> kScaleBits) + ((e >> 11) & 0x3ff);
+    const uint32_t slot = table * kScale + (x & (kScale - 1)), e = slots[slot];
+    x = (e & 0xffff) * (x >> kScaleBits) + (e >> 16);
     uint16_t next;
     std::memcpy(&next, bytes + at, 2);
     rans::renormalize(x, at, next);
-    return e >> 21;
+    return uint32_t(symbol_of[slot]);
   };
   // A symbol whose class steps state x (the next step's); a tagged symbol's rank steps y, then the two swap
   // names, so that x names the next step's state again. A class of a table that never occurs decodes as
@@ -179,14 +182,14 @@ void SymbolDecoder::symbols(size_t count, uint8_t* out) {
   };
   // Two symbols a step, the first on x0, the second on x1 (no moves between the states): they read at most
   // 8 bytes, so a pair starts only while at is within the rANS bytes, and no read leaves the padding.
-  size_t i = 0;
-  for (; i + 2 <= count; i += 2) {
+  uint8_t* const pairs_end = out + (count - count % 2);
+  for (; out != pairs_end; out += 2) {
     if (at > rans_end) fail("symbol rANS stream ends early");
-    out[i] = symbol(x0, x1), out[i + 1] = symbol(x1, x0);
+    out[0] = symbol(x0, x1), out[1] = symbol(x1, x0);
   }
-  if (i < count) {
+  if (count % 2) {
     if (at > rans_end) fail("symbol rANS stream ends early");
-    out[i] = symbol(x0, x1);
+    *out = symbol(x0, x1);
     std::swap(x0, x1);  // x1 steps next
   }
   if (at > rans_end) fail("symbol rANS stream ends early");

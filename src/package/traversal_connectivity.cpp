@@ -313,44 +313,53 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
     if (symbol == symbols_end) fail("symbols end early");
     const Front::Edge& g = front.edge(e);
     const uint32_t a = g.a, b = g.b;
-    const uint32_t code = *symbol >> 3;  // 0: the gate's cluster, else cluster code - 1
-    const uint32_t k = code == 0 ? g.cluster : code - 1;
-    if (k >= C) fail("cluster out of range");
+    const uint32_t byte = *symbol++;
+    // Cluster code 0: the gate's cluster (below C, checked when its triangle was decoded), else code - 1.
+    uint32_t k = g.cluster;
+    if (byte >> 3) [[unlikely]] {
+      k = (byte >> 3) - 1;
+      if (k >= C) fail("cluster out of range");
+    }
     uint32_t c;
-    switch (*symbol++ & 7) {
-      case kVertex:
-        if (next == V) fail("more vertices than the node holds");
-        c = next++;
-        predictors[3 * c] = a, predictors[3 * c + 1] = b, predictors[3 * c + 2] = g.o;
-        front.attach(e, c, k);
-        break;
-      case kLeft:
-        c = front.left(e);
-        if (c == kNone) fail("left turn in a loop of 2");
-        front.close_left(e, k);
-        break;
-      case kRight:
-        c = front.right(e);
-        if (c == kNone) fail("right turn in a loop of 2");
-        front.close_right(e, k);
-        break;
-      case kEnd:
-        if (!front.closes(e)) fail("end of a loop that is not 3 edges");
-        c = front.left(e);
-        front.close_loop(e);
-        break;
-      case kSplit: {
-        const uint64_t r = refs.varint();
-        if (r >= next) fail("reference to a vertex not decoded yet");
-        c = next - 1 - uint32_t(r);
-        front.attach(e, c, k);
-        break;
+    // kVertex, about half the symbols, tested before the jump table of the others.
+    if ((byte & 7) == kVertex) {
+      if (next == V) fail("more vertices than the node holds");
+      c = next++;
+      // The front first: it reads the gate's fields that a, b were loaded from, and no store lies between.
+      const uint32_t o = g.o;
+      front.attach(e, c, k);
+      uint32_t* const predictor = predictors + 3 * size_t(c);
+      predictor[0] = a, predictor[1] = b, predictor[2] = o;
+    } else {
+      switch (byte & 7) {
+        case kLeft:
+          c = front.left(e);
+          if (c == kNone) fail("left turn in a loop of 2");
+          front.close_left(e, k);
+          break;
+        case kRight:
+          c = front.right(e);
+          if (c == kNone) fail("right turn in a loop of 2");
+          front.close_right(e, k);
+          break;
+        case kEnd:
+          if (!front.closes(e)) fail("end of a loop that is not 3 edges");
+          c = front.left(e);
+          front.close_loop(e);
+          break;
+        case kSplit: {
+          const uint64_t r = refs.varint();
+          if (r >= next) fail("reference to a vertex not decoded yet");
+          c = next - 1 - uint32_t(r);
+          front.attach(e, c, k);
+          break;
+        }
+        case kBoundary:
+          front.done(e++);  // the gate is done: the next one lies past it
+          continue;
+        default:
+          fail("unknown symbol");
       }
-      case kBoundary:
-        front.done(e++);  // the gate is done: the next one lies past it
-        continue;
-      default:
-        fail("unknown symbol");
     }
     emit(b, a, c, k);
     --left;
