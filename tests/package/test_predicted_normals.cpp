@@ -1,6 +1,6 @@
 // Normals coded in the frame of their prediction (predicted_normals.hpp): what the decoder rebuilds from the
 // codes, in any frame (degenerate and seam predictions included), and the encoder's choice of the plain or
-// the smoothed prediction.
+// the smoothed prediction; closed vertices' normals derived (derived_normals.hpp).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,7 +12,9 @@
 
 #include "core/mesh.hpp"
 #include "package/byte_planes.hpp"
+#include "package/derived_normals.hpp"
 #include "package/predicted_normals.hpp"
+#include "package/traversal_codec.hpp"
 #include "support/shapes.hpp"
 
 namespace lodstream::test {
@@ -168,6 +170,80 @@ TEST(PredictedNormals, TheEncoderSmoothsWhereQuantizedPositionsTiltTheFacesButNo
     decode_predicted_normals(sum, V, planes.data(), codes->width, 9, decoded);
     for (uint32_t v = 0; v < V; ++v)
       EXPECT_LT(angle(decoded[v], glm::normalize(m->normals[v])), std::ldexp(5.0 / 0.49, -9)) << v;
+  }
+}
+
+TEST(DerivedNormals, AFanIsClosedWhenEveryTriangleAroundTheVertexIsInTheNode) {
+  std::vector<uint8_t> open;
+  const Mesh ball = sphere(1.0f, 8, 16);
+  const uint32_t V = uint32_t(ball.vertex_count());
+  EXPECT_EQ(open_vertices(ball.indices, 0, V, open), 0u);  // closed and consistently oriented
+
+  // A grid's fans are open on its boundary only.
+  const Mesh sheet = grid(4);
+  const uint32_t sheet_vertices = uint32_t(sheet.vertex_count());
+  const uint32_t count = open_vertices(sheet.indices, 0, sheet_vertices, open);
+  EXPECT_EQ(count, 16u);
+  for (uint32_t v = 0; v < sheet_vertices; ++v) {
+    const glm::vec3 p = sheet.positions[v];
+    const bool border = p.x == 0.0f || p.x == 1.0f || p.y == 0.0f || p.y == 1.0f;
+    EXPECT_EQ(open[v], border) << v;
+  }
+
+  // One triangle less opens its three corners' fans; so does a triangle reaching past the node (numbered
+  // from first_vertex 100), which is not counted, and a vertex of no triangle is open.
+  std::vector<uint32_t> holed(ball.indices.begin(), ball.indices.end() - 3);
+  for (uint32_t& i : holed) i += 100;
+  holed.insert(holed.end(), {100 + ball.indices[ball.indices.size() - 3], 100 + V, 100 + V + 1});
+  EXPECT_EQ(open_vertices(holed, 100, V + 1, open), 4u);
+  for (size_t k = ball.indices.size() - 3; k < ball.indices.size(); ++k) EXPECT_TRUE(open[ball.indices[k]]);
+  EXPECT_TRUE(open[V]);
+}
+
+TEST(DerivedNormals, ClosedVerticesWithinOneStepDecodeToThePrediction) {
+  // A sphere whose normals are tilted off the surface's by about one code step at 9 bits (1 / (0.49 * 255)
+  // radians): without derivation the closed vertices would store codes of +-1 and decode off the prediction.
+  Mesh ball = sphere(1.0f, 24, 48);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> turn(0.0f, 6.2831853f);
+  for (glm::vec3& n : ball.normals) {
+    const glm::vec3 t =
+        glm::normalize(glm::cross(n, std::abs(n.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0)));
+    const glm::vec3 b = glm::cross(n, t);
+    const float a = turn(rng);
+    n = glm::normalize(n + 0.009f * (std::cos(a) * t + std::sin(a) * b));
+  }
+  const PositionGrid grid = PositionGrid::for_bounds(ball.bounds(), 14);
+  NodeGeometry g;
+  g.mesh = &ball;
+  g.normal_bits = kDerivedNormalBits;
+  const TraversalCodec codec;
+  const DecodedNode d = codec.decode(codec.encode(g, grid), grid, "derived");
+  const uint32_t V = uint32_t(d.mesh.vertex_count());
+  ASSERT_EQ(V, ball.vertex_count());
+
+  // The vertices (all closed) decode to their prediction, plain or smoothed (the encoder's choice), but for
+  // the few that the prediction's own error (the sphere's tessellation) puts more than a step off.
+  std::vector<glm::vec3> padded(d.mesh.positions);
+  padded.push_back(glm::vec3(0.0f));
+  size_t at_prediction[2] = {0, 0};
+  for (bool smooth : {false, true}) {
+    std::vector<NormalSum> sum;
+    predicted_normals(d.mesh.indices, 0, V, padded.data(), V, smooth, sum);
+    for (uint32_t v = 0; v < V; ++v)
+      at_prediction[smooth] += angle(d.mesh.normals[v], glm::vec3(sum[v][0], sum[v][1], sum[v][2])) < 1e-5;
+  }
+  EXPECT_GE(std::max(at_prediction[0], at_prediction[1]), V * 8 / 10);
+  // And within three code steps of the normal given (both codes within 1.8 steps with the 9-bit dead zone:
+  // 1.8 sqrt(2) = 2.55 steps apart at most) to the same position (the codec renumbers the
+  // vertices).
+  for (uint32_t v = 0; v < V; ++v) {
+    uint32_t source = 0;
+    for (uint32_t s = 1; s < V; ++s)
+      if (glm::length(ball.positions[s] - d.mesh.positions[v]) <
+          glm::length(ball.positions[source] - d.mesh.positions[v]))
+        source = s;
+    EXPECT_LT(angle(d.mesh.normals[v], ball.normals[source]), 3.0 / (0.49 * 255)) << v;
   }
 }
 
