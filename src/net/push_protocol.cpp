@@ -71,6 +71,12 @@ std::optional<wire::Message> PushProtocol::on_message(const wire::Message& messa
     s.height = view->viewport_height;
     if (std::abs(glm::dot(glm::normalize(s.forward), glm::normalize(s.up))) > 0.9999)
       throw wire::WireError("wire: view message: up is parallel to forward");
+    // A converged plan stays so while the client reports the same pose (a still camera: its predictions
+    // are the same views).
+    if (!view_ || view_->eye != s.eye || view_->forward != s.forward || view_->up != s.up ||
+        view_->velocity != s.velocity || view_->angular_velocity != s.angular_velocity ||
+        view_->fov_y_radians != s.fov_y_radians || view_->width != s.width || view_->height != s.height)
+      plan_converged_ = false;
     view_ = s;
     view_received_s_ = now_s;
     if (!planned_view_s_ || s.time_s < *planned_view_s_ ||
@@ -90,7 +96,8 @@ std::optional<wire::Message> PushProtocol::on_message(const wire::Message& messa
         if (!scheduler_.held(PageKind::data, p) || released_[p]) continue;
         held_bytes_ -= reader().root().pages[p].raw_size;
         released_[p] = true;
-        if (restore_failed) {  // what the view needed is not there: due again at once, as bytes
+        plan_converged_ = false;  // the cut may need it again, and the idle fill has room
+        if (restore_failed) {     // what the view needed is not there: due again at once, as bytes
           scheduler_.set_held(PageKind::data, p, false);
           ++remaining_;
         } else {
@@ -150,6 +157,8 @@ void PushProtocol::plan(double now_s, uint64_t bytes) {
     }
   }
   planned_.assign(pages.begin(), pages.end());
+  plan_converged_ = view_ && pages.empty();
+  ++counters_.plans;
 }
 
 std::optional<PageToSend> PushProtocol::next_page(double now_s) {
@@ -158,7 +167,7 @@ std::optional<PageToSend> PushProtocol::next_page(double now_s) {
   if (in_flight >= window) return std::nullopt;
   while (!planned_.empty() && scheduler_.held(planned_.front().kind, planned_.front().id))
     planned_.pop_front();
-  if (planned_.empty() || backoff_.due_by(now_s))
+  if ((planned_.empty() && !plan_converged_) || backoff_.due_by(now_s))
     plan(now_s, uint64_t(options_.plan_windows * double(window)));
   if (planned_.empty()) return std::nullopt;
   const PageRef page = scheduler_.page(planned_.front().kind, planned_.front().id);  // priced as of now

@@ -150,6 +150,32 @@ TEST(PushProtocol, WithoutTheIdleFillANewViewRestartsSending) {
   EXPECT_GT(drain(p, t).size(), 0u);
 }
 
+// Once everything the view needs is sent (no idle fill), acknowledgements and view updates with the same
+// pose cost no plan; another pose does.
+TEST(PushProtocol, AConvergedSessionPlansAgainOnlyForAnotherPose) {
+  Fixture f;
+  PushProtocolOptions options;
+  options.fill_when_idle = false;
+  PushProtocol p(f.package, options);
+  p.on_message(hello(), 0.0);
+  const wire::ViewUpdate still = view({2, 0, 3}, {0, 0, -1});
+  p.on_message(still, 0.0);
+  double t = 0.0;
+  EXPECT_GT(drain(p, t).size(), 0u);
+  const uint64_t plans = p.counters().plans;
+  for (int i = 0; i < 20; ++i) {
+    wire::ViewUpdate again = still;
+    again.client_time_s = t;  // a newer sample of the same pose, past the replan interval
+    p.on_message(again, t);
+    EXPECT_FALSE(p.next_page(t));
+    t += 0.2;
+  }
+  EXPECT_EQ(p.counters().plans, plans);
+  p.on_message(view({14, 0, 3}, {0, 0, -1}), t);
+  EXPECT_GT(drain(p, t).size(), 0u);
+  EXPECT_GT(p.counters().plans, plans);
+}
+
 // The idle fill waits for the first view: a window filled in file order before it would hold back the
 // view's pages by a round trip. The first page after the view is one its cut needs.
 TEST(PushProtocol, NothingIsSentBeforeTheFirstView) {
