@@ -39,8 +39,8 @@ class PackageReader {
   // Whether node `id`'s record is available without a read.
   bool has_node(uint32_t id) const;
   // Node `id`'s record when it is available without a read (in the root index or an index page already
-  // here), else nullptr (also for an id out of range). Never reads. Cost: one binary search over the index
-  // pages (has_node followed by node() took two).
+  // here), else nullptr (also for an id out of range). Never reads. Cost: one IndexPageMap look-up
+  // (has_node followed by node() took two).
   const NodeRecord* held_node(uint32_t id) const;
   // Node `id`'s record, reading its index page first if needed (one read of that page).
   const NodeRecord& node(uint32_t id);

@@ -42,10 +42,7 @@ uint32_t searched(const RootIndex& root, uint32_t id) {
 TEST(IndexPageMap, EveryIdFindsThePageThatHoldsIt) {
   // Pages larger than a bucket, exactly one, single records (many in one bucket), and a ragged end.
   const std::vector<std::vector<uint32_t>> layouts{
-      {300, 64, 1, 1, 1, 63, 65, 128, 7},
-      std::vector<uint32_t>(200, 1),
-      {1000},
-      {}};
+      {300, 64, 1, 1, 1, 63, 65, 128, 7}, std::vector<uint32_t>(200, 1), {1000}, {}};
   for (uint32_t roots : {0u, 1u, 37u, 64u}) {
     for (const auto& counts : layouts) {
       const RootIndex root = root_with_pages(roots, counts);
