@@ -31,8 +31,10 @@ inline constexpr std::array<uint8_t, 8> kMagic = {0x89, 'L', 'O', 'D', 'S', '\r'
 // store the connectivity's references apart from its symbols and the traversal symbols entropy-coded with
 // context (page_parts.hpp, symbol_coder.hpp); 8: traversal symbols' cluster codes stored by recency
 // (symbol_coder.hpp); 9: positions predicted on the gate triangle's plane (predictive_node.hpp,
-// kPlanePrediction), position residuals coded in two streams (page_parts.hpp, the split form).
-inline constexpr uint32_t kFormatVersion = 9;
+// kPlanePrediction), position residuals coded in two streams (page_parts.hpp, the split form); 10: positions
+// predicted by the average of the parallelograms the traversal joins (predictive_node.hpp,
+// kMultiParallelogram).
+inline constexpr uint32_t kFormatVersion = 10;
 inline constexpr size_t kHeaderSize = 64;
 
 // Hard limits a reader enforces before allocating: no valid writer output exceeds them.

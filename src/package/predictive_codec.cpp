@@ -138,7 +138,7 @@ std::vector<uint8_t> PredictiveCodec::encode(const NodeGeometry& g, const Positi
   predictors_of(seen, g.first_vertex, V, predictors);
   const std::vector<uint8_t> locked_stream = encode_locked_stream(n, k);
   return write_predictive_node(NodeHeader::of(kFormat, flags, g, n),
-                               predictive_residuals(g, n, predictors, seen, locked_stream, grid),
+                               predictive_residuals(g, n, predictors, {}, nullptr, seen, locked_stream, grid),
                                encode_attribute_stream(flags, g, n), locked_stream, index_stream, g.extra);
 }
 
@@ -160,7 +160,7 @@ DecodedNode PredictiveCodec::decode(std::span<const uint8_t> bytes, const Positi
   const uint32_t max_index = predictors_of(m.indices, p.first_vertex, V, predictors);
   if (T > 0 && max_index >= p.index_end)
     throw Error(where + ": index " + std::to_string(max_index) + " out of range");
-  decode_predicted_vertices(p, predictors, grid, out, where);
+  decode_predicted_vertices(p, predictors, nullptr, grid, out, where);
   return out;
 }
 

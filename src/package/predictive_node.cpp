@@ -16,6 +16,14 @@ namespace lodstream::package {
 namespace {
 
 constexpr uint32_t kMaxPositionBytes = 5, kMaxNormalBytes = 3;
+// The encoder takes the multi-parallelogram prediction (predictive_node.hpp) only when its residuals' bit
+// lengths add up to at least 3/4 bit a vertex fewer than the best single-parallelogram choice: it costs the
+// decoder about 110 instructions a vertex (the traversal's joins, the second parallelogram and normal).
+// Measured (`lodstream bake`, `bench decode --runs 1` under callgrind), threshold 0 / 1/2 / 3/4 / 1 bit:
+// refined_elephant 271,148 B -> 259,949 / 260,780 / 261,306 / 262,722, elephant_1m 2,972,234 -> 2,892,577
+// / 2,937,462 / unchanged / unchanged, elephant_1m's decode 1,188.9 M instructions -> 1,322.9 / 1,244.8 /
+// unchanged (no node takes it).
+constexpr uint64_t kMultiMinSavedBits = 3;  // quarter bits a vertex
 // Decoded coarse coordinates stay within ±2^32 (valid ones within ±2^31), so no chain of predictions from
 // hostile residuals (< 2^40) overflows int64.
 constexpr int64_t kMaxCoarse = int64_t(1) << 32;
@@ -28,6 +36,19 @@ inline uint64_t damped_parallelogram(uint64_t a, uint64_t b, uint64_t c, uint32_
   return uint64_t(int64_t((4 + j) * (a + b) - 2 * j * c + 4) >> 3);
 }
 
+// The multi-parallelogram P of predictive_node.hpp from vertex v's predictors o and second parallelogram
+// `more` (3 entries each): per axis floor((sum over the two of (4 + j)(c[x] + c[y]) - 2j c[o]) + 8) / 16),
+// wrapping until the final arithmetic shift, so that hostile coordinates never overflow. With more = o it is
+// damped_parallelogram (twice the sum, twice the divisor).
+template <uint32_t j>
+inline void averaged_parallelogram(const uint64_t* c, const uint32_t* o, const uint32_t* more,
+                                   uint64_t (&p)[3]) {
+  const uint64_t *x = c + 3 * size_t(o[0]), *y = c + 3 * size_t(o[1]), *z = c + 3 * size_t(o[2]);
+  const uint64_t *u = c + 3 * size_t(more[0]), *w = c + 3 * size_t(more[1]), *t = c + 3 * size_t(more[2]);
+  for (int a = 0; a < 3; ++a)
+    p[a] = uint64_t(int64_t((4 + j) * (x[a] + y[a] + u[a] + w[a]) - 2 * j * (z[a] + t[a]) + 8) >> 4);
+}
+
 // The plane prediction of predictive_node.hpp at the gate triangle x y z (coarse coordinates, wrapping):
 // the dominant axis d of its normal n = (x - z) x (y - z) and, for the residuals ra, rb of axes d + 1, d + 2
 // (mod 3), the offset floor(-(n[d+1] ra + n[d+2] rb) / n[d] + 1/2) of axis d's residual; d = 0 and offset 0
@@ -35,15 +56,31 @@ inline uint64_t damped_parallelogram(uint64_t a, uint64_t b, uint64_t c, uint32_
 // contraction: x86-64 has no FMA without -mfma), so both get the same bits. |n[d+1]|, |n[d+2]| <= |n[d]|, so
 // |offset| <= |ra| + |rb| + 1 and the conversion back is in range for any residuals below 2^40 (hostile
 // coordinates wrap in the cross product; any n is finite).
+// With the multi-parallelogram prediction n is the sum of the normals of the two parallelograms' triangles
+// (x, y, o), both in their mesh winding (traversal_connectivity.hpp, Parallelograms): with the same triangle
+// twice, twice the gate's normal, the same plane and offsets (doubling is exact in doubles).
+inline void add_normal(const uint64_t* x, const uint64_t* y, const uint64_t* z, uint64_t (&n)[3]) {
+  const uint64_t e[2][3] = {{x[0] - z[0], x[1] - z[1], x[2] - z[2]}, {y[0] - z[0], y[1] - z[1], y[2] - z[2]}};
+  n[0] += e[0][1] * e[1][2] - e[0][2] * e[1][1];
+  n[1] += e[0][2] * e[1][0] - e[0][0] * e[1][2];
+  n[2] += e[0][0] * e[1][1] - e[0][1] * e[1][0];
+}
 struct PlaneGate {
   double n[3];
   uint32_t d;
   PlaneGate(const uint64_t* x, const uint64_t* y, const uint64_t* z) {
-    const uint64_t e[2][3] = {{x[0] - z[0], x[1] - z[1], x[2] - z[2]},
-                              {y[0] - z[0], y[1] - z[1], y[2] - z[2]}};
-    n[0] = double(int64_t(e[0][1] * e[1][2] - e[0][2] * e[1][1]));
-    n[1] = double(int64_t(e[0][2] * e[1][0] - e[0][0] * e[1][2]));
-    n[2] = double(int64_t(e[0][0] * e[1][1] - e[0][1] * e[1][0]));
+    uint64_t s[3] = {0, 0, 0};
+    add_normal(x, y, z, s);
+    set(s);
+  }
+  PlaneGate(const uint64_t* c, const uint32_t* o, const uint32_t* more) {
+    uint64_t s[3] = {0, 0, 0};
+    add_normal(c + 3 * size_t(o[0]), c + 3 * size_t(o[1]), c + 3 * size_t(o[2]), s);
+    add_normal(c + 3 * size_t(more[0]), c + 3 * size_t(more[1]), c + 3 * size_t(more[2]), s);
+    set(s);
+  }
+  void set(const uint64_t (&s)[3]) {
+    n[0] = double(int64_t(s[0])), n[1] = double(int64_t(s[1])), n[2] = double(int64_t(s[2]));
     const double a0 = std::fabs(n[0]), a1 = std::fabs(n[1]), a2 = std::fabs(n[2]);
     d = a0 >= a1 ? (a0 >= a2 ? 0 : 2) : (a1 >= a2 ? 1 : 2);
   }
@@ -59,26 +96,33 @@ struct PlaneGate {
 // c[v] = P + residual[v] per axis for v < V (predictive_node.hpp), wrapping, the residuals as read_planes
 // leaves them (one array per component), with the plane prediction when `plane`. One pass; returns whether a
 // result lies outside [-kMaxCoarse, kMaxCoarse).
-template <uint32_t j, bool plane>
-bool predict_positions(const int64_t* residual, uint32_t V, const uint32_t* o, uint64_t* c) {
+// With `extra` (multi), P is the multi-parallelogram (averaged_parallelogram).
+template <uint32_t j, bool plane, bool multi>
+bool predict_positions(const int64_t* residual, uint32_t V, const uint32_t* o, const Parallelograms* extra,
+                       uint64_t* c) {
   const int64_t *r0 = residual, *r1 = r0 + V, *r2 = r1 + V;
   uint64_t shifted = 0;  // OR of c + kMaxCoarse: in range while below 2 kMaxCoarse
   for (uint32_t v = 0; v < V; ++v, o += 3) {
     const uint64_t *x = c + 3 * size_t(o[0]), *y = c + 3 * size_t(o[1]), *z = c + 3 * size_t(o[2]);
     uint64_t* to = c + 3 * size_t(v);
+    uint64_t p[3];
+    [[maybe_unused]] const uint32_t* more = multi ? extra->corners.data() + 3 * size_t(v) : nullptr;
+    if constexpr (multi) {
+      averaged_parallelogram<j>(c, o, more, p);
+    } else {
+      p[0] = damped_parallelogram(x[0], y[0], z[0], j);
+      p[1] = damped_parallelogram(x[1], y[1], z[1], j);
+      p[2] = damped_parallelogram(x[2], y[2], z[2], j);
+    }
     if constexpr (plane) {
-      const PlaneGate gate(x, y, z);
+      const PlaneGate gate = multi ? PlaneGate(c, o, more) : PlaneGate(x, y, z);
       const uint32_t d = gate.d, a = d == 2 ? 0 : d + 1, b = d == 0 ? 2 : d - 1;
       uint64_t r[3];
       r[a] = uint64_t(r1[v]), r[b] = uint64_t(r2[v]),
       r[d] = uint64_t(r0[v]) + uint64_t(gate.offset(r1[v], r2[v]));
-      to[0] = damped_parallelogram(x[0], y[0], z[0], j) + r[0];
-      to[1] = damped_parallelogram(x[1], y[1], z[1], j) + r[1];
-      to[2] = damped_parallelogram(x[2], y[2], z[2], j) + r[2];
+      to[0] = p[0] + r[0], to[1] = p[1] + r[1], to[2] = p[2] + r[2];
     } else {
-      to[0] = damped_parallelogram(x[0], y[0], z[0], j) + uint64_t(r0[v]);
-      to[1] = damped_parallelogram(x[1], y[1], z[1], j) + uint64_t(r1[v]);
-      to[2] = damped_parallelogram(x[2], y[2], z[2], j) + uint64_t(r2[v]);
+      to[0] = p[0] + uint64_t(r0[v]), to[1] = p[1] + uint64_t(r1[v]), to[2] = p[2] + uint64_t(r2[v]);
     }
     shifted |=
         (to[0] + uint64_t(kMaxCoarse)) | (to[1] + uint64_t(kMaxCoarse)) | (to[2] + uint64_t(kMaxCoarse));
@@ -87,9 +131,13 @@ bool predict_positions(const int64_t* residual, uint32_t V, const uint32_t* o, u
 }
 
 template <uint32_t j>
-bool predict_positions(bool plane, const int64_t* residual, uint32_t V, const uint32_t* o, uint64_t* c) {
-  return plane ? predict_positions<j, true>(residual, V, o, c)
-               : predict_positions<j, false>(residual, V, o, c);
+bool predict_positions(bool plane, const int64_t* residual, uint32_t V, const uint32_t* o,
+                       const Parallelograms* extra, uint64_t* c) {
+  if (extra)
+    return plane ? predict_positions<j, true, true>(residual, V, o, extra, c)
+                 : predict_positions<j, false, true>(residual, V, o, extra, c);
+  return plane ? predict_positions<j, true, false>(residual, V, o, extra, c)
+               : predict_positions<j, false, false>(residual, V, o, extra, c);
 }
 
 // Bits of a zigzagged residual (0 for 0): the encoder's estimate of what a damping costs.
@@ -160,7 +208,8 @@ NodeSizeBreakdown PredictiveNode::layout(std::span<const uint8_t> bytes, size_t 
 
 PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedNode& n,
                                          std::span<const uint32_t> predictors,
-                                         std::span<const uint32_t> indices,
+                                         std::span<const uint32_t> multi_predictors,
+                                         const Parallelograms* extra, std::span<const uint32_t> indices,
                                          std::span<const uint8_t> locked_stream, const PositionGrid& grid) {
   const size_t V = n.order.size();
   PredictiveResiduals r;
@@ -168,53 +217,56 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
   thread_local std::vector<int64_t> c;
   c.assign(n.c.begin(), n.c.end());
   c.insert(c.end(), std::begin(n.cmin), std::end(n.cmin));
-  // The damping j and plane prediction whose residuals take the fewest bits (ties: the larger j, no plane):
-  // one pass counts all six (per vertex its predictors and gate are read once; the gate's plane does not
-  // depend on j), then the choice's residuals.
+  // The damping j, plane and multi-parallelogram prediction whose residuals take the fewest bits (ties:
+  // the larger j, no plane, no multi): one pass counts all twelve (the gate's plane does not depend on j),
+  // then the choice's residuals.
   const uint64_t* cu = reinterpret_cast<const uint64_t*>(c.data());
-  // Vertex v's residuals at damping j, plain (d), and on the plane of `gate` (e: components (d - offset,
+  // Vertex v's residuals at damping j, plain (d), and on the plane of its gate (e: components (d - offset,
   // d + 1, d + 2) of its dominant axis d).
-  auto plain_at = [&](size_t v, uint32_t j, int64_t(&d)[3]) {
-    const uint32_t* o = &predictors[3 * v];
-    const uint64_t *x = cu + 3 * size_t(o[0]), *y = cu + 3 * size_t(o[1]), *z = cu + 3 * size_t(o[2]);
-    for (int a = 0; a < 3; ++a) d[a] = c[3 * v + a] - int64_t(damped_parallelogram(x[a], y[a], z[a], j));
-  };
-  auto lifted = [](const PlaneGate& gate, const int64_t(&d)[3], int64_t(&e)[3]) {
+  auto residuals_at = [&](size_t v, uint32_t j, bool multi, bool plane, int64_t(&e)[3]) {
+    const uint32_t* o = &(multi ? multi_predictors : predictors)[3 * v];
+    uint64_t p[3];
+    const uint32_t* more = multi ? extra->corners.data() + 3 * v : o;  // o twice: the gate's alone
+    j == 4   ? averaged_parallelogram<4>(cu, o, more, p)
+    : j == 3 ? averaged_parallelogram<3>(cu, o, more, p)
+             : averaged_parallelogram<2>(cu, o, more, p);
+    int64_t d[3];
+    for (int a = 0; a < 3; ++a) d[a] = c[3 * v + a] - int64_t(p[a]);
+    if (!plane) {
+      e[0] = d[0], e[1] = d[1], e[2] = d[2];
+      return;
+    }
+    const PlaneGate gate(cu, o, more);
     const uint32_t k = gate.d, a = k == 2 ? 0 : k + 1, b = k == 0 ? 2 : k - 1;
     e[0] = d[k] - gate.offset(d[a], d[b]), e[1] = d[a], e[2] = d[b];
   };
-  auto gate_of = [&](size_t v) {
-    const uint32_t* o = &predictors[3 * v];
-    return PlaneGate(cu + 3 * size_t(o[0]), cu + 3 * size_t(o[1]), cu + 3 * size_t(o[2]));
-  };
-  // [plane][j]: the residuals' bit lengths summed, and OR-ed (bytes_for needs only the highest bit).
-  uint64_t bits[2][5] = {}, high[2][5] = {};
-  for (size_t v = 0; v < V; ++v) {
-    const PlaneGate gate = gate_of(v);
-    auto count = [&](uint32_t j) {  // called with constants: inlined, each damping's arithmetic its own
-      int64_t d[2][3];
-      plain_at(v, j, d[0]);
-      lifted(gate, d[0], d[1]);
-      for (int plane = 0; plane < 2; ++plane)
-        for (int i = 0; i < 3; ++i) {
-          const uint64_t z = zigzag(d[plane][i]);
-          bits[plane][j] += residual_bits(z), high[plane][j] |= z;
+  // [multi][plane][j]: the residuals' bit lengths summed, and OR-ed (bytes_for needs only the highest bit).
+  uint64_t bits[2][2][5] = {}, high[2][2][5] = {};
+  const int multis = extra ? 2 : 1;
+  for (size_t v = 0; v < V; ++v)
+    for (int multi = 0; multi < multis; ++multi)
+      for (uint32_t j = 2; j <= 4; ++j)
+        for (int plane = 0; plane < 2; ++plane) {
+          int64_t e[3];
+          residuals_at(v, j, multi, plane, e);
+          for (int i = 0; i < 3; ++i) {
+            const uint64_t z = zigzag(e[i]);
+            bits[multi][plane][j] += residual_bits(z), high[multi][plane][j] |= z;
+          }
         }
-    };
-    count(4), count(3), count(2);
-  }
+  // The multi-parallelogram prediction must save kMultiMinSavedBits quarter bits a vertex (its decode cost).
   uint64_t fewest = UINT64_MAX;
-  for (int plane = 0; plane < 2; ++plane)
-    for (uint32_t j = 4; j >= 2; --j)
-      if (bits[plane][j] < fewest)
-        fewest = bits[plane][j], r.damping = j, r.plane = plane, r.position_bytes = bytes_for(high[plane][j]);
-  // The choice's residuals (the plane's offset, a division, only when it is chosen).
+  for (int multi = 0; multi < multis; ++multi)
+    for (int plane = 0; plane < 2; ++plane)
+      for (uint32_t j = 4; j >= 2; --j)
+        if (bits[multi][plane][j] + (multi ? kMultiMinSavedBits * V / 4 : 0) < fewest)
+          fewest = bits[multi][plane][j], r.damping = j, r.plane = plane, r.multi = multi,
+          r.position_bytes = bytes_for(high[multi][plane][j]);
   r.positions.resize(3 * V);
   for (size_t v = 0; v < V; ++v) {
-    int64_t d[2][3];
-    plain_at(v, r.damping, d[0]);
-    if (r.plane) lifted(gate_of(v), d[0], d[1]);
-    for (int i = 0; i < 3; ++i) r.positions[3 * v + i] = zigzag(d[r.plane][i]);
+    int64_t e[3];
+    residuals_at(v, r.damping, r.multi, r.plane, e);
+    for (int i = 0; i < 3; ++i) r.positions[3 * v + i] = zigzag(e[i]);
   }
   if (g.mesh->has_normals()) {
     // Kept across nodes: decode_positions overwrites the first V; predicted_normals reads one past them
@@ -243,6 +295,7 @@ std::vector<uint8_t> write_predictive_node(const NodeHeader& header, const Predi
   ByteWriter w;
   NodeHeader h = header;
   if (r.plane) h.flags |= kPlanePrediction;
+  if (r.multi) h.flags |= kMultiParallelogram;
   h.write(w);
   w.u8(static_cast<uint8_t>(r.position_bytes | r.smooth_normals << 3 | r.normal_bytes << 4 |
                             (4 - r.damping) << 6));
@@ -259,7 +312,8 @@ std::vector<uint8_t> write_predictive_node(const NodeHeader& header, const Predi
 }
 
 void decode_predicted_vertices(const PredictiveNode& p, std::span<const uint32_t> predictors,
-                               const PositionGrid& grid, DecodedNode& out, const std::string& where) {
+                               const Parallelograms* extra, const PositionGrid& grid, DecodedNode& out,
+                               const std::string& where) {
   const uint32_t V = p.vertices;
   Mesh& m = out.mesh;
   const LockedStream locked = LockedStream::parse(p.locked_stream, V, p.shift, where);
@@ -275,9 +329,9 @@ void decode_predicted_vertices(const PredictiveNode& p, std::span<const uint32_t
   read_planes(p.position_planes.data(), V, 3, p.position_bytes, residual.data());
   const bool plane = p.flags & kPlanePrediction;
   const bool out_of_range =
-      p.damping == 4   ? predict_positions<4>(plane, residual.data(), V, predictors.data(), cu)
-      : p.damping == 3 ? predict_positions<3>(plane, residual.data(), V, predictors.data(), cu)
-                       : predict_positions<2>(plane, residual.data(), V, predictors.data(), cu);
+      p.damping == 4   ? predict_positions<4>(plane, residual.data(), V, predictors.data(), extra, cu)
+      : p.damping == 3 ? predict_positions<3>(plane, residual.data(), V, predictors.data(), extra, cu)
+                       : predict_positions<2>(plane, residual.data(), V, predictors.data(), extra, cu);
   if (out_of_range) throw Error(where + ": predicted position out of the grid's range");
   // Decoded into scratch and copied (no zero-fill of m.positions first); one spare entry for
   // predicted_normals.

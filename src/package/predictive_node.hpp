@@ -36,6 +36,20 @@
 //   1,336.8 M (+9.4 %: the plane prediction +59 M, the residual coder +58 M as more pages' positions take
 //   a coded form), refined_elephant 70.9 -> 78.2 M (+10.4 %); without the split form elephant_1m 1,282.5 M
 //   (+5.0 %) for 3,709,001 B instead of 3,599,331.
+// Multi-parallelogram prediction (kMultiParallelogram, codec 3 only; Cohen-Or, Cohen & Irony 2002,
+//   "Multi-way geometry encoding", and Draco's "multi-parallelogram" prediction): the connectivity is decoded
+//   before the positions, so the traversal can give vertex v a second parallelogram (x, y, p) across another
+//   edge whose two triangles it joins, every corner below v (traversal_connectivity.hpp, Parallelograms; the
+//   gate itself when there is none). P is then the average of the two damped parallelograms, in integers
+//   floor((sum over both of (4 + j)(c[x] + c[y]) - 2j c[p]) + 8) / 16), and the plane prediction's normal
+//   the sum of both triangles' normals. The encoder takes it, with the j and plane choice, when it saves at
+//   least 3/4 bit a vertex (predictive_node.cpp: it costs the decoder about 110 instructions a vertex).
+//   Measured offline before building it (refined_elephant, residual symbols' order-0 entropy per vertex,
+//   the average of every parallelogram the whole mesh offers): level 0 14.02 -> 12.40 bits, levels >= 1
+//   21.65 -> 20.89; the traversal's second parallelogram alone takes refined_elephant to 259,949 B (all
+//   three further ones found: 258,969), with the threshold 261,306 (-3.6 %; positions at level 0 0.95 ->
+//   0.86 B a stored triangle after zstd). `bench decode --runs 1` (callgrind): refined_elephant 91.1 ->
+//   96.3 M instructions, elephant_1m (no node takes it) 1,188.9 -> 1,185.7 M.
 // Normals: predicted from the decoded positions, plain or smoothed (predicted_normals.hpp).
 #pragma once
 
@@ -46,11 +60,14 @@
 
 #include "package/coarse_positions.hpp"
 #include "package/node_header.hpp"
+#include "package/traversal_connectivity.hpp"
 
 namespace lodstream::package {
 
 // Header flag (node_header.hpp) of a node whose positions use the plane prediction (above).
 constexpr uint32_t kPlanePrediction = 16;
+// Header flag of a node whose positions use the multi-parallelogram prediction (above; codec 3 only).
+constexpr uint32_t kMultiParallelogram = 128;
 
 struct PredictiveNode : NodeHeader {
   uint32_t position_bytes = 0, normal_bytes = 0;
@@ -79,11 +96,13 @@ struct PredictiveResiduals {
   uint32_t position_bytes = 0, normal_bytes = 0;
   uint32_t damping = 4;  // j
   bool plane = false;    // kPlanePrediction
+  bool multi = false;    // kMultiParallelogram
   bool smooth_normals = false;
 };
 PredictiveResiduals predictive_residuals(const NodeGeometry& geometry, const QuantizedNode& node,
                                          std::span<const uint32_t> predictors,
-                                         std::span<const uint32_t> indices,
+                                         std::span<const uint32_t> multi_predictors,
+                                         const Parallelograms* extra, std::span<const uint32_t> indices,
                                          std::span<const uint8_t> locked_stream, const PositionGrid& grid);
 std::vector<uint8_t> write_predictive_node(const NodeHeader& header, const PredictiveResiduals& residuals,
                                            std::span<const uint8_t> attribute_stream,
@@ -96,6 +115,7 @@ std::vector<uint8_t> write_predictive_node(const NodeHeader& header, const Predi
 // index entries below V + 1 only). Throws lodstream::Error starting with `where` on positions off the grid's
 // range. Cost: O(T + V).
 void decode_predicted_vertices(const PredictiveNode& node, std::span<const uint32_t> predictors,
-                               const PositionGrid& grid, DecodedNode& out, const std::string& where);
+                               const Parallelograms* extra, const PositionGrid& grid, DecodedNode& out,
+                               const std::string& where);
 
 }  // namespace lodstream::package

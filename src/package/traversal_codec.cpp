@@ -15,7 +15,7 @@ namespace {
 constexpr uint8_t kFormat = 2;
 constexpr uint8_t kOrderedFormat = 1;  // codec 2's bytes
 constexpr uint32_t kAllFlags =
-    kHasNormals | kHasUvs | kHasColors | kHasVertexData | kClusters | kPlanePrediction;
+    kHasNormals | kHasUvs | kHasColors | kHasVertexData | kClusters | kPlanePrediction | kMultiParallelogram;
 
 const PredictiveCodec& ordered_codec() {
   static const PredictiveCodec codec;
@@ -47,10 +47,16 @@ std::vector<uint8_t> TraversalCodec::encode(const NodeGeometry& g, const Positio
   n.indices = std::move(code.indices);
   quantize_positions(in_order, grid, n);
   const std::vector<uint8_t> locked_stream = encode_locked_stream(n, g.position_shift);
-  return write_predictive_node(NodeHeader::of(kFormat, flags, g, n),
-                               predictive_residuals(g, n, code.predictors, n.indices, locked_stream, grid),
-                               encode_attribute_stream(flags, g, n), locked_stream, code.symbols,
-                               code.references);
+  // The multi-parallelogram predictors as the decoder will find them: from the decoder's own traversal.
+  const uint32_t T = uint32_t(n.indices.size() / 3);
+  std::vector<uint32_t> indices(n.indices.size()), predictors(3 * (size_t(V) + 1));
+  Parallelograms extra;
+  decode_traversal(code.symbols, code.references, T, V, indices.data(), predictors.data(), "node codec",
+                   g.cluster_triangles, &extra);
+  return write_predictive_node(
+      NodeHeader::of(kFormat, flags, g, n),
+      predictive_residuals(g, n, code.predictors, predictors, &extra, n.indices, locked_stream, grid),
+      encode_attribute_stream(flags, g, n), locked_stream, code.symbols, code.references);
 }
 
 DecodedNode TraversalCodec::decode(std::span<const uint8_t> bytes, const PositionGrid& grid,
@@ -75,9 +81,11 @@ void TraversalCodec::decode_into(std::span<const uint8_t> bytes, const PositionG
   out.mesh.indices.resize(3 * size_t(p.triangles));  // zero-fills only beyond the size it had
   thread_local std::vector<uint32_t> predictors;
   predictors.resize(3 * (size_t(V) + 1));
+  thread_local Parallelograms extra;
+  Parallelograms* const multi = p.flags & kMultiParallelogram ? &extra : nullptr;
   decode_traversal(p.connectivity, p.tail, p.triangles, V, out.mesh.indices.data(), predictors.data(), where,
-                   p.cluster_triangles);
-  decode_predicted_vertices(p, predictors, grid, out, where);
+                   p.cluster_triangles, multi);
+  decode_predicted_vertices(p, predictors, multi, grid, out, where);
   out.cluster_triangles = p.cluster_triangles;
 }
 

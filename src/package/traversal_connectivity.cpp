@@ -1,5 +1,6 @@
 #include "package/traversal_connectivity.hpp"
 
+#include <algorithm>
 #include <array>
 
 #include "core/error.hpp"
@@ -249,9 +250,14 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
   return code;
 }
 
-void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t> references, uint32_t T,
-                      uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where,
-                      std::span<const uint32_t> cluster_triangles) {
+namespace {
+
+// decode_traversal, with the further parallelograms when `multi` (a template constant: none of their work
+// without them).
+template <bool multi>
+void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> references, uint32_t T,
+                    uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where,
+                    std::span<const uint32_t> cluster_triangles, Parallelograms* extra) {
   ByteReader refs(references, where);
   auto fail = [&](const char* what) { throw Error(where + ": corrupted connectivity (" + what + ")"); };
   thread_local std::vector<Front::Edge> edges;
@@ -282,6 +288,22 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
     out[0] = v0, out[1] = v1, out[2] = v2;
     out += 3;
   };
+  // The parallelogram of edge x -> y of triangle (x, y, u) joined to triangle (y, x, w), as the triangle of
+  // the smaller of u and w in its winding (traversal_connectivity.hpp).
+  auto join = [&](uint32_t x, uint32_t y, uint32_t u, uint32_t w) {
+    if (u > w) std::swap(x, y), std::swap(u, w);  // (x, y, u) the triangle of the smaller
+    if (w <= std::max(x, y) || u == w) return;
+    uint32_t* to = predictors + 3 * size_t(w);
+    if (to[0] != to[1]) {  // not single: the second parallelogram, unless found
+      if (extra->found[w]) return;
+      extra->found[w] = 1, to = &extra->corners[3 * size_t(w)];
+    }
+    to[0] = x, to[1] = y, to[2] = u;
+  };
+  if constexpr (multi) {
+    extra->found.assign(V, 0);
+    extra->corners.resize(3 * size_t(V));
+  }
   uint32_t e = 0;  // the gate
   for (uint32_t left = T; left > 0;) {
     e = front.gate(e);
@@ -335,16 +357,19 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
         case kLeft:
           c = front.left(e);
           if (c == kNone) fail("left turn in a loop of 2");
+          if constexpr (multi) join(c, a, front.edge(g.prev).o, b);  // P = c -> a
           front.close_left(e, k);
           break;
         case kRight:
           c = front.right(e);
           if (c == kNone) fail("right turn in a loop of 2");
+          if constexpr (multi) join(b, c, front.edge(g.next).o, a);  // N = b -> c
           front.close_right(e, k);
           break;
         case kEnd:
           if (!front.closes(e)) fail("end of a loop that is not 3 edges");
           c = front.left(e);
+          if constexpr (multi) join(c, a, front.edge(g.prev).o, b), join(b, c, front.edge(g.next).o, a);
           front.close_loop(e);
           break;
         case kSplit: {
@@ -360,6 +385,7 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
         default:
           fail("unknown symbol");
       }
+      if constexpr (multi) join(a, b, g.o, c);  // the gate
     }
     emit(b, a, c, k);
     --left;
@@ -371,6 +397,20 @@ void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t>
     const uint32_t from = next > 0 ? next - 1 : V;
     predictors[3 * next] = predictors[3 * next + 1] = predictors[3 * next + 2] = from;
   }
+  if constexpr (multi)
+    for (uint32_t v = 0; v < V; ++v)
+      if (!extra->found[v]) std::copy_n(predictors + 3 * size_t(v), 3, &extra->corners[3 * size_t(v)]);
+}
+
+}  // namespace
+
+void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t> references, uint32_t T,
+                      uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where,
+                      std::span<const uint32_t> cluster_triangles, Parallelograms* extra) {
+  if (extra)
+    decode_symbols<true>(symbols, references, T, V, indices, predictors, where, cluster_triangles, extra);
+  else
+    decode_symbols<false>(symbols, references, T, V, indices, predictors, where, cluster_triangles, nullptr);
 }
 
 }  // namespace lodstream::package

@@ -72,13 +72,27 @@ struct TraversalCode {
 TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
                                std::span<const uint32_t> cluster_triangles = {});
 
+// The second parallelogram of the multi-parallelogram prediction (predictive_node.hpp), which the decoder
+// learns as it joins triangles: an edge x -> y of triangle (x, y, p) whose other triangle (y, x, q) the
+// traversal joins to it (the gate of a kLeft, kRight, kEnd or kSplit, and the loop edge P or N that a kLeft,
+// kRight or kEnd closes), with p < q and x, y < q, gives vertex q the parallelogram (x, y, p): c[q] ~ c[x] +
+// c[y] - c[p], its corners decoded before q and in the winding of their triangle (the gates of kVertex are
+// the predictors themselves). A vertex whose predictor is single (x, x, x: a piece start's) takes its first
+// such parallelogram as its predictors instead; the first (next) one found is its second parallelogram, the
+// rest are dropped; a vertex without one has its predictors as its second.
+struct Parallelograms {
+  std::vector<uint32_t> corners;  // per vertex (x, y, p)
+  std::vector<uint8_t> found;     // per vertex: the second found (the decoder's scratch)
+};
+
 // Decodes T triangles of V vertices into indices (3T entries) and predictors (3V entries, as
 // TraversalCode's), a record's with the encoder's `cluster_triangles` (which must add up to T, each at least
 // 1, at most 31: the caller checks; the decoded triangles of each cluster then form its range); every
 // symbol, reference, cluster and vertex count is checked: corrupted streams throw lodstream::Error starting
-// with `where`. Cost: O(T + V), one pass over the symbols.
+// with `where`. With `extra`, also the second parallelograms above (the predictors of single-predictor
+// vertices replaced as said). Cost: O(T + V), one pass over the symbols.
 void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t> references, uint32_t T,
                       uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where,
-                      std::span<const uint32_t> cluster_triangles = {});
+                      std::span<const uint32_t> cluster_triangles = {}, Parallelograms* extra = nullptr);
 
 }  // namespace lodstream::package

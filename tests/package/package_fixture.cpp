@@ -11,6 +11,11 @@
 #include "package/records.hpp"
 #include "support/shapes.hpp"
 
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
 namespace lodstream::test {
 
 using namespace package;
@@ -154,6 +159,25 @@ TestPackage write_test_package(const std::filesystem::path& file, uint32_t codec
   t.root_nodes = 3;
   t.written = writer.finish(t.scene, t.records, t.root_nodes);
   return t;
+}
+
+Mesh slid_sphere(uint32_t seed) {
+  Mesh m = uv_sphere(1.0f, 24, 32);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> d(-0.03f, 0.03f);
+  for (glm::vec3& p : m.positions) {
+    const glm::vec3 n = glm::normalize(p), move(d(rng), d(rng), d(rng));
+    p = glm::normalize(p + move - glm::dot(move, n) * n);
+  }
+  return m;
+}
+
+void expect_near_input(const Mesh& decoded, const Mesh& input, float distance) {
+  for (const glm::vec3& p : decoded.positions) {
+    float nearest = INFINITY;
+    for (const glm::vec3& q : input.positions) nearest = std::min(nearest, glm::length(p - q));
+    EXPECT_LE(nearest, distance);
+  }
 }
 
 }  // namespace lodstream::test

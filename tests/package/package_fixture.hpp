@@ -35,4 +35,11 @@ TestPackage write_test_package(const std::filesystem::path& file,
 std::vector<Mesh> split_into_chunks(const Mesh& mesh, size_t triangles,
                                     std::vector<std::vector<uint8_t>>& locked);
 
+// A UV sphere (24 rings, 32 segments) whose vertices are moved along the surface by up to a third of an edge
+// (random, from `seed`): irregular, but smooth, like a coarse level's clusters.
+Mesh slid_sphere(uint32_t seed);
+
+// Expects every position of `decoded` within `distance` of some position of `input` (a codec may reorder).
+void expect_near_input(const Mesh& decoded, const Mesh& input, float distance);
+
 }  // namespace lodstream::test

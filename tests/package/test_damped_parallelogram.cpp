@@ -11,6 +11,7 @@
 #include "package/predictive_codec.hpp"
 #include "package/predictive_node.hpp"
 #include "package/traversal_codec.hpp"
+#include "package_fixture.hpp"
 #include "support/shapes.hpp"
 
 namespace lodstream::test {
@@ -28,7 +29,7 @@ Mesh jittered_grid(int n, uint32_t seed) {
 }
 
 uint32_t damping_of(std::span<const uint8_t> node, uint8_t format) {
-  return PredictiveNode::parse(node, format, 15 | kPlanePrediction, "node").damping;
+  return PredictiveNode::parse(node, format, 15 | kPlanePrediction | kMultiParallelogram, "node").damping;
 }
 
 class DampedParallelogram : public ::testing::TestWithParam<uint32_t> {};
@@ -53,11 +54,7 @@ TEST_P(DampedParallelogram, EveryDampingDecodesToTheQuantizedPositions) {
     const DecodedNode d = codec.decode(node, pg, "node");
     ASSERT_EQ(d.mesh.vertex_count(), m.vertex_count());
     // Every decoded position is a grid point within half a step of some input vertex (the codec reorders).
-    for (const glm::vec3& p : d.mesh.positions) {
-      float nearest = INFINITY;
-      for (const glm::vec3& q : m.positions) nearest = std::min(nearest, glm::length(p - q));
-      EXPECT_LE(nearest, 0.87f * pg.step);
-    }
+    expect_near_input(d.mesh, m, 0.87f * pg.step);
   }
   EXPECT_TRUE(plain);   // the regular grid: the plain parallelogram is exact
   EXPECT_TRUE(damped);  // the jittered grids predict better damped
@@ -71,7 +68,7 @@ TEST(DampedParallelogram, AnInvalidDampingIsAnError) {
   const NodeCodec& codec = node_codec(TraversalCodec::kId);
   std::vector<uint8_t> node = codec.encode(g, pg);
   ByteReader r(node, "node");
-  NodeHeader::read(r, 2, 15 | kPlanePrediction, node.size());
+  NodeHeader::read(r, 2, 15 | kPlanePrediction | kMultiParallelogram, node.size());
   const size_t at = r.position();  // the widths byte follows the common header
   ASSERT_EQ(node[at] >> 6, 4 - damping_of(node, 2));
   node[at] |= 3 << 6;  // j = 1
