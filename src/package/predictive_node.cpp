@@ -221,22 +221,22 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
   // the larger j, no plane, no multi): one pass counts all twelve (the gate's plane does not depend on j),
   // then the choice's residuals.
   const uint64_t* cu = reinterpret_cast<const uint64_t*>(c.data());
-  // Vertex v's residuals at damping j, plain (d), and on the plane of its gate (e: components (d - offset,
-  // d + 1, d + 2) of its dominant axis d).
-  auto residuals_at = [&](size_t v, uint32_t j, bool multi, bool plane, int64_t(&e)[3]) {
-    const uint32_t* o = &(multi ? multi_predictors : predictors)[3 * v];
+  // Vertex v's predictors and second parallelogram (its predictors again without the multi prediction:
+  // averaged_parallelogram is then the gate's).
+  auto corners = [&](size_t v, bool multi, const uint32_t*& o, const uint32_t*& more) {
+    o = &(multi ? multi_predictors : predictors)[3 * v];
+    more = multi ? extra->corners.data() + 3 * v : o;
+  };
+  // Vertex v's residuals at damping j, plain (d), and lifted onto the plane of `gate` (e: components (d -
+  // offset, d + 1, d + 2) of its dominant axis d).
+  auto plain_at = [&](size_t v, uint32_t j, const uint32_t* o, const uint32_t* more, int64_t(&d)[3]) {
     uint64_t p[3];
-    const uint32_t* more = multi ? extra->corners.data() + 3 * v : o;  // o twice: the gate's alone
     j == 4   ? averaged_parallelogram<4>(cu, o, more, p)
     : j == 3 ? averaged_parallelogram<3>(cu, o, more, p)
              : averaged_parallelogram<2>(cu, o, more, p);
-    int64_t d[3];
     for (int a = 0; a < 3; ++a) d[a] = c[3 * v + a] - int64_t(p[a]);
-    if (!plane) {
-      e[0] = d[0], e[1] = d[1], e[2] = d[2];
-      return;
-    }
-    const PlaneGate gate(cu, o, more);
+  };
+  auto lifted = [](const PlaneGate& gate, const int64_t(&d)[3], int64_t(&e)[3]) {
     const uint32_t k = gate.d, a = k == 2 ? 0 : k + 1, b = k == 0 ? 2 : k - 1;
     e[0] = d[k] - gate.offset(d[a], d[b]), e[1] = d[a], e[2] = d[b];
   };
@@ -244,16 +244,21 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
   uint64_t bits[2][2][5] = {}, high[2][2][5] = {};
   const int multis = extra ? 2 : 1;
   for (size_t v = 0; v < V; ++v)
-    for (int multi = 0; multi < multis; ++multi)
-      for (uint32_t j = 2; j <= 4; ++j)
-        for (int plane = 0; plane < 2; ++plane) {
-          int64_t e[3];
-          residuals_at(v, j, multi, plane, e);
+    for (int multi = 0; multi < multis; ++multi) {
+      const uint32_t *o, *more;
+      corners(v, multi, o, more);
+      const PlaneGate gate(cu, o, more);  // the same for every j
+      for (uint32_t j = 2; j <= 4; ++j) {
+        int64_t d[2][3];
+        plain_at(v, j, o, more, d[0]);
+        lifted(gate, d[0], d[1]);
+        for (int plane = 0; plane < 2; ++plane)
           for (int i = 0; i < 3; ++i) {
-            const uint64_t z = zigzag(e[i]);
+            const uint64_t z = zigzag(d[plane][i]);
             bits[multi][plane][j] += residual_bits(z), high[multi][plane][j] |= z;
           }
-        }
+      }
+    }
   // The multi-parallelogram prediction must save kMultiMinSavedBits quarter bits a vertex (its decode cost).
   uint64_t fewest = UINT64_MAX;
   for (int multi = 0; multi < multis; ++multi)
@@ -264,9 +269,12 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
           r.position_bytes = bytes_for(high[multi][plane][j]);
   r.positions.resize(3 * V);
   for (size_t v = 0; v < V; ++v) {
-    int64_t e[3];
-    residuals_at(v, r.damping, r.multi, r.plane, e);
-    for (int i = 0; i < 3; ++i) r.positions[3 * v + i] = zigzag(e[i]);
+    const uint32_t *o, *more;
+    corners(v, r.multi, o, more);
+    int64_t d[2][3];
+    plain_at(v, r.damping, o, more, d[0]);
+    if (r.plane) lifted(PlaneGate(cu, o, more), d[0], d[1]);
+    for (int i = 0; i < 3; ++i) r.positions[3 * v + i] = zigzag(d[r.plane][i]);
   }
   if (g.mesh->has_normals()) {
     // Kept across nodes: decode_positions overwrites the first V; predicted_normals reads one past them
