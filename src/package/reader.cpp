@@ -146,16 +146,29 @@ const NodeRecord& PackageReader::node(uint32_t id) {
 }
 
 std::vector<uint8_t> PackageReader::unpack_page(uint32_t page, std::span<const uint8_t> stored) const {
+  std::vector<uint8_t> out;
+  unpack_page(page, stored, out);
+  return out;
+}
+
+std::span<const uint8_t> PackageReader::unpack_page(uint32_t page, std::span<const uint8_t> stored,
+                                                    std::vector<uint8_t>& buffer) const {
   if (page >= root_.pages.size()) throw Error(where("page " + std::to_string(page) + " does not exist"));
   const Range& range = root_.pages[page];
   const std::string what = "page " + std::to_string(page);
   check_stored(range, stored, what);
-  return decompress_page(stored, range.raw_size, *codec_, where(what));
+  return decompress_page(stored, range.raw_size, *codec_, where(what), buffer);
 }
 
 std::vector<uint8_t> PackageReader::read_page(uint32_t page) const {
+  std::vector<uint8_t> out;
+  read_page(page, out);
+  return out;
+}
+
+std::span<const uint8_t> PackageReader::read_page(uint32_t page, std::vector<uint8_t>& buffer) const {
   if (page >= root_.pages.size()) throw Error(where("page " + std::to_string(page) + " does not exist"));
-  return unpack_page(page, read_range(root_.pages[page], "page"));
+  return unpack_page(page, read_range(root_.pages[page], "page"), buffer);
 }
 
 std::span<const uint8_t> PackageReader::node_bytes(uint32_t id, std::span<const uint8_t> page) {
@@ -241,8 +254,9 @@ void PackageReader::verify_contents() {
   }
   std::vector<std::vector<uint32_t>> nodes_of_page(root_.pages.size());
   for (uint32_t id = 0; id < root_.node_count; ++id) nodes_of_page[node(id).page].push_back(id);
+  std::vector<uint8_t> buffer;  // one for every page
   for (uint32_t page = 0; page < root_.pages.size(); ++page) {
-    std::vector<uint8_t> raw = read_page(page);
+    const std::span<const uint8_t> raw = read_page(page, buffer);
     for (uint32_t id : nodes_of_page[page]) {
       if (node(id).encoding == NodeEncoding::codec) decode_node(id, raw);
     }
