@@ -1,5 +1,6 @@
 #include "package/bytes.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -85,6 +86,23 @@ float ByteReader::finite_f32(const char* what) {
   return v;
 }
 uint64_t ByteReader::varint() {
+  // The bytes at hand read without a check each (every varint of a valid stream ends within them); a varint
+  // that does not is read again by varint_checked, for its error. A byte at a time through take() cost ~90
+  // instructions a varint (the error message's set-up in every call): elephant_1m's bench decode -7 M
+  // instructions (callgrind), the parse of its index pages 58.9 -> 48.1 M.
+  const uint8_t* p = data_.data() + pos_;
+  const size_t n = std::min<size_t>(remaining(), 10);
+  uint64_t v = 0;
+  for (size_t i = 0; i < n; ++i) {
+    v |= static_cast<uint64_t>(p[i] & 0x7f) << (7 * i);
+    if (!(p[i] & 0x80)) {
+      pos_ += i + 1;
+      return v;
+    }
+  }
+  return varint_checked();
+}
+uint64_t ByteReader::varint_checked() {
   uint64_t v = 0;
   for (int shift = 0; shift < 64; shift += 7) {
     uint8_t b = *take(1, "varint");

@@ -75,6 +75,8 @@ class ByteReader {
 
  private:
   const uint8_t* take(size_t n, const char* what);
+  // varint() a byte at a time, each checked: the error of a truncated or overlong varint.
+  [[gnu::noinline, gnu::cold]] uint64_t varint_checked();
 
   std::span<const uint8_t> data_;
   std::string_view context_;

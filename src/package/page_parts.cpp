@@ -181,17 +181,26 @@ std::vector<uint8_t> compress_page(std::span<const uint8_t> page, std::span<cons
 
 std::vector<uint8_t> decompress_page(std::span<const uint8_t> stored, uint32_t raw_size,
                                      const NodeCodec& codec, const std::string& where) {
+  std::vector<uint8_t> page;
+  decompress_page(stored, raw_size, codec, where, page);
+  return page;
+}
+
+std::span<const uint8_t> decompress_page(std::span<const uint8_t> stored, uint32_t raw_size,
+                                         const NodeCodec& codec, const std::string& where,
+                                         std::vector<uint8_t>& buffer) {
   const uint64_t declared = zstd_declared_size(stored, 2 * uint64_t(raw_size) + 64, where);
-  if (declared == raw_size) {  // stored whole
-    std::vector<uint8_t> page(raw_size);
+  if (buffer.size() < raw_size) buffer.resize(raw_size);
+  const std::span<uint8_t> page(buffer.data(), raw_size);  // every byte written below (or an error thrown)
+  if (declared == raw_size) {                              // stored whole
     zstd_decompress_to(stored, page, where);
     return page;
   }
   // The regrouped bytes, in a buffer kept across pages: allocated (and cleared) once, not per page.
-  thread_local std::vector<uint8_t> buffer;
-  if (buffer.size() < declared) buffer.resize(declared);
-  const std::span<const uint8_t> content(buffer.data(), declared);
-  zstd_decompress_to(stored, std::span(buffer).first(declared), where);
+  thread_local std::vector<uint8_t> regrouped;
+  if (regrouped.size() < declared) regrouped.resize(declared);
+  const std::span<const uint8_t> content(regrouped.data(), declared);
+  zstd_decompress_to(stored, std::span(regrouped).first(declared), where);
   ByteReader r(content, where);
   std::array<std::span<const uint8_t>, kParts> stream;
   std::array<uint64_t, kParts> size;
@@ -231,7 +240,6 @@ std::vector<uint8_t> decompress_page(std::span<const uint8_t> stored, uint32_t r
       position_rest(split_rest, where),
       normals(coded[kNormals] ? stream[kNormals] : std::span<const uint8_t>(), where);
   SymbolDecoder symbols(coded[kConnectivity] ? stream[kConnectivity] : std::span<const uint8_t>(), where);
-  std::vector<uint8_t> page(raw_size);
   std::array<size_t, kParts> used{};  // bytes of each stream consumed
   ByteReader headers(stream[0], where);
   size_t at = 0;

@@ -47,10 +47,17 @@ class PackageReader {
   // Installs index page `page` from bytes received some other way (a push stream): checked like a read.
   void add_index_page(uint32_t page, std::span<const uint8_t> stored);
 
-  // Data page `page`, read, checked and decompressed.
+  // Data page `page`, read (into a per-thread buffer kept at the largest page read), checked and
+  // decompressed.
   std::vector<uint8_t> read_page(uint32_t page) const;
+  // The same into `buffer` (grown when smaller, never shrunk): returns its first bytes, the page. A buffer
+  // kept across pages is allocated and zero-filled once (decompress_page), for a caller done with each page
+  // before the next.
+  std::span<const uint8_t> read_page(uint32_t page, std::vector<uint8_t>& buffer) const;
   // Checks and decompresses data page `page`'s stored bytes received some other way.
   std::vector<uint8_t> unpack_page(uint32_t page, std::span<const uint8_t> stored) const;
+  std::span<const uint8_t> unpack_page(uint32_t page, std::span<const uint8_t> stored,
+                                       std::vector<uint8_t>& buffer) const;
   // Node `id`'s bytes inside its decompressed page.
   std::span<const uint8_t> node_bytes(uint32_t id, std::span<const uint8_t> page);
   // Decodes codec node `id` from its decompressed page and checks the result against the node's record

@@ -19,6 +19,20 @@ void gather(const std::vector<T>& from, std::span<const uint32_t> order, std::ve
   to.assign(values.begin(), values.end());
 }
 
+// gather of positions and normals in one pass over `order`, into per-thread buffers then copied out (a
+// std::vector cannot be sized without value-initialising it): ~9 instructions a vertex for both plus the
+// copies, where two gathers took ~16 (elephant_1m's bench decode: extract_cluster 157.4 -> 149.8 M).
+// Cost: O(order.size()).
+void gather_positions_normals(const Mesh& in, std::span<const uint32_t> order, Mesh& m) {
+  thread_local std::vector<glm::vec3> positions, normals;
+  if (positions.size() < order.size()) positions.resize(order.size()), normals.resize(order.size());
+  const glm::vec3 *p = in.positions.data(), *q = in.normals.data();
+  glm::vec3 *to_p = positions.data(), *to_q = normals.data();
+  for (size_t k = 0; k < order.size(); ++k) to_p[k] = p[order[k]], to_q[k] = q[order[k]];
+  m.positions.assign(to_p, to_p + order.size());
+  m.normals.assign(to_q, to_q + order.size());
+}
+
 }  // namespace
 
 RecordMesh weld_record(std::span<const Mesh* const> clusters,
@@ -130,8 +144,11 @@ DecodedNode extract_cluster(const DecodedNode& record, uint32_t cluster, const s
     renumber(corners[i]), renumber(corners[i + 1]), renumber(corners[i + 2]);
   for (size_t k = 0; k < n; ++k) map[first_use[k]] = UINT32_MAX;  // before anything may throw
   const std::span<const uint32_t> order(first_use, n);
-  gather(in.positions, order, m.positions);
-  if (in.has_normals()) gather(in.normals, order, m.normals);
+  if (in.has_normals()) {
+    gather_positions_normals(in, order, m);
+  } else {
+    gather(in.positions, order, m.positions);
+  }
   if (in.has_uvs()) gather(in.uvs, order, m.uvs);
   if (in.has_colors()) gather(in.colors, order, m.colors);
   if (!record.vertex_data.empty()) gather(record.vertex_data, order, out.vertex_data);

@@ -296,7 +296,8 @@ TEST_P(Corruption, CorruptedPagesReceivedFromElsewhereAreErrorsOrValidMeshes) {
   reader.source().read(reader.root().pages[0].offset, stored);
   stored[stored.size() / 2] ^= 1;
   EXPECT_THROW(reader.unpack_page(0, stored), Error);
-  // Decoded page bytes (past the checksum) flipped everywhere: the codec's own checks hold.
+  // Decoded page bytes (past the checksum) flipped everywhere: the codec's own checks hold, and an error
+  // names the file, the node and its page.
   for (size_t at = 0; at < page.size(); ++at) {
     std::vector<uint8_t> bad = page;
     bad[at] ^= 0x5a;
@@ -304,7 +305,9 @@ TEST_P(Corruption, CorruptedPagesReceivedFromElsewhereAreErrorsOrValidMeshes) {
       try {
         DecodedNode d = reader.decode_node(id, bad);
         for (uint32_t i : d.mesh.indices) ASSERT_LT(i, d.mesh.vertex_count());
-      } catch (const Error&) {
+      } catch (const Error& e) {
+        const std::string context = reader.source().name() + ": node " + std::to_string(id) + " (page 0)";
+        ASSERT_EQ(std::string(e.what()).rfind(context, 0), 0u) << e.what();
       }
     }
   }

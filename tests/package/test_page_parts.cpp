@@ -131,6 +131,52 @@ TEST(PageParts, NoisyResidualsAreStoredCodedAndSmaller) {
   }
 }
 
+// Into a kept buffer: the page is its first raw-size bytes whatever it held before (a larger page's bytes
+// here), it grows when smaller and never shrinks, for both forms (by part, and whole).
+TEST_P(PageParts, AKeptBufferTakesPagesOfAnySize) {
+  const NodeCodec& codec = node_codec(GetParam());
+  const Page page = sphere_page(codec);
+  const uint32_t raw_size = uint32_t(page.bytes.size());
+  const std::vector<uint8_t> by_part = compress_page(page.bytes, page.node_sizes, codec, 9, 6);
+  const std::vector<uint8_t> whole = zstd_compress(page.bytes, 1);
+  for (const std::vector<uint8_t>* stored : {&by_part, &whole}) {
+    std::vector<uint8_t> buffer(raw_size + 100, 0xab);
+    std::span<const uint8_t> out = decompress_page(*stored, raw_size, codec, "page", buffer);
+    EXPECT_EQ(out.data(), buffer.data());
+    EXPECT_EQ(std::vector<uint8_t>(out.begin(), out.end()), page.bytes);
+    EXPECT_EQ(buffer.size(), raw_size + 100);
+    buffer.resize(10);
+    out = decompress_page(*stored, raw_size, codec, "page", buffer);
+    EXPECT_EQ(std::vector<uint8_t>(out.begin(), out.end()), page.bytes);
+    EXPECT_EQ(buffer.size(), raw_size);
+  }
+}
+
+// ByteReader::varint reads the bytes at hand without a check each: a varint that ends within them reads as
+// it did byte by byte, and one truncated or longer than 10 bytes is still an error naming its position.
+TEST(PageParts, VarintsReadAtOnceKeepTheirErrors) {
+  std::vector<uint8_t> bytes;
+  for (uint64_t v : {uint64_t(0), uint64_t(127), uint64_t(128), uint64_t(300), UINT64_MAX}) {
+    for (; v >= 0x80; v >>= 7) bytes.push_back(uint8_t(v | 0x80));
+    bytes.push_back(uint8_t(v));
+  }
+  ByteReader r(bytes, "varints");
+  for (uint64_t v : {uint64_t(0), uint64_t(127), uint64_t(128), uint64_t(300), UINT64_MAX})
+    EXPECT_EQ(r.varint(), v);
+  EXPECT_TRUE(r.at_end());
+  auto error_of = [](const std::vector<uint8_t>& b) {
+    ByteReader x(b, "stream");
+    try {
+      x.varint();
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(error_of({0x80, 0x80}), "stream at byte 2: truncated varint (1 bytes needed, 0 left)");
+  EXPECT_EQ(error_of(std::vector<uint8_t>(11, 0x80)), "stream at byte 10: varint longer than 10 bytes");
+}
+
 TEST(PageParts, PagesOfNonCodecBytesAreStoredWhole) {
   std::vector<uint8_t> bytes(3000);
   for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = uint8_t(i * 7 % 251);
