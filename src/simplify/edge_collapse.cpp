@@ -27,12 +27,12 @@
 namespace lodstream::simplify {
 namespace {
 
-// The collapse's hot paths (place, try_collapse, vertical_bound) are compiled twice, for x86-64's baseline
+// The hot paths (place, try_collapse, vertical_bound, add_face) are compiled twice, for x86-64's baseline
 // and for AVX2, and the loader picks one for the machine (GCC's function multiversioning, an ifunc): with
-// AVX2 the double lanes take VEX three-operand forms (fewer register copies) and vertical_bound's crossing
-// test four lanes per step. AVX2 does not include FMA, so nothing is fused into a multiply-add and both
-// versions compute the same bits (12 simplify outputs cmp-identical). elephant_1m 0.1, whole command,
-// callgrind: 17,380 -> 16,920 M instructions.
+// AVX2 the float and double lanes take VEX three-operand forms (fewer register copies) and vertical_bound's
+// crossing test four lanes per step. AVX2 does not include FMA, so nothing is fused into a multiply-add and
+// both versions compute the same bits (12 simplify outputs and 4 bakes cmp-identical). elephant_1m 0.1,
+// whole command, callgrind: 17,380 -> 16,920 M instructions (the collapse), -> 16,597 M (add_face).
 #if defined(__x86_64__) && defined(__GNUC__)
 #define LODSTREAM_HOT_PATH __attribute__((target_clones("avx2", "default")))
 #else
@@ -626,8 +626,8 @@ class Simplifier {
   // here, with the face's quadric spilled for it (inlined, a refined_elephant bake's add_face calls take
   // 170.3 -> 156.3 M instructions; the same operations, so the same bits).
   template <int kChannels>
-  [[gnu::flatten]] void add_face(uint32_t f, uint32_t lo, uint32_t hi, const float* weighted,
-                                 AttributeTerm* gradient) {
+  [[gnu::flatten]] LODSTREAM_HOT_PATH void add_face(uint32_t f, uint32_t lo, uint32_t hi,
+                                                    const float* weighted, AttributeTerm* gradient) {
     const int channels = kChannels >= 0 ? kChannels : channels_;
     const uint32_t v0 = indices_[3 * size_t(f)], v1 = indices_[3 * size_t(f) + 1],
                    v2 = indices_[3 * size_t(f) + 2];
