@@ -36,8 +36,10 @@ namespace {
 // whole command, callgrind: 17,380 -> 16,920 M instructions (the collapse), -> 16,597 M (add_face).
 #if defined(__x86_64__) && defined(__GNUC__)
 #define LODSTREAM_HOT_PATH __attribute__((target_clones("avx2", "default")))
+#define LODSTREAM_RUNS_AVX2() __builtin_cpu_supports("avx2")  // the version the loader picks
 #else
 #define LODSTREAM_HOT_PATH
+#define LODSTREAM_RUNS_AVX2() false
 #endif
 
 constexpr uint32_t kNone = UINT32_MAX;
@@ -101,9 +103,55 @@ struct Corners {
   int last_moving;  // the last moving corner (every face has one: it holds a or b); a face that stays has one
   bool dies;
 };
-// What comparisons of WideLanes (quadric.hpp) give in vertical_bound's crossing tests: -1 where true, per
-// lane.
-using WideMask = int64_t __attribute__((vector_size(32)));
+// kLanes doubles (quadric.hpp), and what comparisons of them give: -1 where true, per lane.
+template <int kLanes>
+struct SpokeLanes;
+template <>
+struct SpokeLanes<2> {
+  using Doubles = Lanes;
+  using Mask = int64_t __attribute__((vector_size(16)));
+};
+template <>
+struct SpokeLanes<4> {
+  using Doubles = WideLanes;
+  using Mask = int64_t __attribute__((vector_size(32)));
+};
+// vertical_bound's division-free crossing tests for spokes [k0, k1) against one old edge (direction (dx, dy),
+// origin relative to x (rx, ry), both with the sign that makes sn positive): bit k - k0 set where den =
+// x dy - y dx > threshold and 0 < tn = rx y - ry x < den, with (x, y) = (spoke_x[k], spoke_y[k]). kLanes
+// spokes per step in vector lanes without branches (about 40 % of pairs pass the first test, at random: as
+// branches they were mostly mispredictions; one lane per step cost three times the instructions), each
+// lane's outcome kept as its spoke's bit in the lanes (bit k - k0 of lane (k - k0) % kLanes; moving the bits
+// to a scalar every step took 12 of its 36 instructions). The lanes compute what the scalar expressions
+// would, bit for bit. 4 lanes (one register) in vertical_bound's AVX2 version, 2 in the baseline's (GCC
+// lowers 4 lanes without AVX into scalar code: +1.3 G instructions on elephant_1m 0.1; in the AVX2 version
+// 2 lanes took 151 M more than 4; the whole command 16,134 -> 16,005 M with this
+// function, and 17,269 M for the baseline version alone, against 17,380 M before any AVX2). Reads spoke_x,
+// spoke_y up to the next multiple of kLanes above k1 - 1.
+template <int kLanes>
+[[gnu::always_inline]] inline uint64_t passing_spokes(const double* spoke_x, const double* spoke_y, size_t k0,
+                                                      size_t k1, double dx, double dy, double rx, double ry,
+                                                      double threshold) {
+  using Doubles = typename SpokeLanes<kLanes>::Doubles;
+  using Mask = typename SpokeLanes<kLanes>::Mask;
+  Mask passed{}, bit;  // bit: lane l's spoke in this step
+  if constexpr (kLanes == 4)
+    bit = Mask{1, 2, 4, 8};
+  else
+    bit = Mask{1, 2};
+  for (size_t k = k0; k < k1; k += kLanes, bit <<= kLanes) {
+    Doubles x, y;
+    std::memcpy(&x, &spoke_x[k], sizeof x), std::memcpy(&y, &spoke_y[k], sizeof y);
+    const Doubles den = x * dy - y * dx, tn = rx * y - ry * x;
+    // Each test selects the spokes' bits (as `cmp ? bit : 0`, GCC 12 keeps the masks in the vector
+    // registers; `(cmp) & (cmp) & bit` moved each lane out and back).
+    passed |= (den > threshold ? bit : 0) & (tn > 0 ? bit : 0) & (tn < den ? bit : 0);
+  }
+  if constexpr (kLanes == 4)
+    return uint64_t(passed[0] | passed[1] | passed[2] | passed[3]);
+  else
+    return uint64_t(passed[0] | passed[1]);
+}
 // A projected edge for vertical_bound: origin + t direction, heights and radii at its ends.
 struct Segment {
   glm::dvec2 origin, direction;
@@ -1535,7 +1583,9 @@ class Simplifier {
       spoke[spokes] = {{}, d, c.h[j], 0.0, c.r[j], 0.0};
       spoke_x[spokes] = d.x, spoke_y[spokes] = d.y, ++spokes;
     }
-    // Up to three zero spokes fill the last step: den = 0 fails the first test.
+    // Up to three zero spokes fill the last step: den = 0 fails the first test. Four lanes where this runs
+    // as vertical_bound's AVX2 version (the machine the loader picked it for).
+    const bool wide = LODSTREAM_RUNS_AVX2();
     for (size_t k = spokes; k < spokes + 3; ++k) spoke_x[k] = spoke_y[k] = 0.0;
     // The largest double below 1e-30: den > tiny is den >= 1e-30.
     const double tiny = std::nextafter(1e-30, 0.0);
@@ -1551,26 +1601,12 @@ class Simplifier {
       // tn = sign cross2(rel, nd) = cross2(sign rel, nd): negation commutes with rounding (a zero may change
       // sign, which no test below tells apart).
       const double rx = sign * rel.x, ry = sign * rel.y;
-      // The tests for up to 64 spokes at a time, four per step in vector lanes without branches (about 40 %
-      // of pairs pass the first, at random: as branches they were mostly mispredictions; one lane per step
-      // cost three times the instructions), each lane's outcome kept as its spoke's bit in the lanes (bit
-      // k - k0 of lane (k - k0) % 4; moving the bits to a scalar every step took 12 of its 36 instructions),
-      // then the crossings among them in order. One AVX2 register per step (two SSE2 ones in the baseline
-      // version; two lanes per step took 151 M more instructions on elephant_1m 0.1). The lanes compute what
-      // the scalar expressions would, bit for bit.
+      // The tests for up to 64 spokes at a time (passing_spokes), then the crossings among them in order.
       const double threshold = std::max(sn, tiny);  // den > sn and den >= 1e-30
       for (size_t k0 = 0; k0 < spokes; k0 += 64) {
         const size_t k1 = std::min(spokes, k0 + 64);
-        WideMask passed{0, 0, 0, 0}, bit{1, 2, 4, 8};
-        for (size_t k = k0; k < k1; k += 4, bit <<= 4) {
-          WideLanes x, y;
-          std::memcpy(&x, &spoke_x[k], sizeof x), std::memcpy(&y, &spoke_y[k], sizeof y);
-          const WideLanes den = x * dy - y * dx, tn = rx * y - ry * x;
-          // Each test selects the spokes' bits (as `cmp ? bit : 0`, GCC 12 keeps the masks in the vector
-          // registers; `(cmp) & (cmp) & bit` moved each lane out and back).
-          passed |= (den > threshold ? bit : 0) & (tn > 0 ? bit : 0) & (tn < den ? bit : 0);
-        }
-        const uint64_t any = uint64_t(passed[0] | passed[1] | passed[2] | passed[3]);
+        const uint64_t any = wide ? passing_spokes<4>(spoke_x, spoke_y, k0, k1, dx, dy, rx, ry, threshold)
+                                  : passing_spokes<2>(spoke_x, spoke_y, k0, k1, dx, dy, rx, ry, threshold);
         for (uint64_t crossing = any; crossing != 0; crossing &= crossing - 1) {
           const size_t k = k0 + size_t(__builtin_ctzll(crossing));
           const Segment& e = spoke[k];
