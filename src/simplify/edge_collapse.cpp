@@ -14,6 +14,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <span>
 #include <utility>
 
 #include "core/counting_sort.hpp"
@@ -26,6 +27,20 @@
 
 namespace lodstream::simplify {
 namespace {
+
+// The hot paths (place, try_collapse, vertical_bound, add_face) are compiled twice, for x86-64's baseline
+// and for AVX2, and the loader picks one for the machine (GCC's function multiversioning, an ifunc): with
+// AVX2 the float and double lanes take VEX three-operand forms (fewer register copies) and vertical_bound's
+// crossing test four lanes per step. AVX2 does not include FMA, so nothing is fused into a multiply-add and
+// both versions compute the same bits (12 simplify outputs and 4 bakes cmp-identical). elephant_1m 0.1,
+// whole command, callgrind: 17,380 -> 16,920 M instructions (the collapse), -> 16,597 M (add_face).
+#if defined(__x86_64__) && defined(__GNUC__)
+#define LODSTREAM_HOT_PATH __attribute__((target_clones("avx2", "default")))
+#define LODSTREAM_RUNS_AVX2() __builtin_cpu_supports("avx2")  // the version the loader picks
+#else
+#define LODSTREAM_HOT_PATH
+#define LODSTREAM_RUNS_AVX2() false
+#endif
 
 constexpr uint32_t kNone = UINT32_MAX;
 enum Kind : uint8_t { kManifold, kBorder, kSeam, kLocked };
@@ -88,8 +103,55 @@ struct Corners {
   int last_moving;  // the last moving corner (every face has one: it holds a or b); a face that stays has one
   bool dies;
 };
-// What comparisons of Lanes (quadric.hpp) give in vertical_bound's crossing tests: -1 where true, per lane.
-using LaneMask = int64_t __attribute__((vector_size(16)));
+// kLanes doubles (quadric.hpp), and what comparisons of them give: -1 where true, per lane.
+template <int kLanes>
+struct SpokeLanes;
+template <>
+struct SpokeLanes<2> {
+  using Doubles = Lanes;
+  using Mask = int64_t __attribute__((vector_size(16)));
+};
+template <>
+struct SpokeLanes<4> {
+  using Doubles = WideLanes;
+  using Mask = int64_t __attribute__((vector_size(32)));
+};
+// vertical_bound's division-free crossing tests for spokes [k0, k1) against one old edge (direction (dx, dy),
+// origin relative to x (rx, ry), both with the sign that makes sn positive): bit k - k0 set where den =
+// x dy - y dx > threshold and 0 < tn = rx y - ry x < den, with (x, y) = (spoke_x[k], spoke_y[k]). kLanes
+// spokes per step in vector lanes without branches (about 40 % of pairs pass the first test, at random: as
+// branches they were mostly mispredictions; one lane per step cost three times the instructions), each
+// lane's outcome kept as its spoke's bit in the lanes (bit k - k0 of lane (k - k0) % kLanes; moving the bits
+// to a scalar every step took 12 of its 36 instructions). The lanes compute what the scalar expressions
+// would, bit for bit. 4 lanes (one register) in vertical_bound's AVX2 version, 2 in the baseline's (GCC
+// lowers 4 lanes without AVX into scalar code: +1.3 G instructions on elephant_1m 0.1; in the AVX2 version
+// 2 lanes took 151 M more than 4; the whole command 16,134 -> 16,005 M with this
+// function, and 17,269 M for the baseline version alone, against 17,380 M before any AVX2). Reads spoke_x,
+// spoke_y up to the next multiple of kLanes above k1 - 1.
+template <int kLanes>
+[[gnu::always_inline]] inline uint64_t passing_spokes(const double* spoke_x, const double* spoke_y, size_t k0,
+                                                      size_t k1, double dx, double dy, double rx, double ry,
+                                                      double threshold) {
+  using Doubles = typename SpokeLanes<kLanes>::Doubles;
+  using Mask = typename SpokeLanes<kLanes>::Mask;
+  Mask passed{}, bit;  // bit: lane l's spoke in this step
+  if constexpr (kLanes == 4)
+    bit = Mask{1, 2, 4, 8};
+  else
+    bit = Mask{1, 2};
+  for (size_t k = k0; k < k1; k += kLanes, bit <<= kLanes) {
+    Doubles x, y;
+    std::memcpy(&x, &spoke_x[k], sizeof x), std::memcpy(&y, &spoke_y[k], sizeof y);
+    const Doubles den = x * dy - y * dx, tn = rx * y - ry * x;
+    // Each test selects the spokes' bits (as `cmp ? bit : 0`, GCC 12 keeps the masks in the vector
+    // registers; `(cmp) & (cmp) & bit` moved each lane out and back).
+    passed |= (den > threshold ? bit : 0) & (tn > 0 ? bit : 0) & (tn < den ? bit : 0);
+  }
+  if constexpr (kLanes == 4)
+    return uint64_t(passed[0] | passed[1] | passed[2] | passed[3]);
+  else
+    return uint64_t(passed[0] | passed[1]);
+}
 // A projected edge for vertical_bound: origin + t direction, heights and radii at its ends.
 struct Segment {
   glm::dvec2 origin, direction;
@@ -613,8 +675,8 @@ class Simplifier {
   // here, with the face's quadric spilled for it (inlined, a refined_elephant bake's add_face calls take
   // 170.3 -> 156.3 M instructions; the same operations, so the same bits).
   template <int kChannels>
-  [[gnu::flatten]] void add_face(uint32_t f, uint32_t lo, uint32_t hi, const float* weighted,
-                                 AttributeTerm* gradient) {
+  [[gnu::flatten]] LODSTREAM_HOT_PATH void add_face(uint32_t f, uint32_t lo, uint32_t hi,
+                                                    const float* weighted, AttributeTerm* gradient) {
     const int channels = kChannels >= 0 ? kChannels : channels_;
     const uint32_t v0 = indices_[3 * size_t(f)], v1 = indices_[3 * size_t(f) + 1],
                    v2 = indices_[3 * size_t(f) + 2];
@@ -818,7 +880,7 @@ class Simplifier {
   // Measured with quadrics relative to each vertex (origin_of) it changes little: elephant_1m 10 %
   // identical, horse 10 % Hausdorff 0.87x -> 0.85x meshoptimizer's, 1 % 0.54x -> 0.52x. With attribute
   // weights (attributes eliminated per end) it measured mixed, so it applies positions only.
-  void place(Plan& p) const {
+  LODSTREAM_HOT_PATH void place(Plan& p) const {
     constexpr double kEndShare = 0.1;
     std::array<Reduced, 2> own;  // Q_a, Q_b
     std::array<double, 2> own_w{0.0, 0.0};
@@ -1236,8 +1298,10 @@ class Simplifier {
     if (src != &order_) order_.swap(sorted_);
   }
 
+  // f(face) for each alive face around v's wedges. Always inlined: try_collapse's AVX2 version left it two
+  // calls (elephant_1m 0.1: 31 M instructions).
   template <class F>
-  void for_faces(uint32_t v, F&& f) const {
+  [[gnu::always_inline]] void for_faces(uint32_t v, F&& f) const {
     uint32_t w = v;
     do {
       for (uint32_t s = offsets_[w]; s < offsets_[w + 1]; ++s) {
@@ -1254,7 +1318,7 @@ class Simplifier {
   // later steps read those lists. With a region in `s`, a collapse whose faces (those around a and b) are not
   // all inside it is left alone (kOutsideRegion): two threads then never read or write the same face or
   // vertex. A rejected collapse sets its slot to +inf until an end is touched (rejected_slot).
-  Outcome try_collapse(Plan& p, Scratch& s) {
+  LODSTREAM_HOT_PATH Outcome try_collapse(Plan& p, Scratch& s) {
     const uint32_t pa = pid_[p.a], pb = pid_[p.b];
 
     s.na.clear(), s.nb.clear(), s.apex.clear(), s.removed.clear(), s.star_a.clear(), s.star_b.clear();
@@ -1394,25 +1458,33 @@ class Simplifier {
   // the right side is piecewise linear and concave-kinked over the common refinement of both fans, so it is
   // enough to check the refinement's vertices: x in the old fan, a (and b) in the new fan, and the crossings
   // of old edges at a or b with the new edges at x (ring vertices are shared and hold trivially).
-  double vertical_bound(const Plan& p, const glm::vec3& x, Scratch& sc, double cap) {
+  LODSTREAM_HOT_PATH double vertical_bound(const Plan& p, const glm::vec3& x, Scratch& sc, double cap) {
     constexpr double kInf = std::numeric_limits<double>::infinity();
     auto closed = [&](uint32_t v) { return kind_[v] == kManifold || kind_[v] == kSeam; };
     if (!closed(p.a) || (p.move && !closed(p.b))) return kInf;
-    sc.old.clear();
+    // The scratch arrays only grow (to the largest star so far), and records are written in place: no
+    // capacity test per record (elephant_1m 0.1, whole command: 16,567 -> 16,135 M instructions).
+    auto room = [](auto& v, size_t n) {
+      if (v.size() < n) v.resize(n);
+      return v.data();
+    };
     glm::dvec3 nsum(0.0);
     // a's faces, then (when x moves) b's that are not also a's: one loop, each record filled in place.
     const size_t na = sc.star_a.size(), nab = na + (p.move ? sc.star_b.size() : 0);
+    Corners* const records = room(sc.old, nab);
+    size_t faces = 0;
     for (size_t i = 0; i < nab; ++i) {
       const StarFace& star = i < na ? sc.star_a[i] : sc.star_b[i - na];
       if (i >= na && star.at_a) continue;
       const uint32_t* t = &indices_[3 * size_t(star.face)];
-      Corners& c = sc.old.emplace_back();
+      Corners& c = records[faces++];
       for (int k = 0; k < 3; ++k) c.p[k] = glm::dvec3(pos_[t[k]]), c.r[k] = radius_[t[k]];
       c.moving = star.at_a | star.at_b;
       c.last_moving = std::bit_width(c.moving) - 1;
       c.dies = (c.moving & (c.moving - 1)) != 0;  // two moving corners or more
       nsum += glm::cross(c.p[1] - c.p[0], c.p[2] - c.p[0]);
     }
+    const std::span<Corners> old(records, faces);
     const double len = glm::length(nsum);
     if (!(len > 0)) return kInf;
     const glm::dvec3 n = nsum / len;
@@ -1424,7 +1496,7 @@ class Simplifier {
     const glm::dvec3 xd(x);
     const glm::dvec2 yx = proj(xd);
     const double hx = glm::dot(n, xd);
-    for (Corners& c : sc.old) {
+    for (Corners& c : old) {
       for (int k = 0; k < 3; ++k) c.y[k] = proj(c.p[k]), c.h[k] = glm::dot(n, c.p[k]);
       c.area = cross2(c.y[1] - c.y[0], c.y[2] - c.y[0]);
       if (!(c.area > 0)) return kInf;
@@ -1445,7 +1517,7 @@ class Simplifier {
     double need = 0;
     // x over the old fan.
     bool found = false;
-    for (const Corners& c : sc.old) {
+    for (const Corners& c : old) {
       double l[3];
       if (!inside(c.y, c.area, yx, l)) continue;
       need = std::abs(hx - (l[0] * c.h[0] + l[1] * c.h[1] + l[2] * c.h[2])) + l[0] * c.r[0] + l[1] * c.r[1] +
@@ -1466,7 +1538,7 @@ class Simplifier {
       const glm::dvec3 pv(pos_[v]);
       const glm::dvec2 yv = proj(pv);
       found = false;
-      for (const Corners& c : sc.old) {
+      for (const Corners& c : old) {
         if (c.dies) continue;
         double l[3];
         if (!inside(c.ny, c.new_area, yv, l)) continue;
@@ -1486,14 +1558,19 @@ class Simplifier {
     }
     // Old edges at a or b against new edges at x: both lists once, then every pair (division-free rejection
     // first: most pairs do not cross).
-    sc.old_edges.clear(), sc.spokes.clear(), sc.spoke_x.clear(), sc.spoke_y.clear();
+    // At most three old edges per face (one per moving corner), one spoke per face, and three zero spokes
+    // after the last (below).
+    Segment* const old_edges = room(sc.old_edges, 3 * faces);
+    Segment* const spoke = room(sc.spokes, faces);
+    double *const spoke_x = room(sc.spoke_x, faces + 3), *const spoke_y = room(sc.spoke_y, faces + 3);
+    size_t edges = 0, spokes = 0;
     constexpr int kNext[3] = {1, 2, 0};
     // Each edge at a or b leaves a or b in exactly one of its faces; a face that stays has one moving corner
     // i, and its new edge x -> ring vertex j is that face's spoke (once per spoke).
-    for (const Corners& c : sc.old) {
+    for (const Corners& c : old) {
       auto old_edge = [&](int i) {
         const int j = kNext[i];
-        sc.old_edges.push_back({c.y[i], c.y[j] - c.y[i], c.h[i], c.h[j], c.r[i], c.r[j]});
+        old_edges[edges++] = {c.y[i], c.y[j] - c.y[i], c.h[i], c.h[j], c.r[i], c.r[j]};
       };
       if (c.dies) {
         for (int i = 0; i < 3; ++i)
@@ -1503,14 +1580,16 @@ class Simplifier {
       const int i = c.last_moving, j = kNext[i];
       old_edge(i);
       const glm::dvec2 d = c.y[j] - yx;
-      sc.spokes.push_back({{}, d, c.h[j], 0.0, c.r[j], 0.0});
-      sc.spoke_x.push_back(d.x), sc.spoke_y.push_back(d.y);
+      spoke[spokes] = {{}, d, c.h[j], 0.0, c.r[j], 0.0};
+      spoke_x[spokes] = d.x, spoke_y[spokes] = d.y, ++spokes;
     }
-    const size_t spokes = sc.spokes.size();
-    if (spokes % 2) sc.spoke_x.push_back(0.0), sc.spoke_y.push_back(0.0);  // den = 0 fails the first test
+    // Up to three zero spokes fill the last step: den = 0 fails the first test. Four lanes where this runs
+    // as vertical_bound's AVX2 version (the machine the loader picked it for).
+    const bool wide = LODSTREAM_RUNS_AVX2();
+    for (size_t k = spokes; k < spokes + 3; ++k) spoke_x[k] = spoke_y[k] = 0.0;
     // The largest double below 1e-30: den > tiny is den >= 1e-30.
     const double tiny = std::nextafter(1e-30, 0.0);
-    for (const Segment& o : sc.old_edges) {
+    for (const Segment& o : std::span(old_edges, edges)) {
       const glm::dvec2 rel = o.origin - yx;
       // s = cross2(rel, od) / den, t = cross2(rel, nd) / den, both strictly inside (0, 1), with den =
       // cross2(nd, od). sn is the same for every spoke, so its sign fixes den's: negating od, sn and tn
@@ -1522,29 +1601,17 @@ class Simplifier {
       // tn = sign cross2(rel, nd) = cross2(sign rel, nd): negation commutes with rounding (a zero may change
       // sign, which no test below tells apart).
       const double rx = sign * rel.x, ry = sign * rel.y;
-      // The tests for up to 64 spokes at a time, two per step in vector lanes without branches (about 40 %
-      // of pairs pass the first, at random: as branches they were mostly mispredictions; one lane per step
-      // cost three times the instructions), each lane's outcome kept as its spoke's bit in the lanes (bit
-      // k - k0 of lane (k - k0) % 2; moving the bits to a scalar every step took 12 of its 36 instructions,
-      // now 24), then the crossings among them in order. The lanes compute what the scalar expressions would,
-      // bit for bit.
+      // The tests for up to 64 spokes at a time (passing_spokes), then the crossings among them in order.
       const double threshold = std::max(sn, tiny);  // den > sn and den >= 1e-30
       for (size_t k0 = 0; k0 < spokes; k0 += 64) {
         const size_t k1 = std::min(spokes, k0 + 64);
-        LaneMask passed{0, 0}, bit{1, 2};
-        for (size_t k = k0; k < k1; k += 2, bit <<= 2) {
-          Lanes x, y;
-          std::memcpy(&x, &sc.spoke_x[k], sizeof x), std::memcpy(&y, &sc.spoke_y[k], sizeof y);
-          const Lanes den = x * dy - y * dx, tn = rx * y - ry * x;
-          // Each test selects the spokes' bits (as `cmp ? bit : 0`, GCC 12 keeps the masks in the vector
-          // registers; `(cmp) & (cmp) & bit` moved each lane out and back).
-          passed |= (den > threshold ? bit : 0) & (tn > 0 ? bit : 0) & (tn < den ? bit : 0);
-        }
-        for (uint64_t crossing = uint64_t(passed[0] | passed[1]); crossing != 0; crossing &= crossing - 1) {
+        const uint64_t any = wide ? passing_spokes<4>(spoke_x, spoke_y, k0, k1, dx, dy, rx, ry, threshold)
+                                  : passing_spokes<2>(spoke_x, spoke_y, k0, k1, dx, dy, rx, ry, threshold);
+        for (uint64_t crossing = any; crossing != 0; crossing &= crossing - 1) {
           const size_t k = k0 + size_t(__builtin_ctzll(crossing));
-          const Segment& e = sc.spokes[k];
-          const double den = sc.spoke_x[k] * dy - sc.spoke_y[k] * dx;
-          const double tn = rx * sc.spoke_y[k] - ry * sc.spoke_x[k];
+          const Segment& e = spoke[k];
+          const double den = spoke_x[k] * dy - spoke_y[k] * dx;
+          const double tn = rx * spoke_y[k] - ry * spoke_x[k];
           const double s = sn / den, t = tn / den;
           if (!(s > 0 && s < 1 && t > 0 && t < 1)) continue;
           const double gap = std::abs((1 - s) * hx + s * e.h0 - ((1 - t) * o.h0 + t * o.h1));
