@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <atomic>
 #include <bit>
 #include <cstdio>
@@ -395,17 +396,26 @@ void read_binary(const char* data, size_t size, const Header& h, const std::stri
       std::vector<size_t> offsets;
       for (size_t k = 0, o = 0; k < e.properties.size(); o += type_size(e.properties[k].type), ++k)
         offsets.push_back(o);
-      // Fixed-size items: read on every core.
-      tbb::parallel_for(tbb::blocked_range<uint64_t>(0, e.count, 1 << 14),
-                        [&](const tbb::blocked_range<uint64_t>& r) {
-                          double v[kSlots + 1] = {};
-                          const char* p = data + offset + r.begin() * stride;
-                          for (uint64_t i = r.begin(); i < r.end(); ++i, p += stride) {
-                            for (size_t k = 0; k < offsets.size(); ++k)
-                              v[layout.slots[k]] = load<Swap>(p + offsets[k], e.properties[k].type);
-                            builder.set(i, v);
-                          }
-                        });
+      // Fixed-size items: read on every core, `value(p, k)` reading property k at p. Properties all floats
+      // (the usual x, y, z) are read as such, without load()'s switch on the type (callgrind, bake of
+      // data/elephant_1m.ply: ply_reader.cpp 109.1 -> 89.7 M instructions).
+      auto read_items = [&](auto&& value) {
+        tbb::parallel_for(tbb::blocked_range<uint64_t>(0, e.count, 1 << 14),
+                          [&](const tbb::blocked_range<uint64_t>& r) {
+                            double v[kSlots + 1] = {};
+                            const char* p = data + offset + r.begin() * stride;
+                            for (uint64_t i = r.begin(); i < r.end(); ++i, p += stride) {
+                              for (size_t k = 0; k < offsets.size(); ++k)
+                                v[layout.slots[k]] = value(p + offsets[k], k);
+                              builder.set(i, v);
+                            }
+                          });
+      };
+      if (std::all_of(e.properties.begin(), e.properties.end(),
+                      [](const Property& q) { return q.type == Type::f32; }))
+        read_items([](const char* p, size_t) { return double(load_as<Swap, float>(p)); });
+      else
+        read_items([&](const char* p, size_t k) { return load<Swap>(p, e.properties[k].type); });
       offset += stride * e.count;
     } else if (e.name == "face" && read_triangles<Swap>(data, size, offset, e, vertex_count, mesh)) {
       offset += e.count * (type_size(e.properties[0].count_type) + 3 * type_size(e.properties[0].type));
