@@ -44,9 +44,10 @@ void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indice
   // Per triangle, in one record (a step reads several fields of each triangle it touches; in separate
   // arrays each was a cache miss of its own on a level-0 chunk): used, its distinct corners, corners already
   // in the current cluster (valid while listed in its frontier), flags (it is the last unused triangle of one
-  // of its vertices; it is listed in `near`, valid while listed in the frontier), the cluster that listed it
-  // in its frontier, its place in the order of listing (which breaks ties as one list would), its centroid.
-  constexpr uint8_t kLast = 1, kNear = 2;
+  // of its vertices; it is listed in `near` or `last`; in `last`: both valid while listed in the frontier),
+  // the cluster that listed it in its frontier, its place in the order of listing (which breaks ties as one
+  // list would), its centroid.
+  constexpr uint8_t kLast = 1, kNear = 2, kInLast = 4;
   constexpr uint32_t kUnset = UINT32_MAX;
   struct State {
     uint8_t used = 0, corners = 0, shared = 0, flags = 0;
@@ -62,10 +63,10 @@ void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indice
   }
 
   std::vector<uint32_t> local(vertices, kUnset);  // vertex -> cluster vertex number, current cluster only
-  // The frontier, by priority (below): ready, adding no vertex; near, the last unused triangle of one of its
-  // vertices or adding one; far, the rest (adding two; an entry that moves to near stays behind in far, which
-  // skips it).
-  std::vector<uint32_t> ready, near, far;
+  // The frontier, by priority (below): ready, adding no vertex; last, the last unused triangle of one of its
+  // vertices; near, adding one; far, the rest (adding two). An entry that moves up a list (to near or last)
+  // stays behind in the one it left, which skips it.
+  std::vector<uint32_t> ready, last, near, far;
   uint32_t listings = 0;
   size_t cursor = 0;  // every triangle before it is used
   for (uint32_t cluster = 0;; ++cluster) {
@@ -73,7 +74,7 @@ void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indice
     if (cursor == triangles) break;
     ClusterPart& part = parts.emplace_back();
     part.vertices.reserve(max_vertices), part.indices.reserve(3 * max_triangles);  // no regrowth
-    ready.clear(), near.clear(), far.clear();
+    ready.clear(), last.clear(), near.clear(), far.clear();
     size_t next_ready = 0;
     glm::vec3 sum(0.0f);
     auto add = [&](uint32_t t) {
@@ -86,8 +87,8 @@ void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indice
             for (uint32_t s = offsets[v]; s < offsets[v + 1]; ++s) {
               State& st = state[adjacent[s]];
               st.flags |= kLast;
-              if (!st.used && st.in_frontier == cluster && !(st.flags & kNear))
-                st.flags |= kNear, near.push_back(adjacent[s]);
+              if (!st.used && st.in_frontier == cluster && !(st.flags & kInLast))
+                st.flags |= kNear | kInLast, last.push_back(adjacent[s]);
             }
           if (local[v] == kUnset) {
             local[v] = uint32_t(part.vertices.size());
@@ -97,10 +98,14 @@ void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indice
               State& st = state[n];
               if (st.used) continue;
               const bool first = st.in_frontier != cluster;
-              if (first) st.in_frontier = cluster, st.shared = 0, st.flags &= ~kNear, st.listed = listings++;
+              if (first)
+                st.in_frontier = cluster, st.shared = 0, st.flags &= ~(kNear | kInLast),
+                st.listed = listings++;
               if (++st.shared == st.corners)
                 ready.push_back(n);
-              else if (!(st.flags & kNear) && ((st.flags & kLast) || st.corners - st.shared == 1))
+              else if (st.flags & kLast) {
+                if (!(st.flags & kInLast)) st.flags |= kNear | kInLast, last.push_back(n);
+              } else if (!(st.flags & kNear) && st.corners - st.shared == 1)
                 st.flags |= kNear, near.push_back(n);
               else if (first)
                 far.push_back(n);
@@ -124,14 +129,15 @@ void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indice
       // above: such a triangle lies within the cluster's vertices, so which one matters little.)
       uint32_t best = kUnset, best_priority = UINT32_MAX;
       float best_distance = 0.0f;
-      // Every near entry comes before every far one, so far is scanned only when no near entry fits.
-      auto scan = [&](std::vector<uint32_t>& list, bool is_far) {
+      // Every last entry comes before every near one, and every near one before every far one, so a list is
+      // scanned only when no entry of the ones before fits. `moved`: the flag of the entries that moved to a
+      // list before it.
+      auto scan = [&](std::vector<uint32_t>& list, uint8_t moved) {
         size_t kept = 0;
-        for (size_t i = 0; i < list.size();
-             ++i) {  // drops used (and, from far, moved) entries while scanning
+        for (size_t i = 0; i < list.size(); ++i) {  // drops used and moved entries while scanning
           const uint32_t t = list[i];
           const State& st = state[t];
-          if (st.used || (is_far && (st.flags & kNear))) continue;
+          if (st.used || (st.flags & moved)) continue;
           list[kept++] = t;
           const size_t added = size_t(st.corners - st.shared);
           if (part.vertices.size() + added > max_vertices) continue;
@@ -145,10 +151,11 @@ void grow(std::span<const glm::vec3> positions, std::span<const uint32_t> indice
         }
         list.resize(kept);
       };
-      scan(near, false);
-      if (best == kUnset) scan(far, true);
+      scan(last, 0);
+      if (best == kUnset) scan(near, kInLast);
+      if (best == kUnset) scan(far, kNear);
       if (best == kUnset) {
-        if (!near.empty() || !far.empty()) break;
+        if (!last.empty() || !near.empty() || !far.empty()) break;
         // The component is used up (no unused triangle touches the cluster): continue with the unused
         // triangle nearest the centroid among the next kJumpWindow of the spatial order (near each other).
         constexpr size_t kJumpWindow = 64;

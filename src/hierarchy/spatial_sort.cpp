@@ -5,6 +5,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <array>
 #include <cfloat>
 #include <memory>
 #include <span>
@@ -16,6 +17,19 @@
 namespace lodstream::hierarchy {
 
 namespace {
+
+// morton_spread10 of every 10-bit value: a code is then three look-ups (4 KB, in cache) instead of three
+// spreads of 13 operations each (callgrind, bake of data/horse.ply: 2,344.9 -> 2,338.3 M instructions).
+constexpr std::array<uint32_t, 1024> kSpread10 = [] {
+  std::array<uint32_t, 1024> spread{};
+  for (uint32_t v = 0; v < 1024; ++v) spread[v] = morton_spread10(v);
+  return spread;
+}();
+
+// morton_code10(x, y, z) for coordinates below 1024.
+uint32_t morton_code(uint32_t x, uint32_t y, uint32_t z) {
+  return kSpread10[x & 1023] | kSpread10[y & 1023] << 1 | kSpread10[z & 1023] << 2;
+}
 
 // Sorts a run of (code << 32 | triangle) keys whose codes share their top 10 bits and whose triangles
 // increase (as counting_sort deals them): two stable counting passes by the code's bits 0-9, then 10-19,
@@ -78,7 +92,7 @@ std::vector<uint32_t> spatial_sort_triangles(std::span<const glm::vec3> position
   // (code << 32 | triangle): sorting these sorts by code, ties by triangle (a stable sort by code).
   auto code_of = [&](size_t t) {
     const glm::vec3 q = (centroid[t] - box.lo) * scale * 1023.f + 0.5f;
-    return morton_code10(uint32_t(int(q.x)), uint32_t(int(q.y)), uint32_t(int(q.z)));
+    return morton_code(uint32_t(int(q.x)), uint32_t(int(q.y)), uint32_t(int(q.z)));
   };
   std::vector<uint64_t> order;
   if (!parallel) {

@@ -215,6 +215,14 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
   struct Output {
     uint32_t vertex, group, out;
   };
+  // A group's normal: its sum normalized (+z when zero).
+  auto group_normal = [](const Group& g) {
+    const float len = glm::length(g.sum);
+    return len > 0 ? g.sum / len : glm::vec3(0.0f, 0.0f, 1.0f);
+  };
+  // Without UVs and colours every position class is one vertex (above), so a position's corners are all of
+  // it.
+  const bool one_vertex_per_position = !(mesh.has_uvs() || mesh.has_colors());
   struct Run {
     std::vector<uint32_t> keep;
     std::vector<glm::vec3> normals;
@@ -248,6 +256,15 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
         groups[g].sum += n;
         corner_group.push_back(static_cast<uint32_t>(g));
       }
+      if (one_vertex_per_position) {
+        // Every corner here is of vertex p, and groups were numbered in order of their first corner: the
+        // pairs (p, g) are the groups in order, and the search below would number them so.
+        const uint32_t first = static_cast<uint32_t>(run.keep.size());
+        for (const Group& g : groups)
+          run.keep.push_back(static_cast<uint32_t>(p)), run.normals.push_back(group_normal(g));
+        for (uint32_t k = begin; k < end; ++k) mesh.indices[corners[k]] = first + corner_group[k - begin];
+        continue;
+      }
       outputs.clear();
       for (uint32_t k = begin; k < end; ++k) {
         const uint32_t c = corners[k], w = mesh.indices[c], g = corner_group[k - begin];
@@ -257,8 +274,7 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
         if (o == outputs.size()) {
           const uint32_t out = static_cast<uint32_t>(run.keep.size());
           run.keep.push_back(w);
-          const float len = glm::length(groups[g].sum);
-          run.normals.push_back(len > 0 ? groups[g].sum / len : glm::vec3(0.0f, 0.0f, 1.0f));
+          run.normals.push_back(group_normal(groups[g]));
           outputs.push_back({w, g, out});
         }
         mesh.indices[c] = outputs[o].out;

@@ -142,38 +142,62 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
                                std::span<const uint32_t> cluster_triangles) {
   const uint32_t T = uint32_t(indices.size() / 3);
   const bool clustered = cluster_triangles.size() > 1;
-  std::vector<uint8_t> cluster_of(T, 0), emitted_cluster;  // by input triangle; by emitted triangle
+  // Scratch kept per thread between calls (a bake encodes thousands of records on each core): allocated and
+  // cleared once rather than per record.
+  thread_local std::vector<uint8_t> cluster_of, emitted_cluster, encoded;  // by input triangle; emitted
+  thread_local std::vector<uint32_t> first, fill, decoded, traversal_order;
+  // Per outgoing half-edge of a vertex, in vertex order: the vertex it goes to, the third corner of its
+  // triangle and the triangle (corner c = 3t + k goes from indices[c] to the next corner of t); the look-up
+  // across a gate then compares the first field and reads the others, with no division by 3.
+  struct HalfEdge {
+    uint32_t to, third, triangle;
+  };
+  thread_local std::vector<HalfEdge> half_edges;
+  cluster_of.assign(T, 0);
   for (uint32_t c = 0, t = 0; c < cluster_triangles.size(); ++c)
     for (uint32_t k = 0; k < cluster_triangles[c] && t < T; ++k) cluster_of[t++] = uint8_t(c);
   TraversalCode code;
-  code.indices.reserve(indices.size());
-  code.predictors.reserve(3 * size_t(V));
-  // Outgoing half-edges per vertex (corner c = 3t + k goes from indices[c] to the next corner of t).
-  std::vector<uint32_t> first(size_t(V) + 1, 0), corners(indices.size());
+  // Every triangle is emitted once and every vertex numbered once (the traversal's, then the unused ones):
+  // the outputs are written in place at their final sizes.
+  code.indices.resize(indices.size());
+  code.order.resize(V);
+  code.predictors.resize(3 * size_t(V));
+  first.assign(size_t(V) + 1, 0);
   for (uint32_t i : indices) ++first[i + 1];
   for (uint32_t v = 0; v < V; ++v) first[v + 1] += first[v];
-  {
-    std::vector<uint32_t> fill(first.begin(), first.end() - 1);
-    for (uint32_t c = 0; c < indices.size(); ++c) corners[fill[indices[c]]++] = c;
+  fill.assign(first.begin(), first.end() - 1);
+  half_edges.resize(indices.size());
+  for (uint32_t t = 0; t < T; ++t) {
+    const uint32_t* c = &indices[3 * size_t(t)];
+    half_edges[fill[c[0]]++] = {c[1], c[2], t};
+    half_edges[fill[c[1]]++] = {c[2], c[0], t};
+    half_edges[fill[c[2]]++] = {c[0], c[1], t};
   }
-  auto next_corner = [](uint32_t c) { return c % 3 == 2 ? c - 2 : c + 1; };
-  std::vector<uint8_t> encoded(T, 0);
-  std::vector<uint32_t> decoded(V, kNone);  // decoded[input vertex] = its number
+  encoded.assign(T, 0);
+  decoded.assign(V, kNone);  // decoded[input vertex] = its number
+  uint32_t next = 0;         // the next vertex number
   auto add_vertex = [&](uint32_t input, uint32_t o1, uint32_t o2, uint32_t o) {
-    decoded[input] = uint32_t(code.order.size());
-    code.order.push_back(input);
-    code.predictors.insert(code.predictors.end(), {o1, o2, o});
-    return decoded[input];
+    decoded[input] = next;
+    code.order[next] = input;
+    uint32_t* p = &code.predictors[3 * size_t(next)];
+    p[0] = o1, p[1] = o2, p[2] = o;
+    return next++;
   };
+  // Triangles in traversal order: straight into the result, or for a record into a buffer that is then
+  // sorted by cluster.
+  if (clustered) traversal_order.resize(indices.size()), emitted_cluster.resize(T);
+  uint32_t* const out = clustered ? traversal_order.data() : code.indices.data();
+  uint32_t done = 0;  // triangles emitted
   auto emit = [&](uint32_t a, uint32_t b, uint32_t c, uint8_t k) {
-    code.indices.insert(code.indices.end(), {a, b, c});
-    emitted_cluster.push_back(k);
+    uint32_t* x = out + 3 * size_t(done);
+    x[0] = a, x[1] = b, x[2] = c;
+    if (clustered) emitted_cluster[done] = k;
+    ++done;
   };
 
-  std::vector<Front::Edge> edges;
+  thread_local std::vector<Front::Edge> edges;
   Front front(edges, T);
   uint32_t scan = 0;  // triangles below it are encoded
-  uint32_t done = 0;  // triangles emitted
   uint32_t e = 0;     // the gate
   while (done < T) {
     e = front.gate(e);
@@ -185,7 +209,6 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
       uint32_t corner[3];
       for (int k = 0; k < 3; ++k) {
         const uint32_t input = indices[3 * scan + k];
-        const uint32_t next = uint32_t(code.order.size());
         if (decoded[input] != kNone) {
           put_varint(code.references, next - decoded[input]);
           corner[k] = decoded[input];
@@ -197,25 +220,27 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
       }
       front.start(corner[0], corner[1], corner[2], k);
       emit(corner[0], corner[1], corner[2], k);
-      ++done;
       continue;
     }
     const Front::Edge g = front.edge(e);
     // The triangle across a -> b holds half-edge b -> a.
     const uint32_t a_in = code.order[g.a], b_in = code.order[g.b];
-    uint32_t across = kNone;
-    for (uint32_t i = first[b_in]; i < first[b_in + 1] && across == kNone; ++i) {
-      const uint32_t c = corners[i];
-      if (!encoded[c / 3] && indices[next_corner(c)] == a_in) across = c;
+    const HalfEdge* across = nullptr;
+    for (uint32_t i = first[b_in]; i < first[b_in + 1]; ++i) {
+      const HalfEdge& h = half_edges[i];
+      if (h.to == a_in && !encoded[h.triangle]) {
+        across = &h;
+        break;
+      }
     }
-    if (across == kNone) {
+    if (!across) {
       code.symbols.push_back(kBoundary);
       front.done(e);
       continue;
     }
-    encoded[across / 3] = 1;
-    const uint8_t k = cluster_of[across / 3];
-    const uint32_t c_in = indices[next_corner(next_corner(across))];
+    encoded[across->triangle] = 1;
+    const uint8_t k = cluster_of[across->triangle];
+    const uint32_t c_in = across->third;
     uint32_t c = decoded[c_in];
     if (c == kNone) {
       code.symbols.push_back(tagged(kVertex, k, g.cluster));
@@ -232,21 +257,19 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
       front.close_right(e, k);
     } else {
       code.symbols.push_back(tagged(kSplit, k, g.cluster));
-      put_varint(code.references, uint32_t(code.order.size()) - 1 - c);
+      put_varint(code.references, next - 1 - c);
       front.attach(e, c, k);
     }
     emit(g.b, g.a, c, k);
-    ++done;
   }
   for (uint32_t v = 0; v < V; ++v) {
     if (decoded[v] != kNone) continue;
-    const uint32_t from = code.order.empty() ? V : uint32_t(code.order.size()) - 1;
+    const uint32_t from = next == 0 ? V : next - 1;
     add_vertex(v, from, from, from);
   }
-  if (clustered) {
-    const std::vector<uint32_t> traversal_order = code.indices;
-    sort_by_cluster(traversal_order.data(), code.indices.data(), emitted_cluster, cluster_triangles);
-  }
+  if (clustered)
+    sort_by_cluster(traversal_order.data(), code.indices.data(), std::span(emitted_cluster.data(), T),
+                    cluster_triangles);
   return code;
 }
 

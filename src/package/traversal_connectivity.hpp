@@ -68,7 +68,8 @@ struct TraversalCode {
 // list of outgoing half-edges; a non-manifold edge takes any of its triangles, the others start pieces or
 // arrive as splits. `cluster_triangles`: a record's clusters (counts adding up to T, each at least 1, at
 // most 31 of them; the input's triangles are their consecutive ranges in order), or empty / one for a single
-// cluster. Cost: O(T + V) (times the vertex valence for the look-ups).
+// cluster. Cost: O(T + V) (times the vertex valence for the look-ups); its scratch (about 50 bytes per corner
+// and 8 per vertex) is kept per thread between calls.
 TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
                                std::span<const uint32_t> cluster_triangles = {});
 
