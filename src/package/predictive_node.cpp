@@ -38,12 +38,17 @@ inline uint64_t damped_parallelogram(uint64_t a, uint64_t b, uint64_t c, uint32_
 
 // The multi-parallelogram P of predictive_node.hpp from vertex v's predictors o and second parallelogram
 // `more` (3 entries each): per axis floor((sum over the two of (4 + j)(c[x] + c[y]) - 2j c[o]) + 8) / 16),
-// wrapping until the final arithmetic shift, so that hostile coordinates never overflow. With more = o it is
-// damped_parallelogram (twice the sum, twice the divisor).
+// wrapping until the final arithmetic shift, so that hostile coordinates never overflow; without `more`
+// (null: no second parallelogram found) the damped_parallelogram of o alone, which the average of o with
+// itself equals for valid coordinates, at half the loads and arithmetic.
 template <uint32_t j>
 inline void averaged_parallelogram(const uint64_t* c, const uint32_t* o, const uint32_t* more,
                                    uint64_t (&p)[3]) {
   const uint64_t *x = c + 3 * size_t(o[0]), *y = c + 3 * size_t(o[1]), *z = c + 3 * size_t(o[2]);
+  if (!more) {
+    for (int a = 0; a < 3; ++a) p[a] = damped_parallelogram(x[a], y[a], z[a], j);
+    return;
+  }
   const uint64_t *u = c + 3 * size_t(more[0]), *w = c + 3 * size_t(more[1]), *t = c + 3 * size_t(more[2]);
   for (int a = 0; a < 3; ++a)
     p[a] = uint64_t(int64_t((4 + j) * (x[a] + y[a] + u[a] + w[a]) - 2 * j * (z[a] + t[a]) + 8) >> 4);
@@ -57,8 +62,9 @@ inline void averaged_parallelogram(const uint64_t* c, const uint32_t* o, const u
 // |offset| <= |ra| + |rb| + 1 and the conversion back is in range for any residuals below 2^40 (hostile
 // coordinates wrap in the cross product; any n is finite).
 // With the multi-parallelogram prediction n is the sum of the normals of the two parallelograms' triangles
-// (x, y, o), both in their mesh winding (traversal_connectivity.hpp, Parallelograms): with the same triangle
-// twice, twice the gate's normal, the same plane and offsets (doubling is exact in doubles).
+// (x, y, o), both in their mesh winding (traversal_connectivity.hpp, Parallelograms); without a second one
+// (null), the gate's alone (the sum with itself would give the same plane and offsets for valid coordinates:
+// doubling is exact in doubles).
 inline void add_normal(const uint64_t* x, const uint64_t* y, const uint64_t* z, uint64_t (&n)[3]) {
   const uint64_t e[2][3] = {{x[0] - z[0], x[1] - z[1], x[2] - z[2]}, {y[0] - z[0], y[1] - z[1], y[2] - z[2]}};
   n[0] += e[0][1] * e[1][2] - e[0][2] * e[1][1];
@@ -68,15 +74,10 @@ inline void add_normal(const uint64_t* x, const uint64_t* y, const uint64_t* z, 
 struct PlaneGate {
   double n[3];
   uint32_t d;
-  PlaneGate(const uint64_t* x, const uint64_t* y, const uint64_t* z) {
-    uint64_t s[3] = {0, 0, 0};
-    add_normal(x, y, z, s);
-    set(s);
-  }
   PlaneGate(const uint64_t* c, const uint32_t* o, const uint32_t* more) {
     uint64_t s[3] = {0, 0, 0};
     add_normal(c + 3 * size_t(o[0]), c + 3 * size_t(o[1]), c + 3 * size_t(o[2]), s);
-    add_normal(c + 3 * size_t(more[0]), c + 3 * size_t(more[1]), c + 3 * size_t(more[2]), s);
+    if (more) add_normal(c + 3 * size_t(more[0]), c + 3 * size_t(more[1]), c + 3 * size_t(more[2]), s);
     set(s);
   }
   void set(const uint64_t (&s)[3]) {
@@ -96,26 +97,19 @@ struct PlaneGate {
 // c[v] = P + residual[v] per axis for v < V (predictive_node.hpp), wrapping, the residuals as read_planes
 // leaves them (one array per component), with the plane prediction when `plane`. One pass; returns whether a
 // result lies outside [-kMaxCoarse, kMaxCoarse).
-// With `extra` (multi), P is the multi-parallelogram (averaged_parallelogram).
+// With `extra` (multi), P is the multi-parallelogram (averaged_parallelogram) where a second one was found.
 template <uint32_t j, bool plane, bool multi>
 bool predict_positions(const int64_t* residual, uint32_t V, const uint32_t* o, const Parallelograms* extra,
                        uint64_t* c) {
   const int64_t *r0 = residual, *r1 = r0 + V, *r2 = r1 + V;
   uint64_t shifted = 0;  // OR of c + kMaxCoarse: in range while below 2 kMaxCoarse
   for (uint32_t v = 0; v < V; ++v, o += 3) {
-    const uint64_t *x = c + 3 * size_t(o[0]), *y = c + 3 * size_t(o[1]), *z = c + 3 * size_t(o[2]);
     uint64_t* to = c + 3 * size_t(v);
+    const uint32_t* more = multi && extra->found[v] ? extra->corners.data() + 3 * size_t(v) : nullptr;
     uint64_t p[3];
-    [[maybe_unused]] const uint32_t* more = multi ? extra->corners.data() + 3 * size_t(v) : nullptr;
-    if constexpr (multi) {
-      averaged_parallelogram<j>(c, o, more, p);
-    } else {
-      p[0] = damped_parallelogram(x[0], y[0], z[0], j);
-      p[1] = damped_parallelogram(x[1], y[1], z[1], j);
-      p[2] = damped_parallelogram(x[2], y[2], z[2], j);
-    }
+    averaged_parallelogram<j>(c, o, more, p);
     if constexpr (plane) {
-      const PlaneGate gate = multi ? PlaneGate(c, o, more) : PlaneGate(x, y, z);
+      const PlaneGate gate(c, o, more);
       const uint32_t d = gate.d, a = d == 2 ? 0 : d + 1, b = d == 0 ? 2 : d - 1;
       uint64_t r[3];
       r[a] = uint64_t(r1[v]), r[b] = uint64_t(r2[v]),
@@ -221,11 +215,11 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
   // the larger j, no plane, no multi): one pass counts all twelve (the gate's plane does not depend on j),
   // then the choice's residuals.
   const uint64_t* cu = reinterpret_cast<const uint64_t*>(c.data());
-  // Vertex v's predictors and second parallelogram (its predictors again without the multi prediction:
-  // averaged_parallelogram is then the gate's).
+  // Vertex v's predictors and second parallelogram (null without the multi prediction or where none was
+  // found: averaged_parallelogram is then the gate's).
   auto corners = [&](size_t v, bool multi, const uint32_t*& o, const uint32_t*& more) {
     o = &(multi ? multi_predictors : predictors)[3 * v];
-    more = multi ? extra->corners.data() + 3 * v : o;
+    more = multi && extra->found[v] ? extra->corners.data() + 3 * v : nullptr;
   };
   // Vertex v's residuals at damping j, plain (d), and lifted onto the plane of `gate` (e: components (d -
   // offset, d + 1, d + 2) of its dominant axis d).

@@ -39,17 +39,19 @@
 // Multi-parallelogram prediction (kMultiParallelogram, codec 3 only; Cohen-Or, Cohen & Irony 2002,
 //   "Multi-way geometry encoding", and Draco's "multi-parallelogram" prediction): the connectivity is decoded
 //   before the positions, so the traversal can give vertex v a second parallelogram (x, y, p) across another
-//   edge whose two triangles it joins, every corner below v (traversal_connectivity.hpp, Parallelograms; the
-//   gate itself when there is none). P is then the average of the two damped parallelograms, in integers
-//   floor((sum over both of (4 + j)(c[x] + c[y]) - 2j c[p]) + 8) / 16), and the plane prediction's normal
-//   the sum of both triangles' normals. The encoder takes it, with the j and plane choice, when it saves at
-//   least 3/4 bit a vertex (predictive_node.cpp: it costs the decoder about 110 instructions a vertex).
-//   Measured offline before building it (refined_elephant, residual symbols' order-0 entropy per vertex,
-//   the average of every parallelogram the whole mesh offers): level 0 14.02 -> 12.40 bits, levels >= 1
-//   21.65 -> 20.89; the traversal's second parallelogram alone takes refined_elephant to 259,949 B (all
-//   three further ones found: 258,969), with the threshold 261,306 (-3.6 %; positions at level 0 0.95 ->
-//   0.86 B a stored triangle after zstd). `bench decode --runs 1` (callgrind): refined_elephant 91.1 ->
-//   96.3 M instructions, elephant_1m (no node takes it) 1,188.9 -> 1,185.7 M.
+//   edge whose two triangles it joins, every corner below v (traversal_connectivity.hpp, Parallelograms;
+//   without one, v takes the single parallelogram above). P is then the average of the two damped
+//   parallelograms, in integers floor((sum over both of (4 + j)(c[x] + c[y]) - 2j c[p]) + 8) / 16), and the
+//   plane prediction's normal the sum of both triangles' normals. The encoder takes it, with the j and plane
+//   choice, when it saves at least 3/4 bit a vertex (predictive_node.cpp: it costs the decoder about 110
+//   instructions a vertex). Measured offline before building it (refined_elephant, residual symbols' order-0
+//   entropy per vertex, the average of every parallelogram the whole mesh offers): level 0 14.02 -> 12.40
+//   bits, levels >= 1 21.65 -> 20.89; the traversal's second parallelogram alone takes refined_elephant to
+//   259,949 B (all three further ones found: 258,969), with the threshold 261,306 (-3.6 %; positions at level
+//   0 0.95 -> 0.86 B a stored triangle after zstd). `bench decode --runs 1` (callgrind):
+//   refined_elephant 91.1 -> 96.3 M instructions, elephant_1m (no node takes it) 1,188.9 -> 1,185.7 M.
+//   Vertices without a second parallelogram predicted as single ones (no average of a parallelogram with
+//   itself, no copy of their predictors into the second's place): refined_elephant 93.7 -> 92.7 M.
 // Normals: predicted from the decoded positions, plain or smoothed (predicted_normals.hpp).
 #pragma once
 

@@ -420,9 +420,6 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     const uint32_t from = next > 0 ? next - 1 : V;
     predictors[3 * next] = predictors[3 * next + 1] = predictors[3 * next + 2] = from;
   }
-  if constexpr (multi)
-    for (uint32_t v = 0; v < V; ++v)
-      if (!extra->found[v]) std::copy_n(predictors + 3 * size_t(v), 3, &extra->corners[3 * size_t(v)]);
 }
 
 }  // namespace

@@ -80,10 +80,10 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
 // c[y] - c[p], its corners decoded before q and in the winding of their triangle (the gates of kVertex are
 // the predictors themselves). A vertex whose predictor is single (x, x, x: a piece start's) takes its first
 // such parallelogram as its predictors instead; the first (next) one found is its second parallelogram, the
-// rest are dropped; a vertex without one has its predictors as its second.
+// rest are dropped; a vertex without one is predicted from its predictors alone.
 struct Parallelograms {
-  std::vector<uint32_t> corners;  // per vertex (x, y, p)
-  std::vector<uint8_t> found;     // per vertex: the second found (the decoder's scratch)
+  std::vector<uint32_t> corners;  // per vertex (x, y, p), where found (else left as it was)
+  std::vector<uint8_t> found;     // per vertex: whether its second was found
 };
 
 // Decodes T triangles of V vertices into indices (3T entries) and predictors (3V entries, as

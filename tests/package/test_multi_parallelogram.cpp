@@ -53,7 +53,7 @@ TEST(MultiParallelogram, TheTraversalJoinsTrianglesAcrossTheirSharedEdges) {
     };
     const uint32_t* second = &extra.corners[3 * size_t(q)];
     if (predictors[3 * q] != predictors[3 * q + 1]) check(&predictors[3 * q]);
-    if (!std::equal(second, second + 3, &predictors[3 * q])) check(second), ++seconds;
+    if (extra.found[q]) check(second), ++seconds;
   }
   // A closed mesh: most vertices are reached across several decoded edges.
   EXPECT_GT(seconds, size_t(V) / 2);
