@@ -25,15 +25,20 @@ namespace lodstream::package {
 // open[v] = 1 for v < V when v's fan among the triangles of `indices` whose corners are all in the node
 // (index - first_vertex below V, as predicted_normals counts them) is not closed (above), else 0. Returns the
 // number of open vertices. Cost: O(T + V), one pass over the corners.
-// The normal bits at which the encoder derives closed vertices' normals: 9, level 0's (and progressive
-// meshes') by default, where the stored normals are the source's and the codes already round toward the
-// prediction (predicted_normals.cpp's dead zone); more bits, a precision asked for explicitly, keep their
-// codes, as they keep nearest rounding. Measured (bake, render at 1 px against the full model, the usual
-// three cameras): refined_elephant 291,609 -> 288,725 B (-1.0 %), PSNR near 47.636 -> 47.629 dB, mid and
-// far unchanged; elephant_1m 3,226,511 -> 3,127,899 B (-3.1 %), near 47.797 -> 47.786 dB; horse -0.6 %,
-// near -0.012 dB; bunny -0.06 %, motorBike -0.02 % (their normals are the files' own). From 8 bits too
-// (every DAG level): refined_elephant 284,264 B (-2.5 %) but PSNR -0.03 / -0.08 / -0.03 dB: a coarse
-// cluster's normals are carried from the finer surface it stands for, and its own surface's differ more.
+// The most normal bits at which the encoder derives closed vertices' normals: 9, level 0's (and progressive
+// meshes') by default, and the coarse levels' 8 and 7 (bake --coarse-normal-bits), where the codes already
+// round toward the prediction (predicted_normals.cpp's dead zone); more bits, a precision asked for
+// explicitly, keep their codes, as they keep nearest rounding. Measured (bake, render at 1 px against the
+// full model, the usual three cameras), level 0 only: refined_elephant 291,609 -> 288,725 B (-1.0 %), PSNR
+// near 47.636 -> 47.629 dB, mid and far unchanged; elephant_1m 3,226,511 -> 3,127,899 B (-3.1 %), near
+// 47.797 -> 47.786 dB; horse -0.6 %, near -0.012 dB; bunny -0.06 %, motorBike -0.02 % (their normals are
+// the files' own). Every level too (format 11, against level 0 only): refined_elephant 261,306 -> 256,618 B
+// (-1.8 %), PSNR near / mid / far 47.628 / 51.023 / 56.549 -> 47.600 / 50.943 / 56.511 dB (the same
+// triangles; a coarse cluster's normals are carried from the finer surface it stands for, its own surface's
+// differ more); elephant_1m 2,972,234 -> 2,898,959 (-2.5 %), motorBike 1,419,523 -> 1,409,394 (-0.7 %),
+// bunny 245,519 -> 242,819 (-1.1 %), horse 317,095 -> 312,104 (-1.6 %). Deriving at 8 bits only where one
+// of the two codes is 0: refined_elephant 259,701 B (-0.6 %), PSNR -0.015 / -0.041 / -0.032 dB, a worse
+// trade. At 7 bits alone (shift >= 2): -0.23 %, renders unchanged (no such cluster drawn at 1 px).
 constexpr uint32_t kDerivedNormalBits = 9;
 
 uint32_t open_vertices(std::span<const uint32_t> indices, uint32_t first_vertex, uint32_t V,

@@ -33,8 +33,9 @@ inline constexpr std::array<uint8_t, 8> kMagic = {0x89, 'L', 'O', 'D', 'S', '\r'
 // (symbol_coder.hpp); 9: positions predicted on the gate triangle's plane (predictive_node.hpp,
 // kPlanePrediction), position residuals coded in two streams (page_parts.hpp, the split form); 10: positions
 // predicted by the average of the parallelograms the traversal joins (predictive_node.hpp,
-// kMultiParallelogram).
-inline constexpr uint32_t kFormatVersion = 10;
+// kMultiParallelogram); 11: closed vertices' normals derived at every DAG level, not level 0 only
+// (derived_normals.hpp; the encoder's choice, decoders unchanged).
+inline constexpr uint32_t kFormatVersion = 11;
 inline constexpr size_t kHeaderSize = 64;
 
 // Hard limits a reader enforces before allocating: no valid writer output exceeds them.

@@ -280,7 +280,7 @@ PredictiveResiduals predictive_residuals(const NodeGeometry& g, const QuantizedN
     NormalCodes codes = code_normals(g.mesh->normals, n.order, indices, g.first_vertex, n.index_end,
                                      decoded.data(), g.normal_bits);
     r.normals = std::move(codes.codes), r.normal_bytes = codes.width, r.smooth_normals = codes.smooth;
-    if (g.normal_bits == kDerivedNormalBits) {
+    if (g.normal_bits <= kDerivedNormalBits) {
       std::vector<uint8_t> open;
       open_vertices(indices, g.first_vertex, uint32_t(V), open);
       derive_closed_normals(r.normals, open);

@@ -200,9 +200,16 @@ TEST(DerivedNormals, AFanIsClosedWhenEveryTriangleAroundTheVertexIsInTheNode) {
   EXPECT_TRUE(open[V]);
 }
 
-TEST(DerivedNormals, ClosedVerticesWithinOneStepDecodeToThePrediction) {
-  // A sphere whose normals are tilted off the surface's by about one code step at 9 bits (1 / (0.49 * 255)
-  // radians): without derivation the closed vertices would store codes of +-1 and decode off the prediction.
+// A sphere whose normals are tilted off the surface's by about one code step at `bits` (1.15 / (scale
+// (2^(bits
+// - 1) - 1)) radians, scale 0.49 at 9 bits and 0.52 below, predicted_normals.cpp's frame_scale): without
+// derivation the closed vertices would store codes of +-1 and decode off the prediction. The vertices (all
+// closed) decode to their prediction, plain or smoothed (the encoder's choice), but for the few that the
+// prediction's own error (the sphere's tessellation) puts more than a step off, and within three code steps
+// of the normal given (both codes within 1.8 steps with the dead zone: 1.8 sqrt(2) = 2.55 steps apart at
+// most).
+void expect_closed_vertices_derived(uint32_t bits) {
+  const double step = 1.0 / ((bits == 9 ? 0.49 : 0.52) * double((1 << (bits - 1)) - 1));
   Mesh ball = sphere(1.0f, 24, 48);
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> turn(0.0f, 6.2831853f);
@@ -211,19 +218,17 @@ TEST(DerivedNormals, ClosedVerticesWithinOneStepDecodeToThePrediction) {
         glm::normalize(glm::cross(n, std::abs(n.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0)));
     const glm::vec3 b = glm::cross(n, t);
     const float a = turn(rng);
-    n = glm::normalize(n + 0.009f * (std::cos(a) * t + std::sin(a) * b));
+    n = glm::normalize(n + float(1.15 * step) * (std::cos(a) * t + std::sin(a) * b));
   }
   const PositionGrid grid = PositionGrid::for_bounds(ball.bounds(), 14);
   NodeGeometry g;
   g.mesh = &ball;
-  g.normal_bits = kDerivedNormalBits;
+  g.normal_bits = bits;
   const TraversalCodec codec;
   const DecodedNode d = codec.decode(codec.encode(g, grid), grid, "derived");
   const uint32_t V = uint32_t(d.mesh.vertex_count());
   ASSERT_EQ(V, ball.vertex_count());
 
-  // The vertices (all closed) decode to their prediction, plain or smoothed (the encoder's choice), but for
-  // the few that the prediction's own error (the sphere's tessellation) puts more than a step off.
   std::vector<glm::vec3> padded(d.mesh.positions);
   padded.push_back(glm::vec3(0.0f));
   size_t at_prediction[2] = {0, 0};
@@ -233,18 +238,26 @@ TEST(DerivedNormals, ClosedVerticesWithinOneStepDecodeToThePrediction) {
     for (uint32_t v = 0; v < V; ++v)
       at_prediction[smooth] += angle(d.mesh.normals[v], glm::vec3(sum[v][0], sum[v][1], sum[v][2])) < 1e-5;
   }
-  EXPECT_GE(std::max(at_prediction[0], at_prediction[1]), V * 8 / 10);
-  // And within three code steps of the normal given (both codes within 1.8 steps with the 9-bit dead zone:
-  // 1.8 sqrt(2) = 2.55 steps apart at most) to the same position (the codec renumbers the
-  // vertices).
+  EXPECT_GE(std::max(at_prediction[0], at_prediction[1]), V * 8 / 10) << bits << " bits";
+  // (the codec renumbers the vertices: each decoded vertex is compared with the source's at its position)
   for (uint32_t v = 0; v < V; ++v) {
     uint32_t source = 0;
     for (uint32_t s = 1; s < V; ++s)
       if (glm::length(ball.positions[s] - d.mesh.positions[v]) <
           glm::length(ball.positions[source] - d.mesh.positions[v]))
         source = s;
-    EXPECT_LT(angle(d.mesh.normals[v], ball.normals[source]), 3.0 / (0.49 * 255)) << v;
+    EXPECT_LT(angle(d.mesh.normals[v], ball.normals[source]), 3.0 * step) << bits << " bits, vertex " << v;
   }
+}
+
+TEST(DerivedNormals, ClosedVerticesWithinOneStepDecodeToThePrediction) {
+  expect_closed_vertices_derived(kDerivedNormalBits);
+}
+
+// The coarse levels' normal bits (bake's --coarse-normal-bits 8, one less from shift 2) derive too.
+TEST(DerivedNormals, CoarseNormalBitsDeriveToo) {
+  expect_closed_vertices_derived(8);
+  expect_closed_vertices_derived(7);
 }
 
 }  // namespace
