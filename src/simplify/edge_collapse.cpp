@@ -966,26 +966,28 @@ class Simplifier {
   // Candidates live per face corner (slots_[3f + k]: the edge from corner k to corner k + 1), so that a
   // pass re-evaluates only edges with an end touched by the previous pass: an edge whose ends kept their
   // quadrics, positions and faces keeps its cost and allowed direction (open edges and seam twins only
-  // change at touched vertices). Every vertex is visited in parallel and reads its neighbours' touched_
-  // (O(T / cores) per pass; listing the neighbours of touched vertices first was a serial O(V) scan per pass,
-  // 3 % of the wall time on elephant_1m). An edge with a twin is evaluated once, from its smaller end. Every
-  // edge at a manifold vertex has a twin (its fan is a closed disc, and collapses keep it one: the link
-  // condition), so only other vertices walk their faces to find out (has_edge: 1 % of the instructions).
-  // Every touched edge is evaluated: elephant_1m 0.1 makes 8.3 evaluations per collapse (3.3 of them the
-  // first pass's, 1 the try's) in 6 passes, and nearly all touched edges fall under the next pass's limit, so
-  // evaluating them lazily (only once the limit reaches their old cost) saved 1.9 % of them, took 10 passes
-  // and raised the bound 2.8x.
+  // change at touched vertices). The faces are visited in order in parallel blocks, each corner's edge
+  // checking its ends' touched_ (O(T / cores) per pass, sequential in indices_ and slots_; listing the
+  // neighbours of touched vertices first was a serial O(V) scan per pass, 3 % of the wall time on
+  // elephant_1m; visiting each vertex's fan through faces_ searched each face for the vertex's corner:
+  // elephant_1m 0.1, this loop's own instructions 471.3 -> 396.8 M, callgrind). An edge with a twin is
+  // evaluated once, from its smaller end. Every edge at a manifold vertex has a twin (its fan is a closed
+  // disc, and collapses keep it one: the link condition), so only other vertices walk their faces to find out
+  // (has_edge: 1 % of the instructions). Every touched edge is evaluated: elephant_1m 0.1 makes 8.3
+  // evaluations per collapse (3.3 of them the first pass's, 1 the try's) in 6 passes, and nearly all touched
+  // edges fall under the next pass's limit, so evaluating them lazily (only once the limit reaches their old
+  // cost) saved 1.9 % of them, took 10 passes and raised the bound 2.8x.
   size_t run_pass(size_t target) {
-    const size_t m = source_.size();
     const bool all = slots_.size() != indices_.size();
     if (all) slots_.clear(), slots_.resize(indices_.size());  // every slot is written below
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 1024), [&](const auto& r) {
-      for (uint32_t i = r.begin(); i < r.end(); ++i) {
-        for (uint32_t s = offsets_[i]; s < offsets_[i + 1]; ++s) {  // faces are all alive (compact_faces)
-          const uint32_t* t = &indices_[3 * size_t(faces_[s])];
-          const uint32_t k = t[0] == i ? 0 : (t[1] == i ? 1 : 2), j = t[(k + 1) % 3];
+    const uint32_t faces = uint32_t(indices_.size() / 3);
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, faces, 2048), [&](const auto& r) {
+      for (uint32_t f = r.begin(); f < r.end(); ++f) {
+        const uint32_t* t = &indices_[3 * size_t(f)];  // faces are all alive (compact_faces)
+        for (uint32_t k = 0; k < 3; ++k) {
+          const uint32_t i = t[k], j = t[k == 2 ? 0 : k + 1];
           if (!all && !touched_[i] && !touched_[j]) continue;
-          Slot& slot = slots_[3 * size_t(faces_[s]) + k];
+          Slot& slot = slots_[3 * size_t(f) + k];
           if (i > j && (kind_[i] == kManifold || has_edge(j, i))) {
             slot = Slot::none();
           } else {
