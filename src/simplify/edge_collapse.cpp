@@ -1017,15 +1017,20 @@ class Simplifier {
   // Valid candidates in slots_ are visited in blocks of kSlotBlock slots, in parallel.
   static constexpr size_t kSlotBlock = size_t(1) << 16;
 
+  // The ends of slot s's edge as its face holds them: corner s % 3 and the next one. One remainder by 3 (a
+  // multiply): the prefetch chain, plan_listed and group_by_region read this about five times per candidate,
+  // and a second remainder for the next corner cost 61 M instructions on elephant_1m 0.1 (whole command
+  // 15,567.7 -> 15,506.8 M).
+  std::pair<uint32_t, uint32_t> edge(uint32_t s) const {
+    const uint32_t k = s % 3;
+    return {indices_[s], indices_[k == 2 ? s - 2 : s + 1]};
+  }
+
   // The candidate in slot s, its ends read from the face (Slot); a = kNone when the face is dead.
-  // One remainder by 3 (a multiply): the prefetch chain, plan_listed and group_by_region call this about
-  // five times per candidate, and a second remainder for the next corner cost 61 M instructions on
-  // elephant_1m 0.1 (whole command 15,567.7 -> 15,506.8 M).
   Candidate listed(uint32_t s) const {
-    const uint32_t k = s % 3, first = s - k;
     const Slot slot = slots_[s];
-    if (indices_[first] == kNone) return {slot.cost(), kNone, kNone};
-    const uint32_t i = indices_[s], j = indices_[k == 2 ? first : s + 1];
+    if (indices_[s - s % 3] == kNone) return {slot.cost(), kNone, kNone};
+    const auto [i, j] = edge(s);
     return slot.reverse() ? Candidate{slot.cost(), j, i} : Candidate{slot.cost(), i, j};
   }
 
@@ -1156,20 +1161,19 @@ class Simplifier {
     const uint32_t regions = region_of(uint32_t(source_.size())) + 1;
     const size_t n = order_.size();
     sorted_.resize(n);
-    // Each candidate's region, read from its slot once (counting_sort calls key twice) and looked up
-    // kRegionAhead candidates ahead: order_ is in cost order, so the slots are random reads into an array of
-    // 12 bytes per corner, most of them cache misses (this sort took about as long as gather_candidates).
+    // Each candidate's region, read from its face once (counting_sort calls key twice) and looked up
+    // kRegionAhead candidates ahead: order_ is in cost order, so the faces are random reads, most of them
+    // cache misses (this sort took about as long as gather_candidates). Only the edge's ends are read (all
+    // faces are alive at the start of a pass, and the region does not depend on the direction): the slot
+    // itself was a second miss per candidate.
     constexpr size_t kRegionAhead = 16;
     UninitializedVector<uint32_t> region(n);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const auto& r) {
       for (size_t i = r.begin(); i < r.end(); ++i) {
-        if (i + kRegionAhead < r.end()) {
-          const uint32_t ahead = order_[i + kRegionAhead].slot;
-          __builtin_prefetch(&slots_[ahead]), __builtin_prefetch(&indices_[ahead - ahead % 3]);
-        }
-        const Candidate c = listed(order_[i].slot);
-        const uint32_t ra = region_of(c.a);
-        region[i] = ra == region_of(c.b) ? ra : kAnyRegion;
+        if (i + kRegionAhead < r.end()) __builtin_prefetch(&indices_[order_[i + kRegionAhead].slot]);
+        const auto [a, b] = edge(order_[i].slot);
+        const uint32_t ra = region_of(a);
+        region[i] = ra == region_of(b) ? ra : kAnyRegion;
       }
     });
     counting_sort(
