@@ -304,7 +304,11 @@ class Simplifier {
   size_t alive_triangles_ = 0, welded_triangles_ = 0;  // welded_: before the first collapse
   std::vector<uint32_t> offsets_, faces_;              // vertex -> faces (CSR), rebuilt each pass
   UninitializedVector<Slot> slots_;
-  std::vector<Ranked> order_, sorted_;
+  // Uninitialized: the first pass's resizes (elephant_1m 0.1: 894,508 candidates, 7 MB each) were a serial
+  // zero fill and the arrays' first touch, 16-25 ms of CPU each with the other core idle (temporary timers,
+  // load 6); now their pages are first touched by the parallel writes of gather_candidates and
+  // counting_sort. Every element is written before it is read.
+  UninitializedVector<Ranked> order_, sorted_;
   std::vector<float> bucket_;  // goal_cost's candidate costs in one histogram bucket
   // Regions of the collapse loop's parallel part (region_of): runs of region_vertices_ vertex numbers in
   // Morton order (about kRegionVertices alive vertices, at least kMinRegions regions on a smaller mesh; the
@@ -966,26 +970,28 @@ class Simplifier {
   // Candidates live per face corner (slots_[3f + k]: the edge from corner k to corner k + 1), so that a
   // pass re-evaluates only edges with an end touched by the previous pass: an edge whose ends kept their
   // quadrics, positions and faces keeps its cost and allowed direction (open edges and seam twins only
-  // change at touched vertices). Every vertex is visited in parallel and reads its neighbours' touched_
-  // (O(T / cores) per pass; listing the neighbours of touched vertices first was a serial O(V) scan per pass,
-  // 3 % of the wall time on elephant_1m). An edge with a twin is evaluated once, from its smaller end. Every
-  // edge at a manifold vertex has a twin (its fan is a closed disc, and collapses keep it one: the link
-  // condition), so only other vertices walk their faces to find out (has_edge: 1 % of the instructions).
-  // Every touched edge is evaluated: elephant_1m 0.1 makes 8.3 evaluations per collapse (3.3 of them the
-  // first pass's, 1 the try's) in 6 passes, and nearly all touched edges fall under the next pass's limit, so
-  // evaluating them lazily (only once the limit reaches their old cost) saved 1.9 % of them, took 10 passes
-  // and raised the bound 2.8x.
+  // change at touched vertices). The faces are visited in order in parallel blocks, each corner's edge
+  // checking its ends' touched_ (O(T / cores) per pass, sequential in indices_ and slots_; listing the
+  // neighbours of touched vertices first was a serial O(V) scan per pass, 3 % of the wall time on
+  // elephant_1m; visiting each vertex's fan through faces_ searched each face for the vertex's corner:
+  // elephant_1m 0.1, this loop's own instructions 471.3 -> 396.8 M, callgrind). An edge with a twin is
+  // evaluated once, from its smaller end. Every edge at a manifold vertex has a twin (its fan is a closed
+  // disc, and collapses keep it one: the link condition), so only other vertices walk their faces to find out
+  // (has_edge: 1 % of the instructions). Every touched edge is evaluated: elephant_1m 0.1 makes 8.3
+  // evaluations per collapse (3.3 of them the first pass's, 1 the try's) in 6 passes, and nearly all touched
+  // edges fall under the next pass's limit, so evaluating them lazily (only once the limit reaches their old
+  // cost) saved 1.9 % of them, took 10 passes and raised the bound 2.8x.
   size_t run_pass(size_t target) {
-    const size_t m = source_.size();
     const bool all = slots_.size() != indices_.size();
     if (all) slots_.clear(), slots_.resize(indices_.size());  // every slot is written below
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 1024), [&](const auto& r) {
-      for (uint32_t i = r.begin(); i < r.end(); ++i) {
-        for (uint32_t s = offsets_[i]; s < offsets_[i + 1]; ++s) {  // faces are all alive (compact_faces)
-          const uint32_t* t = &indices_[3 * size_t(faces_[s])];
-          const uint32_t k = t[0] == i ? 0 : (t[1] == i ? 1 : 2), j = t[(k + 1) % 3];
+    const uint32_t faces = uint32_t(indices_.size() / 3);
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, faces, 2048), [&](const auto& r) {
+      for (uint32_t f = r.begin(); f < r.end(); ++f) {
+        const uint32_t* t = &indices_[3 * size_t(f)];  // faces are all alive (compact_faces)
+        for (uint32_t k = 0; k < 3; ++k) {
+          const uint32_t i = t[k], j = t[k == 2 ? 0 : k + 1];
           if (!all && !touched_[i] && !touched_[j]) continue;
-          Slot& slot = slots_[3 * size_t(faces_[s]) + k];
+          Slot& slot = slots_[3 * size_t(f) + k];
           if (i > j && (kind_[i] == kManifold || has_edge(j, i))) {
             slot = Slot::none();
           } else {
@@ -1015,12 +1021,20 @@ class Simplifier {
   // Valid candidates in slots_ are visited in blocks of kSlotBlock slots, in parallel.
   static constexpr size_t kSlotBlock = size_t(1) << 16;
 
+  // The ends of slot s's edge as its face holds them: corner s % 3 and the next one. One remainder by 3 (a
+  // multiply): the prefetch chain, plan_listed and group_by_region read this about five times per candidate,
+  // and a second remainder for the next corner cost 61 M instructions on elephant_1m 0.1 (whole command
+  // 15,567.7 -> 15,506.8 M).
+  std::pair<uint32_t, uint32_t> edge(uint32_t s) const {
+    const uint32_t k = s % 3;
+    return {indices_[s], indices_[k == 2 ? s - 2 : s + 1]};
+  }
+
   // The candidate in slot s, its ends read from the face (Slot); a = kNone when the face is dead.
   Candidate listed(uint32_t s) const {
-    const uint32_t first = s - s % 3;
     const Slot slot = slots_[s];
-    if (indices_[first] == kNone) return {slot.cost(), kNone, kNone};
-    const uint32_t i = indices_[s], j = indices_[first + (s - first + 1) % 3];
+    if (indices_[s - s % 3] == kNone) return {slot.cost(), kNone, kNone};
+    const auto [i, j] = edge(s);
     return slot.reverse() ? Candidate{slot.cost(), j, i} : Candidate{slot.cost(), i, j};
   }
 
@@ -1151,20 +1165,19 @@ class Simplifier {
     const uint32_t regions = region_of(uint32_t(source_.size())) + 1;
     const size_t n = order_.size();
     sorted_.resize(n);
-    // Each candidate's region, read from its slot once (counting_sort calls key twice) and looked up
-    // kRegionAhead candidates ahead: order_ is in cost order, so the slots are random reads into an array of
-    // 12 bytes per corner, most of them cache misses (this sort took about as long as gather_candidates).
+    // Each candidate's region, read from its face once (counting_sort calls key twice) and looked up
+    // kRegionAhead candidates ahead: order_ is in cost order, so the faces are random reads, most of them
+    // cache misses (this sort took about as long as gather_candidates). Only the edge's ends are read (all
+    // faces are alive at the start of a pass, and the region does not depend on the direction): the slot
+    // itself was a second miss per candidate.
     constexpr size_t kRegionAhead = 16;
     UninitializedVector<uint32_t> region(n);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const auto& r) {
       for (size_t i = r.begin(); i < r.end(); ++i) {
-        if (i + kRegionAhead < r.end()) {
-          const uint32_t ahead = order_[i + kRegionAhead].slot;
-          __builtin_prefetch(&slots_[ahead]), __builtin_prefetch(&indices_[ahead - ahead % 3]);
-        }
-        const Candidate c = listed(order_[i].slot);
-        const uint32_t ra = region_of(c.a);
-        region[i] = ra == region_of(c.b) ? ra : kAnyRegion;
+        if (i + kRegionAhead < r.end()) __builtin_prefetch(&indices_[order_[i + kRegionAhead].slot]);
+        const auto [a, b] = edge(order_[i].slot);
+        const uint32_t ra = region_of(a);
+        region[i] = ra == region_of(b) ? ra : kAnyRegion;
       }
     });
     counting_sort(
@@ -1284,7 +1297,7 @@ class Simplifier {
   // 11 + 11 + 10 bits, each digit a counting_sort on both cores.
   void radix_sort_by_cost() {
     sorted_.resize(order_.size());
-    std::vector<Ranked>*src = &order_, *dst = &sorted_;
+    UninitializedVector<Ranked>*src = &order_, *dst = &sorted_;
     for (int shift : {0, 11, 22}) {
       auto digit = [&, shift](size_t i) {
         uint32_t u;
