@@ -1496,7 +1496,7 @@ class Simplifier {
     const glm::dvec3 w = glm::cross(n, u);
     // q's projection (u.q, w.q) and height n.q in the lanes of one vector (one register in the AVX2
     // version): the three glm::dot in three multiplications and two additions, each lane in glm::dot's
-    // order ((x + y) + z), so the same bits (horse 0.1 callgrind: vertical_bound 224.6 -> 216.4 M
+    // order ((x + y) + z), so the same bits (horse 0.1 callgrind: vertical_bound 224.6 -> 215.5 M
     // instructions). The fourth lane repeats n's: a zero there had GCC 12 copy registers with the vmovq
     // form valgrind 3.19 cannot decode.
     const WideLanes lift_x{u.x, w.x, n.x, n.x}, lift_y{u.y, w.y, n.y, n.y}, lift_z{u.z, w.z, n.z, n.z};
