@@ -3,6 +3,8 @@
 // the same distances from its new origin.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstring>
 #include <random>
 
 #include "simplify/quadric.hpp"
@@ -76,6 +78,20 @@ TEST(Quadric, ShiftedSumIsTheScalarFormulaBitForBit) {
     const glm::dvec3 y(u(rng), u(rng), u(rng));
     EXPECT_NEAR(shifted.eval(y), plain.eval(y + d), 1e-12 * (1 + plain.eval(y + d)));
   }
+}
+
+TEST(Quadric, WidenConvertsTwoFloatsExactly) {
+  // The pair conversion (one cvtps2pd on x86-64) gives what two scalar conversions give, bit for bit,
+  // including zeros' signs, subnormals, infinities and the largest float; in either lane.
+  const float values[] = {0.0f,          -0.0f,    1.0f,      -1.5f, 0x1p-149f, -0x1p-126f,
+                          3.4028235e38f, INFINITY, -INFINITY, 0.1f,  1e-7f};
+  for (float x : values)
+    for (float y : values) {
+      const float pair[2] = {x, y};
+      const Lanes l = widen(pair);
+      const double expected[2] = {double(x), double(y)}, got[2] = {l[0], l[1]};
+      EXPECT_EQ(std::memcmp(got, expected, sizeof got), 0) << x << ", " << y;
+    }
 }
 
 TEST(Quadric, EliminationIsTheScalarFormulaBitForBit) {
