@@ -344,6 +344,8 @@ void decode_predicted_vertices(const PredictiveNode& p, std::span<const uint32_t
     thread_local std::vector<NormalSum> sum;
     predicted_normals(m.indices, p.first_vertex, p.index_end, m.positions.data(), V, p.smooth_normals, sum);
     decode_predicted_normals(sum, V, p.normal_planes.data(), p.normal_bytes, p.normal_bits, m.normals);
+  } else {
+    m.normals.clear();
   }
   m.positions.resize(V);
   decode_attribute_stream(p.attribute_stream, p.flags, V, p.uv_min, p.uv_extent, out, where);
