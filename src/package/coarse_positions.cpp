@@ -108,10 +108,17 @@ void decode_positions(std::span<const int64_t> c, const LockedStream& locked, co
     for (int a = 0; a < 3; ++a) {
       int64_t q = c[3 * v + a] * (int64_t(1) << k);
       if (is_locked) {
-        // k ≤ 24 bits at bit offset ≤ 7 lie in 4 bytes; parse() checked that they exist.
+        // k ≤ 24 bits at bit offset ≤ 7 lie in 4 bytes; parse() checked that they exist. One 4-byte load
+        // (little-endian) where 4 bytes remain, byte by byte at the stream's end.
+        const size_t at = bit / 8;
         uint64_t window = 0;
-        for (size_t b = 0; b < 4 && bit / 8 + b < residual_bytes; ++b)
-          window |= uint64_t(residuals[bit / 8 + b]) << (8 * b);
+        if (at + 4 <= residual_bytes) {
+          uint32_t word;
+          std::memcpy(&word, residuals + at, 4);
+          window = word;
+        } else {
+          for (size_t b = 0; at + b < residual_bytes; ++b) window |= uint64_t(residuals[at + b]) << (8 * b);
+        }
         q += static_cast<int64_t>((window >> (bit % 8)) & mask);
         bit += k;
       }
