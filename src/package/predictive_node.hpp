@@ -112,10 +112,10 @@ std::vector<uint8_t> write_predictive_node(const NodeHeader& header, const Predi
                                            std::span<const uint8_t> connectivity,
                                            std::span<const uint8_t> tail);
 
-// The decoder's side: out.mesh.positions and (with normals) out.mesh.normals, UVs, colours and vertex_data of
-// a parsed node whose out.mesh.indices are decoded, from `predictors` (3V entries or more; any values: they
-// index entries below V + 1 only). Throws lodstream::Error starting with `where` on positions off the grid's
-// range. Cost: O(T + V).
+// The decoder's side: out.mesh.positions and out.mesh.normals (cleared without), UVs, colours and vertex_data
+// of a parsed node whose out.mesh.indices are decoded, from `predictors` (3V entries or more; any values:
+// they index entries below V + 1 only). Throws lodstream::Error starting with `where` on positions off the
+// grid's range. Cost: O(T + V).
 void decode_predicted_vertices(const PredictiveNode& node, std::span<const uint32_t> predictors,
                                const Parallelograms* extra, const PositionGrid& grid, DecodedNode& out,
                                const std::string& where);

@@ -74,8 +74,10 @@ void TraversalCodec::decode_into(std::span<const uint8_t> bytes, const PositionG
   }
   const PredictiveNode p = PredictiveNode::parse(bytes, kFormat, kAllFlags, where);
   const uint32_t V = p.vertices;
-  // What the node may not hold cleared (capacity kept); the rest overwritten.
-  out.mesh.normals.clear(), out.mesh.uvs.clear(), out.mesh.colors.clear(), out.mesh.material = 0;
+  // What the node may not hold cleared (capacity kept); the rest overwritten (the normals by
+  // decode_predicted_vertices, which clears them for a node without: resized from the last record's count,
+  // they are zero-filled only where they grow).
+  out.mesh.uvs.clear(), out.mesh.colors.clear(), out.mesh.material = 0;
   out.vertex_data.clear(), out.extra.clear();
   out.first_vertex = 0, out.index_end = V;
   out.mesh.indices.resize(3 * size_t(p.triangles));  // zero-fills only beyond the size it had
