@@ -704,9 +704,14 @@ class Simplifier {
       const glm::vec3 ge1 = glm::cross(e2, n) / (len * len), ge2 = glm::cross(n, e1) / (len * len);
       for (int j = 0; j < channels; ++j) {
         gradient[j] = {(s1[j] - s0[j]) * ge1 + (s2[j] - s0[j]) * ge2, s0[j]};
-        face.add_plane(gradient[j].g, gradient[j].d, area);
+        FloatLanes nd;  // (g, d)
+        std::memcpy(&nd, &gradient[j], sizeof nd);
+        face.add_plane(nd, area);
       }
     }
+    // The face's terms in memory for the shifts' 8-byte loads (widen): held in registers, GCC 12 builds
+    // them with vmovq xmm, xmm, which valgrind 3.19 cannot decode.
+    asm("" : "+m"(face));
     for (int k = 0; k < 3; ++k) {  // relative to each corner's own origin (origin_of)
       const uint32_t v = k == 0 ? v0 : (k == 1 ? v1 : v2);
       if (!mine(v)) continue;
@@ -715,9 +720,15 @@ class Simplifier {
         quadric_[v].add(face);  // the shift by 0
       else
         quadric_[v].add_shifted(face, glm::dvec3(d));
+      // (G, D) += area (g, d + g.d) for each channel, the four floats in vector lanes (the same operations
+      // per lane as the scalar expressions, so the same bits).
       for (int j = 0; j < channels; ++j) {
-        attr_[v * size_t(channels) + j].g += area * gradient[j].g;
-        attr_[v * size_t(channels) + j].d += area * (gradient[j].d + glm::dot(gradient[j].g, d));
+        FloatLanes sum, term;
+        char* t = reinterpret_cast<char*>(&attr_[v * size_t(channels) + j]);
+        std::memcpy(&sum, t, sizeof sum), std::memcpy(&term, &gradient[j], sizeof term);
+        term[3] += glm::dot(gradient[j].g, d);
+        sum += area * term;
+        std::memcpy(t, &sum, sizeof sum);
       }
     }
   }

@@ -18,6 +18,9 @@
 
 namespace lodstream::simplify {
 
+// Four floats in vector lanes (GCC's generic vectors; see Lanes below).
+using FloatLanes = float __attribute__((vector_size(16)));
+
 struct Quadric {
   float a00 = 0, a01 = 0, a02 = 0, a11 = 0, a12 = 0, a22 = 0;
   float b0 = 0, b1 = 0, b2 = 0;
@@ -30,13 +33,20 @@ struct Quadric {
   }
   // Adds q, which is stored relative to an origin `d` away from this one's (see Reduced::add).
   inline void add_shifted(const Quadric& q, const glm::dvec3& d);
-  // Adds weight * (n.p + d)^2 (n need not be unit: a gradient g with offset d adds (g.p + d)^2).
+  // Adds weight * (n.p + d)^2 (n need not be unit: a gradient g with offset d adds (g.p + d)^2): each term
+  // (weight x first factor) x second factor, as the scalar expressions a00 += weight * n.x * n.x, ..., c +=
+  // weight * d * d would give them (the first eight in two float vectors: the same operations per lane, so
+  // the same bits). nd: (n, d), as an AttributeTerm holds them.
+  // (A constant d = 0 had GCC 12 zero lanes with vmovq xmm, xmm, which valgrind 3.19 cannot decode: the
+  // empty asm hides the lanes' values.)
   void add_plane(const glm::vec3& n, float d, float weight) {
-    a00 += weight * n.x * n.x, a01 += weight * n.x * n.y, a02 += weight * n.x * n.z;
-    a11 += weight * n.y * n.y, a12 += weight * n.y * n.z, a22 += weight * n.z * n.z;
-    b0 += weight * d * n.x, b1 += weight * d * n.y, b2 += weight * d * n.z;
-    c += weight * d * d;
+    FloatLanes nd{n.x, n.y, n.z, d};
+#if defined(__SSE2__)
+    asm("" : "+x"(nd));
+#endif
+    add_plane(nd, weight);
   }
+  inline void add_plane(FloatLanes nd, float weight);
 };
 
 // Attribute part of one vertex's quadric: G (3) and D (1) per attribute channel, W shared (Quadric::w).
@@ -45,13 +55,12 @@ struct AttributeTerm {
   float d = 0.0f;
 };
 
-// Two doubles in vector lanes (GCC's generic vectors: SSE2 on x86-64, plain code elsewhere); four floats;
+// Two doubles in vector lanes (GCC's generic vectors: SSE2 on x86-64, plain code elsewhere), like FloatLanes;
 // four doubles (two SSE registers, one AVX register). Each lane computes what the scalar expression would,
 // bit for bit: the same operations in the same order, and nothing fused into multiply-adds (x86-64's baseline
 // has no FMA; a build with -mfma or for another target may contract the two differently, which test_quadric
 // would show).
 using Lanes = double __attribute__((vector_size(16)));
-using FloatLanes = float __attribute__((vector_size(16)));
 using WideLanes = double __attribute__((vector_size(32)));
 
 // The two floats at `at` as a pair of doubles (exact). On x86-64 one 8-byte load and one cvtps2pd: GCC 12
@@ -184,6 +193,18 @@ struct Reduced {
     return t < 0 ? 0 : (t > 1 ? 1 : t);
   }
 };
+
+void Quadric::add_plane(FloatLanes nd, float weight) {
+  // (a00, a01, a02, a11) += (w nx) (nx, ny, nz, ny); (a12, a22, b0, b1) += (w ny, w nz, w d, w d) (nz, nz,
+  // nx, ny); b2 += (w d) nz; c += (w d) d. The lanes are shuffles of nd (one instruction each).
+  char* at = reinterpret_cast<char*>(this);  // a00, then a12 16 bytes on
+  FloatLanes lo, hi;
+  std::memcpy(&lo, at, sizeof lo), std::memcpy(&hi, at + 16, sizeof hi);
+  lo += weight * __builtin_shufflevector(nd, nd, 0, 0, 0, 1) * __builtin_shufflevector(nd, nd, 0, 1, 2, 1);
+  hi += weight * __builtin_shufflevector(nd, nd, 1, 2, 3, 3) * __builtin_shufflevector(nd, nd, 2, 2, 0, 1);
+  std::memcpy(at, &lo, sizeof lo), std::memcpy(at + 16, &hi, sizeof hi);
+  b2 += weight * nd[3] * nd[2], c += weight * nd[3] * nd[3];
+}
 
 void Quadric::add_shifted(const Quadric& q, const glm::dvec3& d) {
   Reduced r;

@@ -80,6 +80,34 @@ TEST(Quadric, ShiftedSumIsTheScalarFormulaBitForBit) {
   }
 }
 
+TEST(Quadric, PlaneIsTheScalarFormulaBitForBit) {
+  // Quadric::add_plane (two float vectors and two scalars): each term (weight x first factor) x second
+  // factor, added to the term before, as the header's scalar formulas; from a vec3 and d (d = 0 as for a
+  // face's plane, or any), and from the (g, d) lanes as build_quadrics passes an AttributeTerm.
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), w(0.01f, 2.0f);
+  for (int trial = 0; trial < 200; ++trial) {
+    const Quadric q = random_quadric(rng);
+    const glm::vec3 n(u(rng), u(rng), u(rng));
+    const float d = trial % 2 ? 0.0f : u(rng), weight = w(rng);
+    const float expected[10] = {q.a00 + weight * n.x * n.x, q.a01 + weight * n.x * n.y,
+                                q.a02 + weight * n.x * n.z, q.a11 + weight * n.y * n.y,
+                                q.a12 + weight * n.y * n.z, q.a22 + weight * n.z * n.z,
+                                q.b0 + weight * d * n.x,    q.b1 + weight * d * n.y,
+                                q.b2 + weight * d * n.z,    q.c + weight * d * d};
+    Quadric from_vec3 = q, from_lanes = q;
+    from_vec3.add_plane(n, d, weight);
+    const AttributeTerm term{n, d};
+    FloatLanes nd;
+    std::memcpy(&nd, &term, sizeof nd);
+    from_lanes.add_plane(nd, weight);
+    for (const Quadric& got : {from_vec3, from_lanes}) {
+      EXPECT_EQ(std::memcmp(&got, expected, sizeof expected), 0) << "trial " << trial;
+      EXPECT_EQ(got.w, q.w);
+    }
+  }
+}
+
 TEST(Quadric, WidenConvertsTwoFloatsExactly) {
   // The pair conversion (one cvtps2pd on x86-64) gives what two scalar conversions give, bit for bit,
   // including zeros' signs, subnormals, infinities and the largest float; in either lane.
