@@ -184,7 +184,9 @@ struct Reduced {
     return std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z);
   }
   // Minimum along the segment p + t e, t in [0,1] (digest §7.6.2: t* = -(e^T A p + b.e) / (e^T A e)).
-  double segment_parameter(const glm::dvec3& p, const glm::dvec3& e) const {
+  // Always inlined: GCC 12 left it a call from place after an unrelated change (elephant_1m 0.1
+  // callgrind, that build: place 3,225.9 M + segment_parameter 91.3 M; inlined, 3,297.1 M).
+  [[gnu::always_inline]] double segment_parameter(const glm::dvec3& p, const glm::dvec3& e) const {
     glm::dvec3 ae{a00() * e.x + a01() * e.y + a02() * e.z, a01() * e.x + a11() * e.y + a12() * e.z,
                   a02() * e.x + a12() * e.y + a22() * e.z};
     double den = glm::dot(e, ae);
