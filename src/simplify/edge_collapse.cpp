@@ -15,6 +15,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <ctime>
 #include <span>
 #include <utility>
 
@@ -43,6 +44,13 @@ namespace {
 #define LODSTREAM_RUNS_AVX2() false
 #endif
 
+
+struct TmpT {
+  timespec w0, c0;
+  static double ms(const timespec& a, const timespec& b) { return (b.tv_sec - a.tv_sec) * 1e3 + (b.tv_nsec - a.tv_nsec) * 1e-6; }
+  TmpT() { clock_gettime(CLOCK_MONOTONIC, &w0); clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0); }
+  ~TmpT() { timespec w1, c1; clock_gettime(CLOCK_MONOTONIC, &w1); clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1); fprintf(stderr, "\nTMP weld wall %.1f cpu %.1f\n", ms(w0, w1), ms(c0, c1)); }
+};
 constexpr uint32_t kNone = UINT32_MAX;
 enum Kind : uint8_t { kManifold, kBorder, kSeam, kLocked };
 
@@ -207,7 +215,7 @@ class Simplifier {
   Result run() {
     Result result;
     result.input_triangles = in_.triangle_count();
-    weld();
+    { TmpT t; weld(); }
     result.weld_remap = weld_remap_;
     build_adjacency();
     classify();
@@ -304,7 +312,7 @@ class Simplifier {
   double prior_error_ = 0.0;    // the largest Options::vertex_error, model units
   bool error_limited_ = false;  // a collapse was refused because of Options::max_error
 
-  std::vector<uint32_t> indices_;  // alive faces; dead ones have indices_[3f] == kNone during a pass
+  UninitializedVector<uint32_t> indices_;  // alive faces; dead ones have indices_[3f] == kNone during a pass
   size_t alive_triangles_ = 0, welded_triangles_ = 0;  // welded_: before the first collapse
   std::vector<uint32_t> offsets_, faces_;              // vertex -> faces (CSR), rebuilt each pass
   UninitializedVector<Slot> slots_;
@@ -414,19 +422,19 @@ class Simplifier {
       r = std::max(r, std::nextafter(float(e / double(scale_) * (1 + 1e-6)), INFINITY));
     }
 
-    indices_.resize(in_.indices.size() / 3 * 3);  // written in place below (an insert per face cost ~60
-                                                  // instructions), then cut to the faces kept
-    size_t kept = 0;
-    for (size_t t = 0; t + 2 < in_.indices.size(); t += 3) {
-      uint32_t a = in_.indices[t], b = in_.indices[t + 1], c = in_.indices[t + 2];
-      if (a >= n || b >= n || c >= n) continue;
-      a = weld_remap_[a], b = weld_remap_[b], c = weld_remap_[c];
-      if (a == b || b == c || a == c) continue;
-      indices_[kept] = a, indices_[kept + 1] = b, indices_[kept + 2] = c, kept += 3;
-    }
-    indices_.resize(kept);
-    alive_triangles_ = welded_triangles_ = indices_.size() / 3;
+    // The faces on welded vertices, in place on every core (uninitialized: first touched there); one with a
+    // vertex out of range or repeated is marked dead, and sort_faces leaves it out. Was a serial loop that
+    // cut the dead ones (about 28 instructions per face) after a serial zero fill.
+    const size_t input_faces = in_.indices.size() / 3;
+    indices_.resize(3 * input_faces);
+    for_each(size_t(0), input_faces, [&](size_t t) {
+      uint32_t a = in_.indices[3 * t], b = in_.indices[3 * t + 1], c = in_.indices[3 * t + 2];
+      if (a < n && b < n && c < n) a = weld_remap_[a], b = weld_remap_[b], c = weld_remap_[c];
+      const bool dead = a >= n || b >= n || c >= n || a == b || b == c || a == c;
+      indices_[3 * t] = dead ? kNone : a, indices_[3 * t + 1] = b, indices_[3 * t + 2] = c;
+    });
     sort_faces();
+    alive_triangles_ = welded_triangles_ = indices_.size() / 3;
   }
 
   // Orders the faces by their smallest vertex, stably (vertices are in Morton order), so that the faces
@@ -435,8 +443,8 @@ class Simplifier {
   // try_collapse's samples on elephant_1m). Two stable counting sorts, on every core: by runs of `span`
   // vertices (counting_sort), then each run's faces by their vertex. Up to kMaxRuns runs, about kRunFaces
   // faces each: a DAG group of 800 faces in 4096 runs spent most of its sort on empty runs (77 M of the
-  // bake's 1.6 G simplifier instructions on refined_elephant). The order does not depend on the runs. O(T +
-  // V).
+  // bake's 1.6 G simplifier instructions on refined_elephant). The order does not depend on the runs. Dead
+  // faces (weld's) are left out. O(T + V).
   void sort_faces() {
     constexpr size_t kMaxRuns = 4096, kRunFaces = 64;
     const size_t faces = indices_.size() / 3;
@@ -448,9 +456,9 @@ class Simplifier {
     UninitializedVector<uint32_t> by_run(faces);
     std::vector<uint32_t> run_start;
     counting_sort(
-        faces, run_count, [&](size_t f) { return key(f) / span; },
+        faces, run_count, [&](size_t f) { return indices_[3 * f] == kNone ? run_count : key(f) / span; },
         [&](size_t f, uint32_t position) { by_run[position] = uint32_t(f); }, &run_start);
-    std::vector<uint32_t> sorted(indices_.size());
+    UninitializedVector<uint32_t> sorted(3 * size_t(run_start[run_count]));  // each written once below
     for_blocks(run_count, 64, [&](const auto& runs) {
       std::vector<uint32_t> start(span + 1);
       for (uint32_t r = runs.begin(); r < runs.end(); ++r) {
@@ -1847,7 +1855,7 @@ class Simplifier {
     both.add(out.bounds());
     const float cap = float((double(both.diagonal()) + prior_error_) * (1 + 1e-6));
     for (float& e : result.vertex_error) e = std::min(e, cap);
-    out.indices = std::move(indices_);
+    out.indices.assign(indices_.begin(), indices_.end());
     result.error_bound = 0.0;
     for (float e : result.vertex_error) result.error_bound = std::max(result.error_bound, double(e));
   }
