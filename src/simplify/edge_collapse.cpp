@@ -44,12 +44,21 @@ namespace {
 #define LODSTREAM_RUNS_AVX2() false
 #endif
 
-
 struct TmpT {
   timespec w0, c0;
-  static double ms(const timespec& a, const timespec& b) { return (b.tv_sec - a.tv_sec) * 1e3 + (b.tv_nsec - a.tv_nsec) * 1e-6; }
-  TmpT() { clock_gettime(CLOCK_MONOTONIC, &w0); clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0); }
-  ~TmpT() { timespec w1, c1; clock_gettime(CLOCK_MONOTONIC, &w1); clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1); fprintf(stderr, "\nTMP weld wall %.1f cpu %.1f\n", ms(w0, w1), ms(c0, c1)); }
+  static double ms(const timespec& a, const timespec& b) {
+    return (b.tv_sec - a.tv_sec) * 1e3 + (b.tv_nsec - a.tv_nsec) * 1e-6;
+  }
+  TmpT() {
+    clock_gettime(CLOCK_MONOTONIC, &w0);
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
+  }
+  ~TmpT() {
+    timespec w1, c1;
+    clock_gettime(CLOCK_MONOTONIC, &w1);
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
+    fprintf(stderr, "\nTMP weld wall %.1f cpu %.1f\n", ms(w0, w1), ms(c0, c1));
+  }
 };
 constexpr uint32_t kNone = UINT32_MAX;
 enum Kind : uint8_t { kManifold, kBorder, kSeam, kLocked };
@@ -215,7 +224,10 @@ class Simplifier {
   Result run() {
     Result result;
     result.input_triangles = in_.triangle_count();
-    { TmpT t; weld(); }
+    {
+      TmpT t;
+      weld();
+    }
     result.weld_remap = weld_remap_;
     build_adjacency();
     classify();
@@ -601,22 +613,27 @@ class Simplifier {
     for_blocks(uint32_t(m), 4096, [&](const auto& r) {
       for (uint32_t v = r.begin(); v < r.end(); ++v) classify_fan(v, open_count, complex);
     });
-    for (uint32_t v = 0; v < m; ++v) {
-      if (kind_[v] == kLocked || complex[v]) {
-        kind_[v] = kLocked;
-        continue;
+    // Each vertex's kind from its own (user-locked) kind and the fans' results: on every core (one core took
+    // 11.4 M instructions on elephant_1m).
+    for_blocks(uint32_t(m), 4096, [&](const auto& r) {
+      for (uint32_t v = r.begin(); v < r.end(); ++v) {
+        if (kind_[v] == kLocked || complex[v]) {
+          kind_[v] = kLocked;
+          continue;
+        }
+        uint32_t w = wedge_[v];
+        if (w == v) {
+          kind_[v] = open_count[v] == 0 ? kManifold : kBorder;
+        } else if (wedge_[w] == v && open_count[v] == 1 && open_count[w] == 1 && !complex[w] &&
+                   pid_[open_out_[v]] == pid_[open_in_[w]] && pid_[open_in_[v]] == pid_[open_out_[w]]) {
+          kind_[v] = kSeam;
+        } else {
+          kind_[v] = kLocked;
+        }
       }
-      uint32_t w = wedge_[v];
-      if (w == v) {
-        kind_[v] = open_count[v] == 0 ? kManifold : kBorder;
-      } else if (wedge_[w] == v && open_count[v] == 1 && open_count[w] == 1 && !complex[w] &&
-                 pid_[open_out_[v]] == pid_[open_in_[w]] && pid_[open_in_[v]] == pid_[open_out_[w]]) {
-        kind_[v] = kSeam;
-      } else {
-        kind_[v] = kLocked;
-      }
-    }
-    // A seam vertex whose partner was locked by the user is locked too.
+    });
+    // A seam vertex whose partner was locked by the user is locked too (serially, in order: a vertex locked
+    // here also locks a later partner).
     for (uint32_t v = 0; v < m; ++v)
       if (kind_[v] == kSeam && kind_[wedge_[v]] != kSeam) kind_[v] = kLocked;
   }
