@@ -4,6 +4,7 @@
 // neither seams nor a bound).
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
@@ -14,6 +15,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <ctime>
 #include <span>
 #include <utility>
 #if defined(__SSE2__)
@@ -45,6 +47,22 @@ namespace {
 #define LODSTREAM_RUNS_AVX2() false
 #endif
 
+struct TmpT {
+  timespec w0, c0;
+  static double ms(const timespec& a, const timespec& b) {
+    return (b.tv_sec - a.tv_sec) * 1e3 + (b.tv_nsec - a.tv_nsec) * 1e-6;
+  }
+  TmpT() {
+    clock_gettime(CLOCK_MONOTONIC, &w0);
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
+  }
+  ~TmpT() {
+    timespec w1, c1;
+    clock_gettime(CLOCK_MONOTONIC, &w1);
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
+    fprintf(stderr, "\nTMP weld wall %.1f cpu %.1f\n", ms(w0, w1), ms(c0, c1));
+  }
+};
 constexpr uint32_t kNone = UINT32_MAX;
 enum Kind : uint8_t { kManifold, kBorder, kSeam, kLocked };
 
@@ -232,7 +250,10 @@ class Simplifier {
   Result run() {
     Result result;
     result.input_triangles = in_.triangle_count();
-    weld();
+    {
+      TmpT t;
+      weld();
+    }
     result.weld_remap = weld_remap_;
     build_adjacency();
     classify();
@@ -329,7 +350,7 @@ class Simplifier {
   double prior_error_ = 0.0;    // the largest Options::vertex_error, model units
   bool error_limited_ = false;  // a collapse was refused because of Options::max_error
 
-  std::vector<uint32_t> indices_;  // alive faces; dead ones have indices_[3f] == kNone during a pass
+  UninitializedVector<uint32_t> indices_;  // alive faces; dead ones have indices_[3f] == kNone during a pass
   size_t alive_triangles_ = 0, welded_triangles_ = 0;  // welded_: before the first collapse
   std::vector<uint32_t> offsets_, faces_;              // vertex -> faces (CSR), rebuilt each pass
   UninitializedVector<Slot> slots_;
@@ -351,6 +372,14 @@ class Simplifier {
   std::vector<uint32_t> region_start_;
   std::vector<uint8_t> pending_;
   Scratch serial_;
+  // collapse_in_parts: per vertex, whether its part's walk defers candidates that read it; per part, its
+  // thread's scratch and the candidates it deferred.
+  std::vector<uint8_t> blocked_;
+  struct Part {
+    Scratch scratch;
+    std::vector<Ranked> deferred;
+  };
+  std::vector<Part> parts_;
   bool rejected_ = false;  // slots were set to +inf by failed collapses since the last full evaluation
   uint32_t step_ = 0;
   std::vector<Collapse>* record_ = nullptr;
@@ -431,19 +460,19 @@ class Simplifier {
       r = std::max(r, std::nextafter(float(e / double(scale_) * (1 + 1e-6)), INFINITY));
     }
 
-    indices_.resize(in_.indices.size() / 3 * 3);  // written in place below (an insert per face cost ~60
-                                                  // instructions), then cut to the faces kept
-    size_t kept = 0;
-    for (size_t t = 0; t + 2 < in_.indices.size(); t += 3) {
-      uint32_t a = in_.indices[t], b = in_.indices[t + 1], c = in_.indices[t + 2];
-      if (a >= n || b >= n || c >= n) continue;
-      a = weld_remap_[a], b = weld_remap_[b], c = weld_remap_[c];
-      if (a == b || b == c || a == c) continue;
-      indices_[kept] = a, indices_[kept + 1] = b, indices_[kept + 2] = c, kept += 3;
-    }
-    indices_.resize(kept);
-    alive_triangles_ = welded_triangles_ = indices_.size() / 3;
+    // The faces on welded vertices, in place on every core (uninitialized: first touched there); one with a
+    // vertex out of range or repeated is marked dead, and sort_faces leaves it out. Was a serial loop that
+    // cut the dead ones (about 28 instructions per face) after a serial zero fill.
+    const size_t input_faces = in_.indices.size() / 3;
+    indices_.resize(3 * input_faces);
+    for_each(size_t(0), input_faces, [&](size_t t) {
+      uint32_t a = in_.indices[3 * t], b = in_.indices[3 * t + 1], c = in_.indices[3 * t + 2];
+      if (a < n && b < n && c < n) a = weld_remap_[a], b = weld_remap_[b], c = weld_remap_[c];
+      const bool dead = a >= n || b >= n || c >= n || a == b || b == c || a == c;
+      indices_[3 * t] = dead ? kNone : a, indices_[3 * t + 1] = b, indices_[3 * t + 2] = c;
+    });
     sort_faces();
+    alive_triangles_ = welded_triangles_ = indices_.size() / 3;
   }
 
   // Orders the faces by their smallest vertex, stably (vertices are in Morton order), so that the faces
@@ -452,8 +481,8 @@ class Simplifier {
   // try_collapse's samples on elephant_1m). Two stable counting sorts, on every core: by runs of `span`
   // vertices (counting_sort), then each run's faces by their vertex. Up to kMaxRuns runs, about kRunFaces
   // faces each: a DAG group of 800 faces in 4096 runs spent most of its sort on empty runs (77 M of the
-  // bake's 1.6 G simplifier instructions on refined_elephant). The order does not depend on the runs. O(T +
-  // V).
+  // bake's 1.6 G simplifier instructions on refined_elephant). The order does not depend on the runs. Dead
+  // faces (weld's) are left out. O(T + V).
   void sort_faces() {
     constexpr size_t kMaxRuns = 4096, kRunFaces = 64;
     const size_t faces = indices_.size() / 3;
@@ -465,9 +494,9 @@ class Simplifier {
     UninitializedVector<uint32_t> by_run(faces);
     std::vector<uint32_t> run_start;
     counting_sort(
-        faces, run_count, [&](size_t f) { return key(f) / span; },
+        faces, run_count, [&](size_t f) { return indices_[3 * f] == kNone ? run_count : key(f) / span; },
         [&](size_t f, uint32_t position) { by_run[position] = uint32_t(f); }, &run_start);
-    std::vector<uint32_t> sorted(indices_.size());
+    UninitializedVector<uint32_t> sorted(3 * size_t(run_start[run_count]));  // each written once below
     for_blocks(run_count, 64, [&](const auto& runs) {
       std::vector<uint32_t> start(span + 1);
       for (uint32_t r = runs.begin(); r < runs.end(); ++r) {
@@ -610,22 +639,27 @@ class Simplifier {
     for_blocks(uint32_t(m), 4096, [&](const auto& r) {
       for (uint32_t v = r.begin(); v < r.end(); ++v) classify_fan(v, open_count, complex);
     });
-    for (uint32_t v = 0; v < m; ++v) {
-      if (kind_[v] == kLocked || complex[v]) {
-        kind_[v] = kLocked;
-        continue;
+    // Each vertex's kind from its own (user-locked) kind and the fans' results: on every core (one core took
+    // 11.4 M instructions on elephant_1m).
+    for_blocks(uint32_t(m), 4096, [&](const auto& r) {
+      for (uint32_t v = r.begin(); v < r.end(); ++v) {
+        if (kind_[v] == kLocked || complex[v]) {
+          kind_[v] = kLocked;
+          continue;
+        }
+        uint32_t w = wedge_[v];
+        if (w == v) {
+          kind_[v] = open_count[v] == 0 ? kManifold : kBorder;
+        } else if (wedge_[w] == v && open_count[v] == 1 && open_count[w] == 1 && !complex[w] &&
+                   pid_[open_out_[v]] == pid_[open_in_[w]] && pid_[open_in_[v]] == pid_[open_out_[w]]) {
+          kind_[v] = kSeam;
+        } else {
+          kind_[v] = kLocked;
+        }
       }
-      uint32_t w = wedge_[v];
-      if (w == v) {
-        kind_[v] = open_count[v] == 0 ? kManifold : kBorder;
-      } else if (wedge_[w] == v && open_count[v] == 1 && open_count[w] == 1 && !complex[w] &&
-                 pid_[open_out_[v]] == pid_[open_in_[w]] && pid_[open_in_[v]] == pid_[open_out_[w]]) {
-        kind_[v] = kSeam;
-      } else {
-        kind_[v] = kLocked;
-      }
-    }
-    // A seam vertex whose partner was locked by the user is locked too.
+    });
+    // A seam vertex whose partner was locked by the user is locked too (serially, in order: a vertex locked
+    // here also locks a later partner).
     for (uint32_t v = 0; v < m; ++v)
       if (kind_[v] == kSeam && kind_[wedge_[v]] != kSeam) kind_[v] = kLocked;
   }
@@ -1136,7 +1170,7 @@ class Simplifier {
           s.region = r, s.region_base = r * region_vertices_;
           for (uint32_t k = begin; k < end; ++k) {
             if (s.removed_triangles - removed_before + 2 > quota) break;
-            prefetch(k, end);
+            prefetch(sorted_.data(), k, end);
             const uint32_t i = sorted_[k].slot;
             pending_[i] = 0;
             Plan p;
@@ -1166,17 +1200,136 @@ class Simplifier {
     sorted_.resize(order_.size());
     for (uint32_t i = 0; i < order_.size(); ++i)
       if (!parallel || pending_[i]) sorted_[end++] = {order_[i].cost, i};
+    const uint32_t parts = uint32_t(std::min<size_t>(
+        kMaxParts, tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
+    if (parallel && parts > 1 && end >= kParallelMin && alive_triangles_ > target + 2 * size_t(end))
+      collapsed += collapse_in_parts(parts, end);
     Scratch& s = serial_;
     s.region = kAnyRegion;
     for (uint32_t k = 0; k < end; ++k) {
       const uint32_t i = sorted_[k].slot;
       if (order_[i].cost > limit || alive_triangles_ - s.removed_triangles <= target) break;
-      if (!small_) prefetch(k, end);
+      if (!small_) prefetch(sorted_.data(), k, end);
       Plan p;
       if (plan_listed(i, p) && try_collapse(p, s) == Outcome::kCollapsed) ++collapsed;
     }
     gather(s);
     return collapsed;
+  }
+
+  // The serial part's candidates (sorted_[0, end)) on `parts` cores first, with the serial loop's result. The
+  // vertex numbers (Morton order) are cut into `parts` runs; a candidate belongs to the parts of its edge's
+  // ends and their wedges. Each part walks its candidates in cost order and tries one only when every vertex
+  // of the faces around its ends, and of its ends' wedge rings, is in the part and not blocked; else, or when
+  // it belongs to several parts, the candidate is deferred to the serial loop and the part blocks its ends'
+  // wedges. A collapse reads and writes only the faces around its ends (and wedges), the data of those
+  // faces' vertices and its slot, and a candidate whose face was renamed is skipped (the new end is
+  // touched), so a walked collapse shares nothing with a deferred candidate before it (whose ends are
+  // blocked, or in another part, as are the ends of a deferred one that renamed its face) nor with another
+  // part's walked collapses: they commute, and the walks then the serial loop give the serial loop's
+  // collapses, bit for bit. The caller calls it only while the candidates cannot reach the target (at most
+  // two triangles each): the serial loop stops there in cost order. Leaves the deferred candidates in
+  // sorted_[0, end), in cost order; returns the walks' collapses. O(candidates x their faces). elephant_1m
+  // 0.1 on two cores: collapses in the serial loop 43,638 -> 3,619 (of 640,282); callgrind, the collapse
+  // loop's serial instructions 445 -> 76 M, the whole command 15,282 -> 15,413 M (the walks' face checks).
+  static constexpr uint32_t kMaxParts = 32;  // a candidate's parts are bits of a word
+  size_t collapse_in_parts(uint32_t parts, uint32_t& end) {
+    const size_t m = source_.size();
+    auto part_of = [&](uint32_t v) { return uint32_t(uint64_t(v) * parts / m); };
+    auto ring = [&](uint32_t v, auto&& f) {
+      uint32_t w = v;
+      do f(w), w = wedge_[w];
+      while (w != v);
+    };
+    // The lists, each in cost order: per part, its candidates' sorted_ entries and their edges' ends as the
+    // faces hold them now (dead faces stay dead: the serial loop would skip them); `shared` when a
+    // candidate belongs to several parts.
+    struct Listed {
+      Ranked entry;
+      uint32_t i, j;
+      bool shared;
+    };
+    // Each candidate's ends and parts (a mask; 0 when its face is dead) on every core (random reads), then
+    // the lists in order.
+    std::vector<uint32_t> mask(end), start(parts + 1, 0);
+    std::vector<std::pair<uint32_t, uint32_t>> ends(end);
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, end, 1024), [&](const auto& r) {
+      for (uint32_t k = r.begin(); k < r.end(); ++k) {
+        const uint32_t slot = order_[sorted_[k].slot].slot;
+        mask[k] = 0;
+        if (indices_[slot - slot % 3] == kNone) continue;
+        ends[k] = edge(slot);
+        ring(ends[k].first, [&](uint32_t w) { mask[k] |= 1u << part_of(w); });
+        ring(ends[k].second, [&](uint32_t w) { mask[k] |= 1u << part_of(w); });
+      }
+    });
+    for (uint32_t k = 0; k < end; ++k)
+      for (uint32_t bits = mask[k]; bits; bits &= bits - 1) ++start[std::countr_zero(bits) + 1];
+    for (uint32_t h = 0; h < parts; ++h) start[h + 1] += start[h];
+    std::vector<Listed> listed_in(start[parts]);
+    {
+      std::vector<uint32_t> at(start.begin(), start.end() - 1);
+      for (uint32_t k = 0; k < end; ++k)
+        for (uint32_t bits = mask[k]; bits; bits &= bits - 1)
+          listed_in[at[std::countr_zero(bits)]++] = {sorted_[k], ends[k].first, ends[k].second,
+                                                     std::popcount(mask[k]) > 1};
+    }
+    std::vector<Ranked> list(listed_in.size());
+    for (size_t k = 0; k < list.size(); ++k) list[k] = listed_in[k].entry;
+    blocked_.assign(m, 0);
+    parts_.resize(parts);
+    std::atomic<size_t> count{0};
+    tbb::parallel_for(uint32_t(0), parts, [&](uint32_t h) {
+      Scratch& s = parts_[h].scratch;
+      std::vector<Ranked>& deferred = parts_[h].deferred;
+      deferred.clear();
+      s.region = kAnyRegion;
+      auto block = [&](uint32_t v) {
+        ring(v, [&](uint32_t w) {
+          if (part_of(w) == h) blocked_[w] = 1;
+        });
+      };
+      auto clear = [&](uint32_t v) { return part_of(v) == h && !blocked_[v]; };
+      auto faces_clear = [&](uint32_t v) {
+        bool ok = true;
+        ring(v, [&](uint32_t w) { ok = ok && clear(w); });
+        if (ok)
+          for_faces(v, [&](uint32_t f) {
+            const uint32_t* t = &indices_[3 * size_t(f)];
+            ok = ok && clear(t[0]) && clear(t[1]) && clear(t[2]);
+          });
+        return ok;
+      };
+      size_t here = 0;
+      for (uint32_t k = start[h]; k < start[h + 1]; ++k) {
+        prefetch(list.data(), k, start[h + 1]);
+        const Listed& e = listed_in[k];
+        if (e.shared) {
+          block(e.i), block(e.j);
+          if (part_of(e.i) == h) deferred.push_back(e.entry);
+          continue;
+        }
+        const Candidate c = listed(order_[e.entry.slot].slot);
+        if (c.a == kNone || touched_[c.a] || touched_[c.b]) continue;  // skipped by the serial loop too
+        if (!faces_clear(c.a) || !faces_clear(c.b)) {
+          block(c.a), block(c.b);
+          deferred.push_back(e.entry);
+          continue;
+        }
+        Plan p;
+        if (plan_listed(e.entry.slot, p) && try_collapse(p, s) == Outcome::kCollapsed) ++here;
+      }
+      count += here;
+    });
+    end = 0;
+    for (Part& part : parts_) {
+      gather(part.scratch);
+      std::copy(part.deferred.begin(), part.deferred.end(), sorted_.data() + end);
+      end += uint32_t(part.deferred.size());
+    }
+    std::sort(sorted_.data(), sorted_.data() + end,
+              [](const Ranked& x, const Ranked& y) { return x.slot < y.slot; });
+    return count;
   }
 
   // The plan of order_ entry i for the collapse loop; false when it is skipped: its face died, an end (or a
@@ -1233,19 +1386,19 @@ class Simplifier {
 
   // Candidates come in cost order, random in their region, so each try starts with cache misses on a chain of
   // loads (order_ entry, slot, the ends' offsets_, their face lists, those faces' corners). This loads each
-  // link of the chain for a candidate further on in the list being walked (sorted_, before `end`: a region's
-  // candidates or the serial part's), the link
+  // link of the chain for a candidate further on in the list being walked (`list`, before `end`: a region's
+  // candidates in sorted_, a part's or the serial part's), the link
   // before it having been loaded some tries earlier: order_ kOrderAhead places on, the slot kSlotAhead, the
   // ends' per-vertex data kEndAhead, their face lists kFacesAhead and those faces' indices kCornersAhead, so
   // that the misses overlap the tries between instead of stalling each one in turn. Always inlined: called,
   // it was removed as dead code by GCC 12 at -O2 (kept with -fno-tree-dce), so the collapse loop had no
   // prefetch instruction at all.
-  [[gnu::always_inline]] void prefetch(uint32_t k, uint32_t end) const {
+  [[gnu::always_inline]] void prefetch(const Ranked* list, uint32_t k, uint32_t end) const {
     constexpr uint32_t kOrderAhead = 32, kSlotAhead = 16, kEndAhead = 8, kFacesAhead = 4, kCornersAhead = 2;
-    auto candidate = [&](uint32_t ahead) { return listed(order_[sorted_[k + ahead].slot].slot); };
-    if (k + kOrderAhead < end) __builtin_prefetch(&order_[sorted_[k + kOrderAhead].slot]);
+    auto candidate = [&](uint32_t ahead) { return listed(order_[list[k + ahead].slot].slot); };
+    if (k + kOrderAhead < end) __builtin_prefetch(&order_[list[k + kOrderAhead].slot]);
     if (k + kSlotAhead < end) {
-      const uint32_t s = order_[sorted_[k + kSlotAhead].slot].slot;
+      const uint32_t s = order_[list[k + kSlotAhead].slot].slot;
       __builtin_prefetch(&slots_[s]), __builtin_prefetch(&indices_[s - s % 3]);
     }
     if (k + kEndAhead < end) {
@@ -1766,7 +1919,7 @@ class Simplifier {
     both.add(out.bounds());
     const float cap = float((double(both.diagonal()) + prior_error_) * (1 + 1e-6));
     for (float& e : result.vertex_error) e = std::min(e, cap);
-    out.indices = std::move(indices_);
+    out.indices.assign(indices_.begin(), indices_.end());
     result.error_bound = 0.0;
     for (float e : result.vertex_error) result.error_bound = std::max(result.error_bound, double(e));
   }

@@ -208,6 +208,32 @@ TEST(EdgeCollapse, OneThreadGivesTheResultOfAll) {
   EXPECT_TRUE(all.target_reached);
 }
 
+TEST(EdgeCollapse, BorderCandidatesInPartsGiveTheSerialLoopsResult) {
+  // The candidates the parallel regions leave go to one walk per thread (parts of the vertex numbers) before
+  // the serial loop: the result must be the serial loop's, with any number of parts. Seams (wedge rings) and
+  // a border (a grid) give every kind of candidate; 32 parts put most of them near a part's border.
+  Mesh in = lumpy(uv_sphere(1.0f, 120, 240), 7);
+  Mesh sheet = grid(160);
+  for (auto& p : sheet.positions) p.z = 0.1f * std::sin(17 * p.x + 11 * p.y) + 3.0f;
+  const uint32_t base = uint32_t(in.vertex_count());
+  in.positions.insert(in.positions.end(), sheet.positions.begin(), sheet.positions.end());
+  in.normals.resize(in.positions.size(), glm::vec3(0, 0, 1)), in.uvs.resize(in.positions.size());
+  for (uint32_t v : sheet.indices) in.indices.push_back(base + v);
+  const Options o = with_target(in.triangle_count() / 10);
+  auto run = [&](size_t threads) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    return simplify_mesh(in, o);
+  };
+  const auto one = run(1);
+  for (size_t threads : {2, 32}) {
+    const auto parts = run(threads);
+    EXPECT_EQ(one.mesh.indices, parts.mesh.indices) << threads;
+    EXPECT_EQ(one.mesh.positions, parts.mesh.positions) << threads;
+    EXPECT_EQ(one.mesh.uvs, parts.mesh.uvs) << threads;
+    EXPECT_EQ(one.vertex_error, parts.vertex_error) << threads;
+  }
+}
+
 TEST(EdgeCollapse, NoTriangleFlips) {
   // On a star-shaped surface a flipped triangle faces the centre.
   Mesh in = lumpy(sphere(1.0f, 24, 48), 5);
