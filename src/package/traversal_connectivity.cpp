@@ -366,7 +366,13 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
       if (k >= C) fail("cluster out of range");
     }
     uint32_t c;
-    // kVertex, about half the symbols, tested before the jump table of the others.
+    // kVertex, about half the symbols, tested before the jump table of the others. Branch-free forms of this
+    // dispatch were slower (refined_elephant's `bench decode`, main 2b2a9a3, callgrind --branch-sim on
+    // decode_node, wall as paired new / old ratios of `--runs 50`): kVertex and kRight on one path by
+    // conditional moves, 47.8 -> 58.7 M instructions, simulated mispredictions 255 -> 205 K, wall 0.92; every
+    // kind by conditional moves and tables, 82.0 M, 149 K, wall 0.73. Conditional moves for the cluster code
+    // and the gate scan's first step: 48.9 M, 186 K, wall 0.99-1.01 (noise +-1.5 %): the CPU predicts most of
+    // what the simulation counts as mispredicted.
     if ((byte & 7) == kVertex) {
       if (next == V) fail("more vertices than the node holds");
       c = next++;
