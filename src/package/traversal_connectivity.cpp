@@ -16,25 +16,32 @@ constexpr uint32_t kNone = UINT32_MAX;
 // The front of traversal_connectivity.hpp, shared by encoder and decoder so that both apply the same rules.
 class Front {
  public:
-  enum State : uint32_t { kPending, kDone, kGone };  // to process; in its loop, processed; out of the loops
-  // 32 bytes (7 fields, aligned): an edge's address is its index shifted, where 28 took three instructions
+  // 32 bytes (6 fields, aligned): an edge's address is its index shifted, where 28 took three instructions
   // at every look-up.
   struct alignas(32) Edge {
-    uint32_t a, b, o, prev, next, state;
+    uint32_t a, b, o, prev, next;
     uint32_t cluster;  // of its triangle (records of several clusters; 0 otherwise)
   };
+  // The callers process the gates in order, each once, so the edges below the gate need no mark: only an
+  // edge that a kLeft, kRight or kEnd takes out of its loop before its turn does, kTaken in its o (a field
+  // nothing reads once the edge is out). No state field to store in every new edge and every processed
+  // gate: `bench decode --runs 1` under callgrind, decode_traversal 211.0 -> 200.7 M instructions
+  // (elephant_1m), 16.99 -> 16.35 M (refined_elephant).
+  static constexpr uint32_t kTaken = kNone;
 
   // A front for T triangles in `storage` (reused between calls): its edges pointer and size live in the
   // Front, a local of the caller, so that the compiler keeps them in registers.
   Front(std::vector<Edge>& storage, size_t triangles) {
     // A piece start adds 3 edges, every other triangle at most 2: no more than 3T edges, whatever the
-    // symbols.
-    if (storage.size() < 3 * triangles) storage.resize(3 * triangles);
+    // symbols; gate reads one more.
+    if (storage.size() < 3 * triangles + 1) storage.resize(3 * triangles + 1);
     edges_ = storage.data();
   }
-  // The first pending edge at or after e (edges are processed in creation order), or size() when none is.
+  // The first edge at or after e still in its loop (edges are processed in creation order), or size() when
+  // none is. The bound is tested only for a taken edge (the storage's edge at size(), of no meaning, is
+  // read): one test and branch fewer a gate.
   uint32_t gate(uint32_t e) const {
-    while (e < size_ && edges_[e].state != kPending) ++e;
+    while (edges_[e].o == kTaken && e < size_) ++e;
     return e;
   }
   uint32_t size() const { return size_; }
@@ -69,32 +76,29 @@ class Front {
     push(c, b, a, x, next, k);
     edges_[prev].next = x;  // a loop has 2 edges or more: prev and next are not the gate
     edges_[next].prev = y;
-    edges_[e].state = kGone;
   }
   // kLeft: P = p -> a and the gate become p -> b.
   void close_left(uint32_t e, uint32_t k) {
     Edge &g = edges_[e], &p = edges_[g.prev];
     link(p.prev, g.next, p.a, g.b, g.a, k);
-    p.state = g.state = kGone;
+    p.o = kTaken;
   }
   // kRight: the gate and N = b -> n become a -> n.
   void close_right(uint32_t e, uint32_t k) {
     Edge &g = edges_[e], &n = edges_[g.next];
     link(g.prev, n.next, g.a, n.b, g.b, k);
-    n.state = g.state = kGone;
+    n.o = kTaken;
   }
   // kEnd: the loop of 3 is gone.
   void close_loop(uint32_t e) {
-    Edge& g = edges_[e];
-    edges_[g.prev].state = edges_[g.next].state = g.state = kGone;
+    const Edge& g = edges_[e];
+    edges_[g.prev].o = edges_[g.next].o = kTaken;
   }
-  // kBoundary.
-  void done(uint32_t e) { edges_[e].state = kDone; }
 
  private:
   void push(uint32_t a, uint32_t b, uint32_t o, uint32_t prev, uint32_t next, uint32_t k) {
     Edge& x = edges_[size_++];
-    x.a = a, x.b = b, x.o = o, x.prev = prev, x.next = next, x.state = kPending, x.cluster = k;
+    x.a = a, x.b = b, x.o = o, x.prev = prev, x.next = next, x.cluster = k;
   }
   // A new edge a -> b (third corner o) between `before` and `after`.
   void link(uint32_t before, uint32_t after, uint32_t a, uint32_t b, uint32_t o, uint32_t k) {
@@ -235,7 +239,7 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
     }
     if (!across) {
       code.symbols.push_back(kBoundary);
-      front.done(e);
+      ++e;  // the gate stays in its loop, processed
       continue;
     }
     encoded[across->triangle] = 1;
@@ -261,6 +265,7 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
       front.attach(e, c, k);
     }
     emit(g.b, g.a, c, k);
+    ++e;  // the gate is out of its loop
   }
   for (uint32_t v = 0; v < V; ++v) {
     if (decoded[v] != kNone) continue;
@@ -366,7 +371,13 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
       if (k >= C) fail("cluster out of range");
     }
     uint32_t c;
-    // kVertex, about half the symbols, tested before the jump table of the others.
+    // kVertex, about half the symbols, tested before the jump table of the others. Branch-free forms of this
+    // dispatch were slower (refined_elephant's `bench decode`, main 2b2a9a3, callgrind --branch-sim on
+    // decode_node, wall as paired new / old ratios of `--runs 50`): kVertex and kRight on one path by
+    // conditional moves, 47.8 -> 58.7 M instructions, simulated mispredictions 255 -> 205 K, wall 0.92; every
+    // kind by conditional moves and tables, 82.0 M, 149 K, wall 0.73. Conditional moves for the cluster code
+    // and the gate scan's first step: 48.9 M, 186 K, wall 0.99-1.01 (noise +-1.5 %): the CPU predicts most of
+    // what the simulation counts as mispredicted.
     if ((byte & 7) == kVertex) {
       if (next == V) fail("more vertices than the node holds");
       c = next++;
@@ -403,7 +414,7 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
           break;
         }
         case kBoundary:
-          front.done(e++);  // the gate is done: the next one lies past it
+          ++e;  // the gate stays in its loop, processed: the next one lies past it
           continue;
         default:
           fail("unknown symbol");
