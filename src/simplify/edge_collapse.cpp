@@ -15,7 +15,6 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
-#include <ctime>
 #include <span>
 #include <utility>
 #if defined(__SSE2__)
@@ -47,22 +46,6 @@ namespace {
 #define LODSTREAM_RUNS_AVX2() false
 #endif
 
-struct TmpT {
-  timespec w0, c0;
-  static double ms(const timespec& a, const timespec& b) {
-    return (b.tv_sec - a.tv_sec) * 1e3 + (b.tv_nsec - a.tv_nsec) * 1e-6;
-  }
-  TmpT() {
-    clock_gettime(CLOCK_MONOTONIC, &w0);
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
-  }
-  ~TmpT() {
-    timespec w1, c1;
-    clock_gettime(CLOCK_MONOTONIC, &w1);
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
-    fprintf(stderr, "\nTMP weld wall %.1f cpu %.1f\n", ms(w0, w1), ms(c0, c1));
-  }
-};
 constexpr uint32_t kNone = UINT32_MAX;
 enum Kind : uint8_t { kManifold, kBorder, kSeam, kLocked };
 
@@ -250,10 +233,7 @@ class Simplifier {
   Result run() {
     Result result;
     result.input_triangles = in_.triangle_count();
-    {
-      TmpT t;
-      weld();
-    }
+    weld();
     result.weld_remap = weld_remap_;
     build_adjacency();
     classify();
