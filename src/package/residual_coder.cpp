@@ -205,8 +205,8 @@ void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, 
   // bits, rare (residual_coder.hpp), take a branch too.
   const auto step = [&](uint32_t & x, uint8_t * out) __attribute__((always_inline)) {
     const size_t slot = x & (kScale - 1);  // 64-bit: the symbol's address is slots + slot + 4 * kScale
-    const uint32_t e = slots[slot], s = reinterpret_cast<const uint8_t*>(slots)[4 * kScale + slot];
-    x = (e & 0xffff) * (x >> kScaleBits) + (e >> 16);
+    const uint32_t s = reinterpret_cast<const uint8_t*>(slots)[4 * kScale + slot];
+    x = rans::step(x, slots, slot, kScaleBits);
     uint16_t next;
     std::memcpy(&next, bytes + at, 2);
     rans::renormalize(x, at, next);
