@@ -153,14 +153,14 @@ ResidualDecoder::ResidualDecoder(std::span<const uint8_t> stream, const std::str
   if (D < kMinDirect || D > kMaxDirect) r.fail("residual direct bits out of range");
   direct_bits_ = D;
   if (A == 0 || A > symbols_for(D)) r.fail("residual table of an invalid size");
-  slot_ = std::make_unique_for_overwrite<uint32_t[]>(kScale);
-  symbol_ = std::make_unique_for_overwrite<uint8_t[]>(kScale);
+  slot_ = std::make_unique_for_overwrite<uint32_t[]>(kScale + kScale / 4);  // the slots, then the symbols
+  uint8_t* const symbols = reinterpret_cast<uint8_t*>(slot_.get() + kScale);
   uint32_t sum = 0;
   for (uint32_t s = 0; s < A; ++s) {
     const uint64_t f = r.varint();
     if (f > kScale - sum) r.fail("residual frequencies add up past the scale");
     rans::fill_slots(slot_.get() + sum, uint32_t(f), uint32_t(f), 16);
-    std::memset(symbol_.get() + sum, int(s), f);
+    std::memset(symbols + sum, int(s), f);
     sum += uint32_t(f);
   }
   if (sum != kScale) r.fail("residual frequencies do not add up to the scale");
@@ -191,8 +191,7 @@ void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, 
   // The higher planes are zero but for values of raw bits, which write their higher bytes themselves.
   for (uint32_t b = 1; b < width; ++b) std::memset(planes + b * stride, 0, values);
   // The decoder's state in locals (registers) for the loop, written back after it; x0 decodes next.
-  const uint32_t* slots = slot_.get();
-  const uint8_t* symbols = symbol_.get();
+  const uint32_t* slots = slot_.get();  // then the symbols, at byte 4 * kScale
   const uint8_t* bytes = bytes_.data();
   size_t at = rans_at_;
   uint64_t raw_at = raw_bit_at_;
@@ -205,8 +204,9 @@ void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, 
   // symbol of slot x mod 2^12), then x read back up to kLow from the next 2 rANS bytes; a value's raw
   // bits, rare (residual_coder.hpp), take a branch too.
   const auto step = [&](uint32_t & x, uint8_t * out) __attribute__((always_inline)) {
-    const uint32_t slot = x & (kScale - 1), e = slots[slot], s = symbols[slot];
-    x = (e & 0xffff) * (x >> kScaleBits) + (e >> 16);
+    const size_t slot = x & (kScale - 1);  // 64-bit: the symbol's address is slots + slot + 4 * kScale
+    const uint32_t s = reinterpret_cast<const uint8_t*>(slots)[4 * kScale + slot];
+    x = rans::step(x, slots, slot, kScaleBits);
     uint16_t next;
     std::memcpy(&next, bytes + at, 2);
     rans::renormalize(x, at, next);
@@ -219,7 +219,10 @@ void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, 
       const uint64_t z = uint64_t(1) << n | ((word >> (raw_at & 7)) & ((uint64_t(1) << n) - 1));
       raw_at += n;
       if (z > largest) fail("residual wider than its node's planes");
-      for (uint32_t b = 0; b < width; ++b) out[b * stride] = uint8_t(z >> (8 * b));
+      // z < 2^(n + 1): bytes 0..n / 8, fewer than width by the check above; the planes above are zero
+      // already (the memset).
+      *out = uint8_t(z);
+      for (uint32_t b = 1; b <= n / 8; ++b) out[b * stride] = uint8_t(z >> (8 * b));
     }
   };
   // Values in blocks of kStates, then one by one, rotating the states. A block reads at most 8 bytes:

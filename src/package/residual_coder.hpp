@@ -73,9 +73,10 @@ class ResidualDecoder {
   // Per slot of 2^12 (null for no stream): bits 0-15 its symbol's frequency, 16-31 the slot minus the
   // symbol's start; and apart, its symbol (a step takes each with one instruction: 3 fewer a value than with
   // the symbol in the same word). Allocated without zero-filling: the constructor writes every slot or throws
-  // (zero-filling 2^12 slots for every page part took ~0.9 % of elephant_1m's decode instructions).
+  // (zero-filling 2^12 slots for every page part took ~0.9 % of elephant_1m's decode instructions). The
+  // symbols (2^12 bytes) follow the slots in the same allocation, so that the decode loop reaches both from
+  // one register (two took one register too many: the loop reloaded them from the stack, two loads a value).
   std::unique_ptr<uint32_t[]> slot_;
-  std::unique_ptr<uint8_t[]> symbol_;
   uint32_t direct_bits_ = 0;  // D
   // The rANS bytes then the raw bits, followed by 8 zero bytes, so that reads a few bytes past the rANS
   // bytes' end stay in the buffer (the decoder checks after each block of 4 values that they were not used)

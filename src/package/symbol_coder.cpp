@@ -160,8 +160,8 @@ void SymbolDecoder::symbols(size_t count, uint8_t* out) {
   // of slot x mod 2^8 of `table`), then x read back up to kLow from the next 2 rANS bytes; the states
   // alternate.
   const auto step = [&](uint32_t & x, uint32_t table) __attribute__((always_inline)) {
-    const uint32_t slot = table * kScale + (x & (kScale - 1)), e = slots[slot];
-    x = (e & 0xffff) * (x >> kScaleBits) + (e >> 16);
+    const size_t slot = table * kScale + (x & (kScale - 1));
+    x = rans::step(x, slots, slot, kScaleBits);
     uint16_t next;
     std::memcpy(&next, bytes + at, 2);
     rans::renormalize(x, at, next);

@@ -76,6 +76,25 @@ TEST(ResidualCoder, DecodesToThePlanesOfTheResiduals) {
   }
 }
 
+// The decoder writes every byte of the planes it is asked for, over whatever they held: a value of raw bits
+// writes only its own bytes, the planes above them zeroed first (the page buffer is reused across pages).
+TEST(ResidualCoder, WritesEveryByteOfItsPlanesOverOldBytes) {
+  for (uint32_t seed = 0; seed < 4; ++seed) {
+    const Residuals r = random_residuals(seed + 10, 0.3);
+    ResidualDecoder decoder(encode_residuals(r.values), "stream 3");
+    std::vector<uint8_t> out;
+    for (size_t node = 0; node < r.counts.size(); ++node) {
+      const size_t at = out.size(), n = r.counts[node];
+      out.resize(at + 3 * n * r.widths[node], 0xa5);
+      // Component 0, then components 1 and 2 (the split form's two calls).
+      decoder.planes(n, 3, r.widths[node], out.data() + at, 0, 1);
+      decoder.planes(n, 3, r.widths[node], out.data() + at, 1, 2);
+    }
+    decoder.finish();
+    EXPECT_EQ(out, expected_planes(r)) << "seed " << seed;
+  }
+}
+
 TEST(ResidualCoder, OneSymbolAloneAndNoResiduals) {
   const std::vector<uint64_t> zeros(1000, 0);
   const std::vector<uint8_t> stream = encode_residuals(zeros);
