@@ -200,14 +200,13 @@ TEST(DerivedNormals, AFanIsClosedWhenEveryTriangleAroundTheVertexIsInTheNode) {
   EXPECT_TRUE(open[V]);
 }
 
-// A sphere whose normals are tilted off the surface's by about one code step at `bits` (1.15 / (scale
-// (2^(bits
-// - 1) - 1)) radians, scale 0.49 at 9 bits and 0.52 below, predicted_normals.cpp's frame_scale): without
-// derivation the closed vertices would store codes of +-1 and decode off the prediction. The vertices (all
-// closed) decode to their prediction, plain or smoothed (the encoder's choice), but for the few that the
-// prediction's own error (the sphere's tessellation) puts more than a step off, and within three code steps
-// of the normal given (both codes within 1.8 steps with the dead zone: 1.8 sqrt(2) = 2.55 steps apart at
-// most).
+// A sphere whose normals are tilted off the surface's by about one code step at `bits` (1.15 step, with
+// step = 1 / (scale (2^(bits - 1) - 1)) radians, scale 0.49 at 9 bits and 0.52 below: predicted_normals.cpp's
+// frame_scale): without derivation the closed vertices would store codes of +-1 and decode off the
+// prediction. The vertices (all closed) decode to their prediction, plain or smoothed (the encoder's choice),
+// but for the few that the prediction's own error (the sphere's tessellation) puts more than a step off, and
+// within three code steps of the normal given (both codes within 1.8 steps with the dead zone: 1.8 sqrt(2)
+// = 2.55 steps apart at most).
 void expect_closed_vertices_derived(uint32_t bits) {
   const double step = 1.0 / ((bits == 9 ? 0.49 : 0.52) * double((1 << (bits - 1)) - 1));
   Mesh ball = sphere(1.0f, 24, 48);
