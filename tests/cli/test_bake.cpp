@@ -28,6 +28,15 @@ nlohmann::json bake_and_verify(const std::string& model, const std::filesystem::
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["bytes"].get<uint64_t>(), std::filesystem::file_size(out));
   EXPECT_NE(bake.err.find("bake: hierarchy"), std::string::npos) << "no progress line";
+  // stderr carries only bake's own progress and summary lines, each starting "bake: " (a stray debug print
+  // once went to stderr on every bake unnoticed): split at '\r' and '\n'.
+  for (size_t start = 0; start < bake.err.size();) {
+    size_t end = bake.err.find_first_of("\r\n", start);
+    if (end == std::string::npos) end = bake.err.size();
+    if (end > start)
+      EXPECT_EQ(bake.err.compare(start, 6, "bake: "), 0) << bake.err.substr(start, end - start);
+    start = end + 1;
+  }
 
   auto inspect = run_lodstream({"inspect", out.string(), "--verify", "--json"});
   EXPECT_EQ(inspect.status, 0) << inspect.err;
