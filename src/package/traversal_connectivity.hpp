@@ -52,12 +52,12 @@
 // (-3.7 %; level-0 connectivity 0.25 -> 0.16 B a stored triangle, levels 1-2 0.38 / 0.43 -> 0.35 / 0.42),
 // elephant_1m 2,898,959 -> 2,808,434 (-3.1 %), elephant_5m 11,027,977 -> 10,705,624 (-2.9 %), motorBike
 // 1,409,394 -> 1,377,952 (-2.2 %), bunny 242,819 -> 237,429 (-2.2 %), horse 312,104 -> 305,860 (-2.0 %).
-// The decoder's cost: a byte counter per vertex, three increments a triangle and a table look-up a symbol,
-// about 25 instructions a triangle with the loop's extra register pressure (`bench decode --runs 1` under
-// callgrind, decode_node + read_page: refined_elephant 62.15 -> 66.11 M, elephant_1m 958.2 -> 1,020.0 M,
-// +6.4 %). Tried: counters that saturate at 7 (no min at the look-up) 21.10 M in decode_traversal against
-// 19.90 M; 16-bit counters 20.41 M; each front edge carrying its first vertex's wedge (no per-vertex array)
-// 19.45 M for 247,901 B; contexts modulo 8 19.27 M for 247,694 B (old decode_traversal: 15.83 M).
+// The decoder's cost: a byte counter per vertex, three increments a triangle and two table look-ups a
+// symbol, about 22 instructions a triangle with the loop's extra register pressure (`bench decode --runs 1`
+// under callgrind, decode_node + read_page: refined_elephant 62.15 -> 65.48 M, +5.4 %; elephant_1m 958.2 ->
+// 1,004.5 M, +4.8 %; decode_traversal 15.83 -> 19.27 M and 191.4 -> 238.4 M). Tried: the context by min()
+// 19.90 M; counters that saturate at 7 21.10 M; 16-bit counters 20.41 M; each front edge carrying its
+// first vertex's wedge (no per-vertex array) 19.45 M for 247,901 B; contexts modulo 8 19.27 M for 247,694 B.
 //
 // On a manifold patch about half the symbols are kVertex and most others kLeft / kRight / kBoundary (border
 // edges), so zstd's entropy stage takes them to about 2 bits per triangle; a page codes them with the
