@@ -3,7 +3,8 @@
 // each symbol byte alone, in one bit at least; the traversal's symbols follow each other in patterns (at
 // level 0 of a subdivided scan kVertex and kRight alternate) that the previous symbol predicts.
 //
-// A symbol byte holds a kind t (bits 0-2: 0..5) and a cluster code g (bits 3-7: 0 for the gate's cluster).
+// A symbol byte holds a kind t (bits 0-2: 0..5; since format 12 the kind's rank in its gate's context,
+// traversal_connectivity.hpp) and a cluster code g (bits 3-7: 0 for the gate's cluster).
 // Each is coded as its class s = t + 6 [g > 0] (12 classes) under the table of the previous symbol's class
 // (the page's first symbol: under class 0's), followed when g > 0 by the rank of g among the cluster codes,
 // most recently coded first (move-to-front, format 8), under one table of ranks (order 0). rANS (rans.hpp)

@@ -117,9 +117,52 @@ void put_varint(std::vector<uint8_t>& out, uint32_t v) {
   out.push_back(uint8_t(v));
 }
 
-// The symbol byte of a triangle of cluster k across a gate of cluster `gate` (traversal_connectivity.hpp).
-uint8_t tagged(TraversalSymbol symbol, uint32_t k, uint32_t gate) {
-  return uint8_t(symbol | (k == gate ? 0 : (k + 1) << 3));
+// The kinds by rank in each gate context 8 min(t_a, 7) + min(t_b, 7) (traversal_connectivity.hpp, ranked
+// symbols), most frequent first: measured on the bakes of horse and motorBike (format 11's traversals, every
+// level, 0.77 M gates); a context they never met (t_a or t_b 0: no gate has them) takes the first row.
+constexpr char kKindsByFrequency[64][7] = {
+    "021345", "021345", "021345", "021345", "021345", "021345", "021345", "021345",  // t_a 0
+    "021345", "035421", "034215", "034251", "032451", "203451", "023451", "023451",  // 1
+    "021345", "304125", "304125", "032415", "032415", "203415", "203415", "023415",  // 2
+    "021345", "304152", "304125", "032145", "023415", "203415", "320415", "302415",  // 3
+    "021345", "031452", "013425", "013245", "013245", "203415", "302145", "301425",  // 4
+    "021345", "103452", "103425", "103425", "310425", "321045", "301245", "304251",  // 5
+    "021345", "103452", "130425", "310425", "310425", "310245", "340125", "304125",  // 6
+    "021345", "013452", "301425", "350214", "304125", "350421", "304512", "350421",  // 7
+};
+struct RankTables {
+  uint8_t kind[64 * 8];  // kind[8 context + rank]; ranks 6 and 7 give 6, no kind (the decoder refuses it)
+  uint8_t rank[64 * 8];  // rank[8 context + kind]
+  // By a vertex's triangle count t (a byte): 64 min(t, 7) and 8 min(t, 7), the offsets of kind's entries for
+  // a gate's first and second vertex (two loads where a min took four instructions with its constant:
+  // refined_elephant's decode_traversal 19.90 -> 19.27 M instructions).
+  uint16_t first[256], second[256];
+};
+constexpr RankTables kRankTables = [] {
+  RankTables t{};
+  for (uint32_t c = 0; c < 256; ++c)
+    t.first[c] = uint16_t(64 * std::min(c, kRankedTriangles)),
+    t.second[c] = uint16_t(8 * std::min(c, kRankedTriangles));
+  for (uint32_t c = 0; c < 64; ++c) {
+    t.kind[8 * c + 6] = t.kind[8 * c + 7] = 6;
+    for (uint32_t r = 0; r < 6; ++r) {
+      t.kind[8 * c + r] = uint8_t(kKindsByFrequency[c][r] - '0');
+      t.rank[8 * c + t.kind[8 * c + r]] = uint8_t(r);
+    }
+  }
+  return t;
+}();
+
+// The context of a gate a -> b from the triangles decoded at a and b (counts wrapping at 2^8 alike in encoder
+// and decoder).
+inline uint32_t gate_context(uint32_t at_a, uint32_t at_b) {
+  return 8 * std::min(at_a, kRankedTriangles) + std::min(at_b, kRankedTriangles);
+}
+
+// The symbol byte of a triangle of cluster k across a gate of cluster `gate` whose context is `context`:
+// the kind's rank in bits 0-2 (traversal_connectivity.hpp).
+uint8_t tagged(TraversalSymbol symbol, uint32_t context, uint32_t k, uint32_t gate) {
+  return uint8_t(kRankTables.rank[8 * context + symbol] | (k == gate ? 0 : (k + 1) << 3));
 }
 
 // Writes the triangles `from` (3 indices each) into `to` in the clusters' ranges, in their order within each
@@ -142,6 +185,10 @@ bool sort_by_cluster(const uint32_t* from, uint32_t* to, std::span<const uint8_t
 
 }  // namespace
 
+uint8_t traversal_rank(TraversalSymbol kind, uint32_t triangles_at_a, uint32_t triangles_at_b) {
+  return kRankTables.rank[8 * gate_context(triangles_at_a, triangles_at_b) + kind];
+}
+
 TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
                                std::span<const uint32_t> cluster_triangles) {
   const uint32_t T = uint32_t(indices.size() / 3);
@@ -150,6 +197,7 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
   // cleared once rather than per record.
   thread_local std::vector<uint8_t> cluster_of, emitted_cluster, encoded;  // by input triangle; emitted
   thread_local std::vector<uint32_t> first, fill, decoded, traversal_order;
+  thread_local std::vector<uint8_t> triangles_at;  // by vertex number: triangles emitted at it (wrapping)
   // Per outgoing half-edge of a vertex, in vertex order: the vertex it goes to, the third corner of its
   // triangle and the triangle (corner c = 3t + k goes from indices[c] to the next corner of t); the look-up
   // across a gate then compares the first field and reads the others, with no division by 3.
@@ -192,7 +240,9 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
   if (clustered) traversal_order.resize(indices.size()), emitted_cluster.resize(T);
   uint32_t* const out = clustered ? traversal_order.data() : code.indices.data();
   uint32_t done = 0;  // triangles emitted
+  triangles_at.assign(V, 0);
   auto emit = [&](uint32_t a, uint32_t b, uint32_t c, uint8_t k) {
+    ++triangles_at[a], ++triangles_at[b], ++triangles_at[c];
     uint32_t* x = out + 3 * size_t(done);
     x[0] = a, x[1] = b, x[2] = c;
     if (clustered) emitted_cluster[done] = k;
@@ -227,6 +277,7 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
       continue;
     }
     const Front::Edge g = front.edge(e);
+    const uint32_t context = gate_context(triangles_at[g.a], triangles_at[g.b]);
     // The triangle across a -> b holds half-edge b -> a.
     const uint32_t a_in = code.order[g.a], b_in = code.order[g.b];
     const HalfEdge* across = nullptr;
@@ -238,7 +289,7 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
       }
     }
     if (!across) {
-      code.symbols.push_back(kBoundary);
+      code.symbols.push_back(tagged(kBoundary, context, 0, 0));
       ++e;  // the gate stays in its loop, processed
       continue;
     }
@@ -247,20 +298,20 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
     const uint32_t c_in = across->third;
     uint32_t c = decoded[c_in];
     if (c == kNone) {
-      code.symbols.push_back(tagged(kVertex, k, g.cluster));
+      code.symbols.push_back(tagged(kVertex, context, k, g.cluster));
       c = add_vertex(c_in, g.a, g.b, g.o);
       front.attach(e, c, k);
     } else if (front.closes(e) && c == front.left(e)) {
-      code.symbols.push_back(tagged(kEnd, k, g.cluster));
+      code.symbols.push_back(tagged(kEnd, context, k, g.cluster));
       front.close_loop(e);
     } else if (c == front.left(e)) {
-      code.symbols.push_back(tagged(kLeft, k, g.cluster));
+      code.symbols.push_back(tagged(kLeft, context, k, g.cluster));
       front.close_left(e, k);
     } else if (c == front.right(e)) {
-      code.symbols.push_back(tagged(kRight, k, g.cluster));
+      code.symbols.push_back(tagged(kRight, context, k, g.cluster));
       front.close_right(e, k);
     } else {
-      code.symbols.push_back(tagged(kSplit, k, g.cluster));
+      code.symbols.push_back(tagged(kSplit, context, k, g.cluster));
       put_varint(code.references, next - 1 - c);
       front.attach(e, c, k);
     }
@@ -309,8 +360,13 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     placed += C > 1 ? cluster_triangles[k] : T;
     range_end[k] = indices + 3 * placed;
   }
-  // Triangle (v0, v1, v2) of cluster k < C into its range.
+  // Per vertex, the triangles decoded at it (wrapping at 2^8, as the encoder counts them).
+  thread_local std::vector<uint8_t> triangles_at;
+  triangles_at.assign(V, 0);
+  uint8_t* const count = triangles_at.data();
+  // Triangle (v0, v1, v2) of cluster k < C into its range (every corner below V: checked as decoded).
   auto emit = [&](uint32_t v0, uint32_t v1, uint32_t v2, uint32_t k) {
+    ++count[v0], ++count[v1], ++count[v2];
     uint32_t*& out = at[k];
     if (out == range_end[k]) fail("triangles per cluster differ from the header's");
     out[0] = v0, out[1] = v1, out[2] = v2;
@@ -364,6 +420,8 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     const Front::Edge& g = front.edge(e);
     const uint32_t a = g.a, b = g.b;
     const uint32_t byte = *symbol++;
+    const uint32_t kind =
+        kRankTables.kind[kRankTables.first[count[a]] + kRankTables.second[count[b]] + (byte & 7)];
     // Cluster code 0: the gate's cluster (below C, checked when its triangle was decoded), else code - 1.
     uint32_t k = g.cluster;
     if (byte >> 3) [[unlikely]] {
@@ -378,7 +436,7 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     // kind by conditional moves and tables, 82.0 M, 149 K, wall 0.73. Conditional moves for the cluster code
     // and the gate scan's first step: 48.9 M, 186 K, wall 0.99-1.01 (noise +-1.5 %): the CPU predicts most of
     // what the simulation counts as mispredicted.
-    if ((byte & 7) == kVertex) {
+    if (kind == kVertex) {
       if (next == V) fail("more vertices than the node holds");
       c = next++;
       // The front first: it reads the gate's fields that a, b were loaded from, and no store lies between.
@@ -387,7 +445,7 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
       uint32_t* const predictor = predictors + 3 * size_t(c);
       predictor[0] = a, predictor[1] = b, predictor[2] = o;
     } else {
-      switch (byte & 7) {
+      switch (kind) {
         case kLeft:
           c = front.left(e);
           if (c == kNone) fail("left turn in a loop of 2");

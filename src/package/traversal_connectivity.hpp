@@ -36,6 +36,29 @@
 // into later clusters, no tags) gave 5,689,401 B, its connectivity 0.38 B/tri: it breaks the regular symbol
 // runs zstd finds.
 //
+// Ranked symbols (format 12): bits 0-2 of a symbol byte hold not the kind but its rank in the gate's
+// context, the kinds ordered by their frequency after gates a -> b where a lies in min(t_a, 7) and b in
+// min(t_b, 7) decoded triangles (t counted as the triangles arrive, by encoder and decoder alike; a fixed
+// table of 64 orders, traversal_connectivity.cpp). A vertex that already holds most of a fan's triangles is
+// about to close it (the valence insight of Touma & Gotsman 1998 and Alliez & Desbrun 2001, "Valence-driven
+// connectivity encoding for 3D meshes"): at level 0 of refined_elephant a gate (2, 5) turns right 98 % of
+// the time, a gate (4, 3) takes a new vertex 97 %, a gate (5, 1) turns left 86 %, a gate (6, 6) is a
+// border 100 %. The page's symbol coder (symbol_coder.hpp) then codes ranks, mostly 0, under the previous
+// rank. Measured offline first (order-0 entropy of the classes, aggregated per level, table costs not
+// counted; the table learnt on horse and motorBike): under the previous class, then the previous rank,
+// then (t_a, t_b) alone, bits a symbol: refined_elephant level 0 1.558 / 0.871 / 0.742, levels >= 1 2.253
+// / 2.104 / 1.890; bunny 1.865 / 1.308 / 1.220 and 2.226 / 2.183 / 1.983. Packages, format 11 -> 12
+// (`lodstream bake --json`; decoded nodes and 1 px renders identical): refined_elephant 256,618 -> 247,049 B
+// (-3.7 %; level-0 connectivity 0.25 -> 0.16 B a stored triangle, levels 1-2 0.38 / 0.43 -> 0.35 / 0.42),
+// elephant_1m 2,898,959 -> 2,808,434 (-3.1 %), elephant_5m 11,027,977 -> 10,705,624 (-2.9 %), motorBike
+// 1,409,394 -> 1,377,952 (-2.2 %), bunny 242,819 -> 237,429 (-2.2 %), horse 312,104 -> 305,860 (-2.0 %).
+// The decoder's cost: a byte counter per vertex, three increments a triangle and two table look-ups a
+// symbol, about 22 instructions a triangle with the loop's extra register pressure (`bench decode --runs 1`
+// under callgrind, decode_node + read_page: refined_elephant 62.15 -> 65.48 M, +5.4 %; elephant_1m 958.2 ->
+// 1,004.5 M, +4.8 %; decode_traversal 15.83 -> 19.27 M and 191.4 -> 238.4 M). Tried: the context by min()
+// 19.90 M; counters that saturate at 7 21.10 M; 16-bit counters 20.41 M; each front edge carrying its
+// first vertex's wedge (no per-vertex array) 19.45 M for 247,901 B; contexts modulo 8 19.27 M for 247,694 B.
+//
 // On a manifold patch about half the symbols are kVertex and most others kLeft / kRight / kBoundary (border
 // edges), so zstd's entropy stage takes them to about 2 bits per triangle; a page codes them with the
 // previous symbol as context (symbol_coder.hpp), and stores the references apart (page_parts.hpp). Levels >=
@@ -54,8 +77,15 @@ namespace lodstream::package {
 
 enum TraversalSymbol : uint8_t { kVertex = 0, kLeft = 1, kRight = 2, kBoundary = 3, kSplit = 4, kEnd = 5 };
 
+// Gate contexts count at most this many triangles at each of the gate's two vertices.
+inline constexpr uint32_t kRankedTriangles = 7;
+
+// The rank (0..5) of `kind` at a gate a -> b whose vertices lie in the given numbers of decoded triangles
+// (ranked symbols, above). Cost: O(1), a table look-up.
+uint8_t traversal_rank(TraversalSymbol kind, uint32_t triangles_at_a, uint32_t triangles_at_b);
+
 struct TraversalCode {
-  std::vector<uint8_t> symbols;     // one per gate processed
+  std::vector<uint8_t> symbols;     // one per gate processed: its kind's rank, tagged (above)
   std::vector<uint8_t> references;  // varints: three per piece start, one per split
   std::vector<uint32_t> order;      // order[decoded vertex] = the input vertex
   std::vector<uint32_t> indices;    // the input's triangles in decoded order and numbering, each rotated
