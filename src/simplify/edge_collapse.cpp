@@ -940,18 +940,29 @@ class Simplifier {
   // weights (attributes eliminated per end) it measured mixed, so it applies positions only.
   LODSTREAM_HOT_PATH void place(Plan& p) const {
     constexpr double kEndShare = 0.1;
-    std::array<Reduced, 2> own;  // Q_a, Q_b
-    std::array<double, 2> own_w{0.0, 0.0};
     // Everything relative to b's origin o (a's quadrics shifted by o - o_a; b's wedges share o), x = o + y.
     const glm::dvec3 o = origin_of(p.b), shift = o - origin_of(p.a);
-    uint32_t v = p.a;
-    do own[0].add(quadric_[v], shift), own_w[0] += quadric_[v].w, v = wedge_[v];
-    while (v != p.a);
-    v = p.b;
-    do own[1].add(quadric_[v]), own_w[1] += quadric_[v].w, v = wedge_[v];
-    while (v != p.b);
-    Reduced r = own[0];
-    r.add(own[1]);
+    // Q_a (side 0) or Q_b (side 1), summed over the end's wedges, and its weight W_side in `w_side`. The
+    // end-share rule below sums one again (the same operations, so the same bits) rather than keeping both
+    // live through the whole function, where they took registers from the rest and were spilled
+    // (elephant_1m 0.1 callgrind: place 3,297.1 -> 3,107.9 M instructions default).
+    auto own = [&](int side, double& w_side) __attribute__((always_inline)) {
+      Reduced q;
+      w_side = 0.0;
+      const uint32_t first = side == 0 ? p.a : p.b;
+      uint32_t v = first;
+      do {
+        if (side == 0)
+          q.add(quadric_[v], shift);
+        else
+          q.add(quadric_[v]);
+        w_side += quadric_[v].w, v = wedge_[v];
+      } while (v != first);
+      return q;
+    };
+    std::array<double, 2> own_w;
+    Reduced r = own(0, own_w[0]);
+    r.add(own(1, own_w[1]));
     const double w = own_w[0] + own_w[1];
     for (int pair = 0; pair < 2 && channels_ > 0; ++pair) {
       uint32_t a = pair ? p.a2 : p.a, b = pair ? p.b2 : p.b;
@@ -998,9 +1009,11 @@ class Simplifier {
     if (channels_ > 0) return;
     // An end's own term can exceed the sum's only when W_side < k W (Q_side(x) <= Q(x), rounding aside:
     // both are sums of squares), so only the smaller end of an unbalanced edge is evaluated.
-    for (int side = 0; side < 2; ++side)
+    for (int side = 0; side < 2; ++side) {
+      double w_side;
       if (own_w[side] > 0 && own_w[side] < kEndShare * w)
-        p.cost = std::max(p.cost, kEndShare * own[side].eval(y) / own_w[side]);
+        p.cost = std::max(p.cost, kEndShare * own(side, w_side).eval(y) / w_side);
+    }
   }
 
   // The cheaper allowed direction of edge (i, j), as a candidate; cost = +inf when neither is allowed.
