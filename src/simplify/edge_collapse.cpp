@@ -971,7 +971,12 @@ class Simplifier {
       if (!(ww > 0)) continue;
       ChannelSums sums;
       const AttributeTerm *ta = &attr_[a * size_t(channels_)], *tb = &attr_[b * size_t(channels_)];
-      for (int j = 0; j < channels_; ++j) sums.add(ta[j], tb[j], shift);
+      // Unrolled for normals alone (three channels: the usual case; elephant_1m 0.1 callgrind: place
+      // 2,973.6 -> 2,925.9 M instructions).
+      if (channels_ == 3)
+        sums.add(ta[0], tb[0], shift), sums.add(ta[1], tb[1], shift), sums.add(ta[2], tb[2], shift);
+      else
+        for (int j = 0; j < channels_; ++j) sums.add(ta[j], tb[j], shift);
       r.eliminate(sums, ww);
     }
     const glm::dvec3 pa = glm::dvec3(pos_[p.a]) - o, pb = glm::dvec3(pos_[p.b]) - o;
