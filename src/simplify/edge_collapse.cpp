@@ -32,12 +32,13 @@
 namespace lodstream::simplify {
 namespace {
 
-// The hot paths (place, try_collapse, vertical_bound, add_face) are compiled twice, for x86-64's baseline
-// and for AVX2, and the loader picks one for the machine (GCC's function multiversioning, an ifunc): with
-// AVX2 the float and double lanes take VEX three-operand forms (fewer register copies) and vertical_bound's
-// crossing test four lanes per step. AVX2 does not include FMA, so nothing is fused into a multiply-add and
-// both versions compute the same bits (12 simplify outputs and 4 bakes cmp-identical). elephant_1m 0.1,
-// whole command, callgrind: 17,380 -> 16,920 M instructions (the collapse), -> 16,597 M (add_face).
+// The hot paths (place, try_collapse, vertical_bound, add_face, merge) are compiled twice, for x86-64's
+// baseline and for AVX2, and the loader picks one for the machine (GCC's function multiversioning, an ifunc):
+// with AVX2 the float and double lanes take VEX three-operand forms (fewer register copies) and
+// vertical_bound's crossing test four lanes per step. AVX2 does not include FMA, so nothing is fused into a
+// multiply-add and both versions compute the same bits (12 simplify outputs and 4 bakes cmp-identical).
+// elephant_1m 0.1, whole command, callgrind: 17,380 -> 16,920 M instructions (the collapse), -> 16,597 M
+// (add_face); later merge 356.0 -> 311.2 M.
 #if defined(__x86_64__) && defined(__GNUC__)
 #define LODSTREAM_HOT_PATH __attribute__((target_clones("avx2", "default")))
 #define LODSTREAM_RUNS_AVX2() __builtin_cpu_supports("avx2")  // the version the loader picks
@@ -1860,7 +1861,7 @@ class Simplifier {
   // Merges quadrics and sets b's attributes: the attribute quadric's optimum s* = (G.x + D)/W for the
   // channels in the cost (channel_), linear interpolation along the edge for the others; half-edge collapses
   // keep b's.
-  void merge(uint32_t a, uint32_t b, const Plan& p) {
+  LODSTREAM_HOT_PATH void merge(uint32_t a, uint32_t b, const Plan& p) {
     const glm::dvec3 ob = origin_of(b), shift = ob - origin_of(a);
     if (p.move) {
       glm::dvec3 pa(pos_[a]), pb(pos_[b]), e = pa - pb;
