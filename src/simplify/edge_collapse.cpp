@@ -939,8 +939,24 @@ class Simplifier {
   // Measured with quadrics relative to each vertex (origin_of) it changes little: elephant_1m 10 %
   // identical, horse 10 % Hausdorff 0.87x -> 0.85x meshoptimizer's, 1 % 0.54x -> 0.52x. With attribute
   // weights (attributes eliminated per end) it measured mixed, so it applies positions only.
-  LODSTREAM_HOT_PATH void place(Plan& p) const {
+  // One version per channel count known at compile time (place_with, as add_face): positions only, or
+  // normals alone, else channels_. Not inlined: inlined into its callers it changed how GCC compiled them
+  // (try_collapse +104 M instructions on elephant_1m 0.1).
+  [[gnu::noinline]] void place(Plan& p) const {
+    if (channels_ == 0)
+      place_with<0>(p);
+    else if (channels_ == 3)
+      place_with<3>(p);
+    else
+      place_with<-1>(p);
+  }
+  // place for kChannels channels (-1: channels_). Positions only it has no channel code to hold registers
+  // for, and with normals alone the channel sums are unrolled (elephant_1m 0.1 callgrind: place 2,925.9 ->
+  // 2,698.3 M instructions default, 2,120.2 -> 2,044.2 M positions-only; the dispatch above 37.1 / 26.0 M).
+  template <int kChannels>
+  LODSTREAM_HOT_PATH void place_with(Plan& p) const {
     constexpr double kEndShare = 0.1;
+    const int channels = kChannels >= 0 ? kChannels : channels_;
     // Everything relative to b's origin o (a's quadrics shifted by o - o_a; b's wedges share o), x = o + y.
     const glm::dvec3 o = origin_of(p.b), shift = o - origin_of(p.a);
     // Q_a (side 0) or Q_b (side 1), summed over the end's wedges, and its weight W_side in `w_side`. The
@@ -965,19 +981,14 @@ class Simplifier {
     Reduced r = own(0, own_w[0]);
     r.add(own(1, own_w[1]));
     const double w = own_w[0] + own_w[1];
-    for (int pair = 0; pair < 2 && channels_ > 0; ++pair) {
+    for (int pair = 0; pair < 2 && channels > 0; ++pair) {
       uint32_t a = pair ? p.a2 : p.a, b = pair ? p.b2 : p.b;
       if (a == kNone) continue;
       double ww = double(quadric_[a].w) + quadric_[b].w;
       if (!(ww > 0)) continue;
       ChannelSums sums;
-      const AttributeTerm *ta = &attr_[a * size_t(channels_)], *tb = &attr_[b * size_t(channels_)];
-      // Unrolled for normals alone (three channels: the usual case; elephant_1m 0.1 callgrind: place
-      // 2,973.6 -> 2,925.9 M instructions).
-      if (channels_ == 3)
-        sums.add(ta[0], tb[0], shift), sums.add(ta[1], tb[1], shift), sums.add(ta[2], tb[2], shift);
-      else
-        for (int j = 0; j < channels_; ++j) sums.add(ta[j], tb[j], shift);
+      const AttributeTerm *ta = &attr_[a * size_t(channels)], *tb = &attr_[b * size_t(channels)];
+      for (int j = 0; j < channels; ++j) sums.add(ta[j], tb[j], shift);
       r.eliminate(sums, ww);
     }
     const glm::dvec3 pa = glm::dvec3(pos_[p.a]) - o, pb = glm::dvec3(pos_[p.b]) - o;
@@ -1020,7 +1031,7 @@ class Simplifier {
     const glm::dvec3 y = p.x;
     p.x += o;
     p.cost = q_x / (w + 1e-20);
-    if (channels_ > 0) return;
+    if (channels > 0) return;
     // An end's own term can exceed the sum's only when W_side < k W (Q_side(x) <= Q(x), rounding aside:
     // both are sums of squares), so only the smaller end of an unbalanced edge is evaluated.
     for (int side = 0; side < 2; ++side) {
