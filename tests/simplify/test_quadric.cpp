@@ -95,8 +95,9 @@ TEST(Quadric, LineGivesTheQuadricAlongTheSegment) {
     EXPECT_EQ(t_opt, r.segment_parameter(p, e));
     const double scale = 1e-12 * (1 + r.eval(p) + r.eval(p + e));
     for (double t : {0.0, 0.5, 1.0, t_opt}) EXPECT_NEAR(l.at(q_p, t), r.eval(p + t * e), scale) << trial;
-    if (l.den > 0)  // a minimum: Q is convex along the line
+    if (l.den > 0) {  // a minimum: Q is convex along the line
       for (int k = 0; k <= 20; ++k) EXPECT_LE(l.at(q_p, t_opt), l.at(q_p, k / 20.0) + scale) << trial;
+    }
   }
 }
 
