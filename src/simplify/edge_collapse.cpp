@@ -32,12 +32,13 @@
 namespace lodstream::simplify {
 namespace {
 
-// The hot paths (place, try_collapse, vertical_bound, add_face) are compiled twice, for x86-64's baseline
-// and for AVX2, and the loader picks one for the machine (GCC's function multiversioning, an ifunc): with
-// AVX2 the float and double lanes take VEX three-operand forms (fewer register copies) and vertical_bound's
-// crossing test four lanes per step. AVX2 does not include FMA, so nothing is fused into a multiply-add and
-// both versions compute the same bits (12 simplify outputs and 4 bakes cmp-identical). elephant_1m 0.1,
-// whole command, callgrind: 17,380 -> 16,920 M instructions (the collapse), -> 16,597 M (add_face).
+// The hot paths (place, try_collapse, vertical_bound, add_face, merge) are compiled twice, for x86-64's
+// baseline and for AVX2, and the loader picks one for the machine (GCC's function multiversioning, an ifunc):
+// with AVX2 the float and double lanes take VEX three-operand forms (fewer register copies) and
+// vertical_bound's crossing test four lanes per step. AVX2 does not include FMA, so nothing is fused into a
+// multiply-add and both versions compute the same bits (12 simplify outputs and 4 bakes cmp-identical).
+// elephant_1m 0.1, whole command, callgrind: 17,380 -> 16,920 M instructions (the collapse), -> 16,597 M
+// (add_face); later merge 356.0 -> 311.2 M.
 #if defined(__x86_64__) && defined(__GNUC__)
 #define LODSTREAM_HOT_PATH __attribute__((target_clones("avx2", "default")))
 #define LODSTREAM_RUNS_AVX2() __builtin_cpu_supports("avx2")  // the version the loader picks
@@ -938,29 +939,56 @@ class Simplifier {
   // Measured with quadrics relative to each vertex (origin_of) it changes little: elephant_1m 10 %
   // identical, horse 10 % Hausdorff 0.87x -> 0.85x meshoptimizer's, 1 % 0.54x -> 0.52x. With attribute
   // weights (attributes eliminated per end) it measured mixed, so it applies positions only.
-  LODSTREAM_HOT_PATH void place(Plan& p) const {
+  // One version per channel count known at compile time (place_with, as add_face): positions only, or
+  // normals alone, else channels_. Not inlined: inlined into its callers it changed how GCC compiled them
+  // (try_collapse +104 M instructions on elephant_1m 0.1).
+  [[gnu::noinline]] void place(Plan& p) const {
+    if (channels_ == 0)
+      place_with<0>(p);
+    else if (channels_ == 3)
+      place_with<3>(p);
+    else
+      place_with<-1>(p);
+  }
+  // place for kChannels channels (-1: channels_). Positions only it has no channel code to hold registers
+  // for, and with normals alone the channel sums are unrolled (elephant_1m 0.1 callgrind: place 2,925.9 ->
+  // 2,698.3 M instructions default, 2,120.2 -> 2,044.2 M positions-only; the dispatch above 37.1 / 26.0 M).
+  template <int kChannels>
+  LODSTREAM_HOT_PATH void place_with(Plan& p) const {
     constexpr double kEndShare = 0.1;
-    std::array<Reduced, 2> own;  // Q_a, Q_b
-    std::array<double, 2> own_w{0.0, 0.0};
+    const int channels = kChannels >= 0 ? kChannels : channels_;
     // Everything relative to b's origin o (a's quadrics shifted by o - o_a; b's wedges share o), x = o + y.
     const glm::dvec3 o = origin_of(p.b), shift = o - origin_of(p.a);
-    uint32_t v = p.a;
-    do own[0].add(quadric_[v], shift), own_w[0] += quadric_[v].w, v = wedge_[v];
-    while (v != p.a);
-    v = p.b;
-    do own[1].add(quadric_[v]), own_w[1] += quadric_[v].w, v = wedge_[v];
-    while (v != p.b);
-    Reduced r = own[0];
-    r.add(own[1]);
+    // Q_a (side 0) or Q_b (side 1), summed over the end's wedges, and its weight W_side in `w_side`. The
+    // end-share rule below sums one again (the same operations, so the same bits) rather than keeping both
+    // live through the whole function, where they took registers from the rest and were spilled
+    // (elephant_1m 0.1 callgrind: place 3,297.1 -> 3,107.9 M instructions default).
+    auto own = [&](int side, double& w_side) __attribute__((always_inline)) {
+      Reduced q;
+      w_side = 0.0;
+      const uint32_t first = side == 0 ? p.a : p.b;
+      uint32_t v = first;
+      do {
+        if (side == 0)
+          q.add(quadric_[v], shift);
+        else
+          q.add(quadric_[v]);
+        w_side += quadric_[v].w, v = wedge_[v];
+      } while (v != first);
+      return q;
+    };
+    std::array<double, 2> own_w;
+    Reduced r = own(0, own_w[0]);
+    r.add(own(1, own_w[1]));
     const double w = own_w[0] + own_w[1];
-    for (int pair = 0; pair < 2 && channels_ > 0; ++pair) {
+    for (int pair = 0; pair < 2 && channels > 0; ++pair) {
       uint32_t a = pair ? p.a2 : p.a, b = pair ? p.b2 : p.b;
       if (a == kNone) continue;
       double ww = double(quadric_[a].w) + quadric_[b].w;
       if (!(ww > 0)) continue;
       ChannelSums sums;
-      const AttributeTerm *ta = &attr_[a * size_t(channels_)], *tb = &attr_[b * size_t(channels_)];
-      for (int j = 0; j < channels_; ++j) sums.add(ta[j], tb[j], shift);
+      const AttributeTerm *ta = &attr_[a * size_t(channels)], *tb = &attr_[b * size_t(channels)];
+      for (int j = 0; j < channels; ++j) sums.add(ta[j], tb[j], shift);
       r.eliminate(sums, ww);
     }
     const glm::dvec3 pa = glm::dvec3(pos_[p.a]) - o, pb = glm::dvec3(pos_[p.b]) - o;
@@ -981,12 +1009,20 @@ class Simplifier {
         glm::dvec3 opt = pb + r.segment_parameter(pb, e) * e;
         if (const double q_opt = r.eval(opt); q_opt < 0.5 * std::min(ca, cb)) x = opt, q_x = q_opt;
       } else if (!r.solve(x) || glm::dot(x - mid, x - mid) > glm::dot(e, e)) {
-        // Ill-conditioned (or far away): the best of both ends, the midpoint and the minimum along the edge.
+        // Ill-conditioned (or far away): the best of both ends, the midpoint and the minimum along the edge,
+        // their costs from Q(pb) and the edge's line (Reduced::Line) instead of four evaluations: 32 % of
+        // the calls positions-only, 15 % default (elephant_1m 0.1 callgrind: place 2,333.5 -> 2,094.2 M
+        // instructions positions-only, 3,107.9 -> 2,973.6 M default). Not the same bits as the evaluations
+        // (Q(pb) + t (2 g + t den) rounds differently), but the costs are stored as floats, and all 20
+        // simplify outputs and 4 bakes compared came out identical.
+        const double q_b = r.unclamped(pb);
+        const Reduced::Line l = r.line(pb, e);
+        const double t_opt = l.parameter();
         x = pb;
-        q_x = r.eval(pb);
-        glm::dvec3 cands[3] = {pa, mid, pb + r.segment_parameter(pb, e) * e};
-        for (const auto& c : cands)
-          if (double v = r.eval(c); v < q_x) q_x = v, x = c;
+        q_x = Reduced::clamped(q_b);
+        const std::pair<double, glm::dvec3> cands[3] = {{1.0, pa}, {0.5, mid}, {t_opt, pb + t_opt * e}};
+        for (const auto& [t, c] : cands)
+          if (const double v = l.at(q_b, t); v < q_x) q_x = v, x = c;
       } else {
         q_x = r.eval(x);
       }
@@ -995,12 +1031,14 @@ class Simplifier {
     const glm::dvec3 y = p.x;
     p.x += o;
     p.cost = q_x / (w + 1e-20);
-    if (channels_ > 0) return;
+    if (channels > 0) return;
     // An end's own term can exceed the sum's only when W_side < k W (Q_side(x) <= Q(x), rounding aside:
     // both are sums of squares), so only the smaller end of an unbalanced edge is evaluated.
-    for (int side = 0; side < 2; ++side)
+    for (int side = 0; side < 2; ++side) {
+      double w_side;
       if (own_w[side] > 0 && own_w[side] < kEndShare * w)
-        p.cost = std::max(p.cost, kEndShare * own[side].eval(y) / own_w[side]);
+        p.cost = std::max(p.cost, kEndShare * own(side, w_side).eval(y) / w_side);
+    }
   }
 
   // The cheaper allowed direction of edge (i, j), as a candidate; cost = +inf when neither is allowed.
@@ -1834,7 +1872,7 @@ class Simplifier {
   // Merges quadrics and sets b's attributes: the attribute quadric's optimum s* = (G.x + D)/W for the
   // channels in the cost (channel_), linear interpolation along the edge for the others; half-edge collapses
   // keep b's.
-  void merge(uint32_t a, uint32_t b, const Plan& p) {
+  LODSTREAM_HOT_PATH void merge(uint32_t a, uint32_t b, const Plan& p) {
     const glm::dvec3 ob = origin_of(b), shift = ob - origin_of(a);
     if (p.move) {
       glm::dvec3 pa(pos_[a]), pb(pos_[b]), e = pa - pb;

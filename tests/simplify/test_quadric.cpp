@@ -80,6 +80,27 @@ TEST(Quadric, ShiftedSumIsTheScalarFormulaBitForBit) {
   }
 }
 
+TEST(Quadric, LineGivesTheQuadricAlongTheSegment) {
+  // Reduced::Line (place's fallback): Q(p + t e) from Q(p), g and den agrees with an evaluation at the
+  // point, for the ends, the midpoint and the parameter it picks, which is the minimum over [0, 1] where Q
+  // is convex along the line; and segment_parameter is that parameter.
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-0.01, 0.01);
+  for (int trial = 0; trial < 200; ++trial) {
+    Reduced r;
+    r.add(random_quadric(rng));
+    const glm::dvec3 p(u(rng), u(rng), u(rng)), e(u(rng), u(rng), u(rng));
+    const Reduced::Line l = r.line(p, e);
+    const double q_p = r.unclamped(p), t_opt = l.parameter();
+    EXPECT_EQ(t_opt, r.segment_parameter(p, e));
+    const double scale = 1e-12 * (1 + r.eval(p) + r.eval(p + e));
+    for (double t : {0.0, 0.5, 1.0, t_opt}) EXPECT_NEAR(l.at(q_p, t), r.eval(p + t * e), scale) << trial;
+    if (l.den > 0) {  // a minimum: Q is convex along the line
+      for (int k = 0; k <= 20; ++k) EXPECT_LE(l.at(q_p, t_opt), l.at(q_p, k / 20.0) + scale) << trial;
+    }
+  }
+}
+
 TEST(Quadric, PlaneIsTheScalarFormulaBitForBit) {
   // Quadric::add_plane (two float vectors and two scalars): each term (weight x first factor) x second
   // factor, added to the term before, as the header's scalar formulas; from a vec3 and d (d = 0 as for a
