@@ -104,10 +104,12 @@ __attribute__((target_clones("avx2", "default"))) void predicted_normals(
     for (size_t i = 0; i + 2 < indices.size(); i += 3) {
       const uint32_t a = indices[i] - base, b = indices[i + 1] - base, c = indices[i + 2] - base;
       if (!all_inside && (a >= V || b >= V || c >= V)) continue;
-      // cross(e, f) = e.yzx * f.zxy - e.zxy * f.yzx, as glm::cross computes each component.
+      // cross(e, f) = e.yzx * f.zxy - e.zxy * f.yzx, as glm::cross computes each component, here as the
+      // rotation of e * f.yzx - e.yzx * f (lane i: e[i] f[i + 1] - e[i + 1] f[i], the same products and
+      // difference): three shuffles a triangle instead of four (refined_elephant's `bench decode --runs 1`
+      // under callgrind: predicted_normals 6.22 -> 6.07 M instructions).
       const NormalSum pa = p(a), e = p(b) - pa, f = p(c) - pa;
-      const NormalSum e1 = rotate(e), f1 = rotate(f);
-      const NormalSum n = e1 * rotate(f1) - rotate(e1) * f1;
+      const NormalSum n = rotate(e * rotate(f) - rotate(e) * f);
       sum[a] += n, sum[b] += n, sum[c] += n;
     }
   };
