@@ -141,7 +141,9 @@ DecodedNode extract_cluster(const DecodedNode& record, uint32_t cluster, const s
   size_t n = 0;
   // Without a branch (which mispredicted at about every first use, a fifth of the corners): first_use[n] is
   // written every time and kept only when v is new. A triangle a step, the count in 64 bits (no zero
-  // extension before it indexes): ~15 -> ~12.5 instructions a corner.
+  // extension before it indexes): ~15 -> ~12.5 instructions a corner; the loop by pointer, one counter a
+  // triangle fewer (`bench decode --runs 1` under callgrind, decode_node: refined_elephant 44.32 -> 44.18 M,
+  // elephant_1m 668.4 -> 666.0 M).
   auto renumber = [&](uint32_t& v) {
     const size_t seen = map[v];
     const size_t fresh = seen >> 31;  // 1 for UINT32_MAX (not used yet): cluster vertices are below 2^31
@@ -150,9 +152,8 @@ DecodedNode extract_cluster(const DecodedNode& record, uint32_t cluster, const s
     map[v] = c, n += fresh;
     v = c;
   };
-  uint32_t* const corners = m.indices.data();
-  for (size_t i = 0; i < 3 * count; i += 3)
-    renumber(corners[i]), renumber(corners[i + 1]), renumber(corners[i + 2]);
+  for (uint32_t *t = m.indices.data(), *const end = t + 3 * count; t != end; t += 3)
+    renumber(t[0]), renumber(t[1]), renumber(t[2]);
   // Whether the cluster leaves the record's last vertex out: its others are followed by 4 bytes of their
   // arrays (gather_positions_normals' wide form).
   const bool wide = !in.positions.empty() && map[in.positions.size() - 1] == UINT32_MAX;
