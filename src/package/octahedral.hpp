@@ -55,10 +55,14 @@ inline glm::vec3 oct_decode(int x, int y, float inv_scale) {
   return {fx * inv_length, fy * inv_length, fz * inv_length};
 }
 
-// Four lanes (GCC / Clang vector extensions, one SSE register). The 4-lane oct_decode below computes in each
-// lane exactly what the scalar one computes (the same operations in the same order).
+// Four lanes (GCC / Clang vector extensions, one SSE register). The 4- and 8-lane oct_decode below computes
+// in each lane exactly what the scalar one computes (the same operations in the same order).
 using Float4 = float __attribute__((vector_size(16)));
 using Int4 = int32_t __attribute__((vector_size(16)));
+// Eight lanes: decode_predicted_normals takes 8 vertices a step (one AVX register in its AVX2 build, two SSE
+// registers in the baseline one).
+using Float8 = float __attribute__((vector_size(32)));
+using Int8 = int32_t __attribute__((vector_size(32)));
 
 // Lane i of the result is lane I[i] of the concatenation (a, b).
 template <int... I>
@@ -69,18 +73,27 @@ inline Float4 shuffle(Float4 a, Float4 b) {
   return __builtin_shuffle(a, b, Int4{I...});
 #endif
 }
-inline Float4 splat(float v) {
-  return Float4{v, v, v, v};
+// Every lane v, in any of the vector types above.
+template <class V>
+inline V splat_as(float v) {
+  V r;
+  for (size_t i = 0; i < sizeof(V) / sizeof(float); ++i) r[i] = v;
+  return r;
 }
-inline Float4 select(Int4 mask, Float4 yes, Float4 no) {
-  return Float4((Int4(yes) & mask) | (Int4(no) & ~mask));
+// The lanes and masks below for Float4 / Int4 and Float8 / Int8 alike (M the mask type of V).
+template <class M, class V>
+inline V select(M mask, V yes, V no) {
+  return V((M(yes) & mask) | (M(no) & ~mask));
 }
-inline Float4 abs(Float4 v) {
-  return Float4(Int4(v) & 0x7fffffff);
+template <class V>
+inline V abs(V v) {
+  using M = decltype(v < v);
+  return V(M(v) & 0x7fffffff);
 }
 // std::max(v, lo) and std::min(v, hi) as the standard defines them ((a < b) ? b : a, (b < a) ? b : a).
-inline Float4 clamp(Float4 v, Float4 lo, Float4 hi) {
-  const Float4 m = select(v < lo, lo, v);
+template <class V>
+inline V clamp(V v, V lo, V hi) {
+  const V m = select(v < lo, lo, v);
   return select(hi < m, hi, m);
 }
 inline Float4 sqrt(Float4 v) {
@@ -90,17 +103,25 @@ inline Float4 sqrt(Float4 v) {
   return Float4{std::sqrt(v[0]), std::sqrt(v[1]), std::sqrt(v[2]), std::sqrt(v[3])};
 #endif
 }
+// Float8 by its halves (a template, instantiated only where Float8 is used: a function of Float8 values
+// draws GCC's ABI note, -Wpsabi, in a translation unit built without AVX).
+template <class V>
+requires(sizeof(V) == sizeof(Float8)) inline V sqrt(V v) {
+  const Float4 low = sqrt(Float4{v[0], v[1], v[2], v[3]}), high = sqrt(Float4{v[4], v[5], v[6], v[7]});
+  return V{low[0], low[1], low[2], low[3], high[0], high[1], high[2], high[3]};
+}
 
-// oct_decode of 4 codes (x[i], y[i]) into (nx[i], ny[i], nz[i]).
-inline void oct_decode(Int4 x, Int4 y, float inv_scale, Float4& nx, Float4& ny, Float4& nz) {
-  const Float4 zero = splat(0.0f), one = splat(1.0f);
-  Float4 fx = clamp(__builtin_convertvector(x, Float4) * inv_scale, -one, one);
-  Float4 fy = clamp(__builtin_convertvector(y, Float4) * inv_scale, -one, one);
-  const Float4 fz = one - abs(fx) - abs(fy);
-  const Float4 t = select(-fz < zero, zero, -fz);
+// oct_decode of 4 or 8 codes (x[i], y[i]: Int4 or Int8) into (nx[i], ny[i], nz[i]).
+template <class I, class V>
+inline void oct_decode(I x, I y, float inv_scale, V& nx, V& ny, V& nz) {
+  const V zero = splat_as<V>(0.0f), one = splat_as<V>(1.0f);
+  V fx = clamp(__builtin_convertvector(x, V) * inv_scale, -one, one);
+  V fy = clamp(__builtin_convertvector(y, V) * inv_scale, -one, one);
+  const V fz = one - abs(fx) - abs(fy);
+  const V t = select(-fz < zero, zero, -fz);
   fx += select(fx >= zero, -t, t);
   fy += select(fy >= zero, -t, t);
-  const Float4 inv_length = one / sqrt(fx * fx + fy * fy + fz * fz);
+  const V inv_length = one / sqrt(fx * fx + fy * fy + fz * fz);
   nx = fx * inv_length, ny = fy * inv_length, nz = fz * inv_length;
 }
 

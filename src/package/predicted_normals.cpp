@@ -1,3 +1,7 @@
+// Float8 values (decode_predicted_normals) pass only between inline functions of this file and
+// octahedral.hpp: GCC's note that their ABI differs without AVX (-Wpsabi) does not apply.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
 #include "package/predicted_normals.hpp"
 
 #include <algorithm>
@@ -19,26 +23,29 @@ NormalSum rotate(NormalSum v) {
   return shuffle<1, 2, 0, 3>(v, v);
 }
 
-// The orthonormal frame (t, b, p) of 4 predictions, lane i from (x[i], y[i], z[i]): p the unit prediction
-// (+z for a zero or non-finite sum), t and b from Duff et al. 2017, "Building an Orthonormal Basis,
-// Revisited" (JCGT 6(1), listing 3): with s = sign(p.z), a = -1 / (s + p.z), c = p.x p.y a,
-// t = (1 + s p.x^2 a, s c, -s p.x), b = (c, s + p.y^2 a, -p.y). The encoder and the decoder both call it, so
-// that they work in the same frame to the bit (the frame jumps where p.z changes sign). Forced inline (as
-// transpose): out of line, the decoder's AVX2 build called it and spilled the frame per 4 vertices (1.8 %
-// more decode instructions on refined_elephant).
-struct Frame4 {
-  Float4 t[3], b[3], p[3];
+// The orthonormal frame (t, b, p) of 4 (Float4) or 8 (Float8) predictions, lane i from (x[i], y[i], z[i]):
+// p the unit prediction (+z for a zero or non-finite sum), t and b from Duff et al. 2017, "Building an
+// Orthonormal Basis, Revisited" (JCGT 6(1), listing 3): with s = sign(p.z), a = -1 / (s + p.z), c = p.x p.y
+// a, t = (1 + s p.x^2 a, s c, -s p.x), b = (c, s + p.y^2 a, -p.y). The encoder and the decoder both call it,
+// so that they work in the same frame to the bit (the frame jumps where p.z changes sign; the same
+// operations in every lane, however many lanes). Forced inline (as transpose): out of line, the decoder's
+// AVX2 build called it and spilled the frame per 4 vertices (1.8 % more decode instructions on
+// refined_elephant).
+template <class V>
+struct Frame {
+  V t[3], b[3], p[3];
 };
-[[gnu::always_inline]] inline Frame4 prediction_frame(Float4 x, Float4 y, Float4 z) {
-  const Float4 zero = splat(0.0f), one = splat(1.0f);
-  const Float4 length2 = x * x + y * y + z * z;
-  const Int4 usable = (length2 > zero) & (length2 <= splat(std::numeric_limits<float>::max()));
-  const Float4 inv_length = one / sqrt(select(usable, length2, one));
-  Frame4 f;
+template <class V>
+[[gnu::always_inline]] inline Frame<V> prediction_frame(V x, V y, V z) {
+  const V zero = splat_as<V>(0.0f), one = splat_as<V>(1.0f);
+  const V length2 = x * x + y * y + z * z;
+  const auto usable = (length2 > zero) & (length2 <= splat_as<V>(std::numeric_limits<float>::max()));
+  const V inv_length = one / sqrt(select(usable, length2, one));
+  Frame<V> f;
   f.p[0] = select(usable, x * inv_length, zero), f.p[1] = select(usable, y * inv_length, zero);
   f.p[2] = select(usable, z * inv_length, one);
-  const Float4 s = select(f.p[2] >= zero, one, -one);
-  const Float4 a = -one / (s + f.p[2]), c = f.p[0] * f.p[1] * a;
+  const V s = select(f.p[2] >= zero, one, -one);
+  const V a = -one / (s + f.p[2]), c = f.p[0] * f.p[1] * a;
   f.t[0] = one + s * f.p[0] * f.p[0] * a, f.t[1] = s * c, f.t[2] = -s * f.p[0];
   f.b[0] = c, f.b[1] = s + f.p[1] * f.p[1] * a, f.b[2] = -f.p[1];
   return f;
@@ -104,10 +111,12 @@ __attribute__((target_clones("avx2", "default"))) void predicted_normals(
     for (size_t i = 0; i + 2 < indices.size(); i += 3) {
       const uint32_t a = indices[i] - base, b = indices[i + 1] - base, c = indices[i + 2] - base;
       if (!all_inside && (a >= V || b >= V || c >= V)) continue;
-      // cross(e, f) = e.yzx * f.zxy - e.zxy * f.yzx, as glm::cross computes each component.
+      // cross(e, f) = e.yzx * f.zxy - e.zxy * f.yzx, as glm::cross computes each component, here as the
+      // rotation of e * f.yzx - e.yzx * f (lane i: e[i] f[i + 1] - e[i + 1] f[i], the same products and
+      // difference): three shuffles a triangle instead of four (refined_elephant's `bench decode --runs 1`
+      // under callgrind: predicted_normals 6.22 -> 6.07 M instructions).
       const NormalSum pa = p(a), e = p(b) - pa, f = p(c) - pa;
-      const NormalSum e1 = rotate(e), f1 = rotate(f);
-      const NormalSum n = e1 * rotate(f1) - rotate(e1) * f1;
+      const NormalSum n = rotate(e * rotate(f) - rotate(e) * f);
       sum[a] += n, sum[b] += n, sum[c] += n;
     }
   };
@@ -147,7 +156,7 @@ std::vector<uint64_t> normal_residuals(std::span<const glm::vec3> normals, std::
   for (size_t i = 0; i < V; i += 4) {  // sum holds a multiple of 4 entries
     Float4 x, y, z;
     transpose(&sum[i], x, y, z);
-    const Frame4 f = prediction_frame(x, y, z);
+    const Frame<Float4> f = prediction_frame(x, y, z);
     for (size_t l = 0; l < 4 && i + l < V; ++l) {
       const glm::vec3 n = normals[order[i + l]];
       auto dot = [&](const Float4(&axis)[3]) {
@@ -182,42 +191,84 @@ NormalCodes code_normals(std::span<const glm::vec3> normals, std::span<const uin
   return best;
 }
 
-// An AVX2 build besides the baseline one, as predicted_normals.
+namespace {
+
+// Lanes 0-3 of x, y, z as 4 normals (12 floats) at out.
+[[gnu::always_inline]] inline void store_normals(Float4 x, Float4 y, Float4 z, glm::vec3* out) {
+  // (x0 y0 z0 x1) (y1 z1 x2 y2) (z2 x3 y3 z3)
+  const Float4 xy = shuffle<0, 4, 1, 5>(x, y), yz = shuffle<3, 5, 3, 5>(xy, z),
+               high = shuffle<2, 6, 3, 7>(x, y);
+  const Float4 rows[3] = {shuffle<0, 1, 4, 2>(xy, z), shuffle<0, 1, 4, 5>(yz, high),
+                          shuffle<6, 2, 3, 7>(high, z)};
+  std::memcpy(out, rows, sizeof rows);
+}
+
+// a then b as one Float8.
+[[gnu::always_inline]] inline Float8 joined(Float4 a, Float4 b) {
+  return Float8{a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]};
+}
+
+// The codes r[0 .. lanes) as an Int4 or Int8: codes of a valid node are below 2^16, hostile ones are clamped
+// to +-2^18 first (oct_decode clamps them again).
+template <class I>
+[[gnu::always_inline]] inline I clamped_codes(const int32_t* r) {
+  const I limit = I{} + (1 << 18);
+  I v;
+  std::memcpy(&v, r, sizeof v);
+  v = v < -limit ? -limit : v;
+  return v > limit ? limit : v;
+}
+
+// The normals of 4 (Float4, Int4) or 8 (Float8, Int8) predictions x, y, z from their codes u (first
+// components) and v: each code decoded in its prediction's frame.
+template <class F, class I>
+[[gnu::always_inline]] inline void decode_in_frames(F px, F py, F pz, const int32_t* u_codes,
+                                                    const int32_t* v_codes, float inv_scale, F& x, F& y,
+                                                    F& z) {
+  const Frame<F> f = prediction_frame(px, py, pz);
+  F u, w, h;  // the normal in the frame
+  oct_decode(clamped_codes<I>(u_codes), clamped_codes<I>(v_codes), inv_scale, u, w, h);
+  x = u * f.t[0] + w * f.b[0] + h * f.p[0], y = u * f.t[1] + w * f.b[1] + h * f.p[1];
+  z = u * f.t[2] + w * f.b[2] + h * f.p[2];
+}
+
+}  // namespace
+
+// An AVX2 build besides the baseline one, as predicted_normals; 8 vertices a step in both (the baseline
+// build's 8 lanes are two SSE registers), where 4 a step took more instructions for the frames and decodes
+// (`bench decode --runs 1` under callgrind, decode_node: refined_elephant 45.80 -> 45.49 M, elephant_1m
+// 687.9 -> 682.8 M).
 __attribute__((target_clones("avx2", "default"))) void decode_predicted_normals(
     std::span<const NormalSum> sum, uint32_t V, const uint8_t* planes, uint32_t width, uint32_t bits,
     std::vector<glm::vec3>& normals) {
-  // Four vertices a step: their sums transposed to lanes, their frames built, the codes decoded in them,
-  // transposed back into 12 floats. sum holds a multiple of 4 entries; residual and normals take the last
-  // step's spare lanes, dropped at the end (written in place: a reused `normals` is zero-filled only where it
-  // grows, where decoding into scratch copied every normal, refined_elephant's bench decode 0.9 M of memcpy).
-  const size_t steps = (size_t(V) + 3) / 4;
+  // Eight vertices a step, then four: their sums transposed to lanes, their frames built, the codes decoded
+  // in them, transposed back into 3 floats each. sum holds a multiple of 4 entries; residual and normals
+  // take the last step's spare lanes, dropped at the end (written in place: a reused `normals` is
+  // zero-filled only where it grows, where decoding into scratch copied every normal, refined_elephant's
+  // bench decode 0.9 M of memcpy).
+  const size_t lanes = (size_t(V) + 3) & ~size_t(3);
   thread_local std::vector<int32_t> residual;
-  residual.resize(2 * size_t(V) + 4), normals.resize(4 * steps);
+  residual.resize(2 * size_t(V) + 4), normals.resize(lanes);
   glm::vec3* const out = normals.data();
   read_planes(planes, V, 2, width, residual.data());
   const float inv_scale = 1.0f / frame_scale(bits);
-  const Int4 limit = {1 << 18, 1 << 18, 1 << 18, 1 << 18};
-  auto clamp_residual = [&](const int32_t* r) {
-    // codes of a valid node are below 2^16, hostile ones are clamped first (oct_decode clamps them again).
-    Int4 v;
-    std::memcpy(&v, r, sizeof v);
-    v = v < -limit ? -limit : v;
-    return v > limit ? limit : v;
-  };
-  for (size_t i = 0; i < steps; ++i) {
-    Float4 px, py, pz;
-    transpose(&sum[4 * i], px, py, pz);
-    const Frame4 f = prediction_frame(px, py, pz);
-    Float4 u, w, h;  // the normal in the frame
-    oct_decode(clamp_residual(&residual[4 * i]), clamp_residual(&residual[V + 4 * i]), inv_scale, u, w, h);
-    const Float4 x = u * f.t[0] + w * f.b[0] + h * f.p[0], y = u * f.t[1] + w * f.b[1] + h * f.p[1],
-                 z = u * f.t[2] + w * f.b[2] + h * f.p[2];
-    // (x0 y0 z0 x1) (y1 z1 x2 y2) (z2 x3 y3 z3)
-    const Float4 xy = shuffle<0, 4, 1, 5>(x, y), yz = shuffle<3, 5, 3, 5>(xy, z),
-                 high = shuffle<2, 6, 3, 7>(x, y);
-    const Float4 rows[3] = {shuffle<0, 1, 4, 2>(xy, z), shuffle<0, 1, 4, 5>(yz, high),
-                            shuffle<6, 2, 3, 7>(high, z)};
-    std::memcpy(&out[4 * i], rows, sizeof rows);
+  size_t i = 0;
+  for (; i + 8 <= lanes; i += 8) {
+    Float4 x[2], y[2], z[2];
+    transpose(&sum[i], x[0], y[0], z[0]), transpose(&sum[i + 4], x[1], y[1], z[1]);
+    Float8 nx, ny, nz;
+    decode_in_frames<Float8, Int8>(joined(x[0], x[1]), joined(y[0], y[1]), joined(z[0], z[1]), &residual[i],
+                                   &residual[V + i], inv_scale, nx, ny, nz);
+    store_normals(Float4{nx[0], nx[1], nx[2], nx[3]}, Float4{ny[0], ny[1], ny[2], ny[3]},
+                  Float4{nz[0], nz[1], nz[2], nz[3]}, &out[i]);
+    store_normals(Float4{nx[4], nx[5], nx[6], nx[7]}, Float4{ny[4], ny[5], ny[6], ny[7]},
+                  Float4{nz[4], nz[5], nz[6], nz[7]}, &out[i + 4]);
+  }
+  for (; i < lanes; i += 4) {
+    Float4 px, py, pz, nx, ny, nz;
+    transpose(&sum[i], px, py, pz);
+    decode_in_frames<Float4, Int4>(px, py, pz, &residual[i], &residual[V + i], inv_scale, nx, ny, nz);
+    store_normals(nx, ny, nz, &out[i]);
   }
   normals.resize(V);
 }

@@ -7,7 +7,7 @@
 // area around its poles than on average). The codes are zigzag-mapped, as byte planes (byte_planes.hpp;
 // byte b of component a at plane 2b + a). Interior vertices of a smooth mesh mostly store 0; seams and
 // creases store what they differ by. The frame is discontinuous where p.z changes sign, so the decoder must
-// build it from the same bits as the encoder: both use the same 4-lane functions on the same sums.
+// build it from the same bits as the encoder: both use the same lane-wise functions on the same sums.
 #pragma once
 
 #include <cstdint>
@@ -56,8 +56,8 @@ std::vector<uint64_t> normal_residuals(std::span<const glm::vec3> normals, std::
                                        std::span<const NormalSum> sum, uint32_t bits, uint32_t& width);
 
 // normals = V entries decoded from the code planes (2 * width * V bytes; hostile codes are clamped, never
-// overflow) in the frames of sum[v], with octahedral.hpp's 4-lane decode. Cost: O(V), one pass of 4-lane
-// frames and decodes.
+// overflow) in the frames of sum[v], with octahedral.hpp's 8- and 4-lane decodes. Cost: O(V), one pass of
+// 8-lane frames and decodes (4 for the last 4 vertices when the padded count is not a multiple of 8).
 void decode_predicted_normals(std::span<const NormalSum> sum, uint32_t V, const uint8_t* planes,
                               uint32_t width, uint32_t bits, std::vector<glm::vec3>& normals);
 

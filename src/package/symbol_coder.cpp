@@ -23,8 +23,10 @@ constexpr uint32_t alphabet(uint32_t t) {
 
 // Move-to-front (Bentley, Sleator, Tarjan & Wei 1986, "A locally adaptive data compression scheme", CACM
 // 29(4)) over the recent cluster codes (symbol_coder.hpp): the code of rank r, which then moves to the front.
-// Cost: a few instructions for r < 8 (most ranks: the codes of bytes 0..r of one little-endian word move
-// up a byte, without a loop), O(r) above.
+// Cost: a few instructions for r < 16 (most ranks: the codes of bytes 0..r of one or two little-endian
+// words move up a byte, without a loop), a memmove above. Measured (`bench decode --runs 1` under
+// callgrind, read_page): a byte loop for every rank from 8 took elephant_1m 257.20 M instructions,
+// refined_elephant 15.50 M (~180 a rank above 16, 14,172 of them in elephant_1m), these 255.92 / 15.37.
 uint32_t to_front(RecentClusterCodes& recent, uint32_t r) {
   const uint8_t code = recent[r];
   if (r < 8) [[likely]] {
@@ -35,7 +37,16 @@ uint32_t to_front(RecentClusterCodes& recent, uint32_t r) {
     std::memcpy(recent.data(), &word, 8);
     return code;
   }
-  for (; r > 0; --r) recent[r] = recent[r - 1];
+  if (r < 16) {
+    uint64_t word[2];
+    std::memcpy(word, recent.data(), 16);
+    const uint64_t moved = ~uint64_t(0) >> (56 - 8 * (r - 8));  // bytes 8..r
+    word[1] = (word[1] & ~moved) | (((word[1] << 8) | (word[0] >> 56)) & moved);
+    word[0] = (word[0] << 8) | code;
+    std::memcpy(recent.data(), word, 16);
+    return code;
+  }
+  std::memmove(recent.data() + 1, recent.data(), r);
   recent[0] = code;
   return code;
 }

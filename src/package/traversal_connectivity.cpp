@@ -375,8 +375,10 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
   // The parallelogram of edge x -> y of triangle (x, y, u) joined to triangle (y, x, w), as the triangle of
   // the smaller of u and w in its winding (traversal_connectivity.hpp).
   auto join = [&](uint32_t x, uint32_t y, uint32_t u, uint32_t w) {
+    // Tested before the swap, which most joins then skip (refined_elephant's `bench decode --runs 1` under
+    // callgrind: decode_symbols<true> 12.92 -> 12.84 M instructions).
+    if (std::max(u, w) <= std::max(x, y) || u == w) return;
     if (u > w) std::swap(x, y), std::swap(u, w);  // (x, y, u) the triangle of the smaller
-    if (w <= std::max(x, y) || u == w) return;
     uint32_t* to = predictors + 3 * size_t(w);
     if (to[0] != to[1]) {  // not single: the second parallelogram, unless found
       if (extra->found[w]) return;

@@ -73,6 +73,39 @@ TEST(PredictedNormals, EveryNormalComesBackInAnyFrame) {
   }
 }
 
+TEST(PredictedNormals, EightLanesDecodeTheBitsOfFour) {
+  // decode_predicted_normals takes 8 vertices a step and the last 4 alone: each group of 4 decoded alone (4
+  // lanes) gives the same bits as within the whole (8 lanes), in every frame of the test above.
+  std::mt19937 rng(7);
+  std::normal_distribution<float> g;
+  const uint32_t V = 36, bits = 9;  // 4 steps of 8, then one of 4
+  std::vector<NormalSum> sum(V);
+  std::vector<glm::vec3> normals(V);
+  for (uint32_t v = 0; v < V; ++v) {
+    sum[v] = v % 7 == 0 ? NormalSum{0, 0, -0.0f, 0} : NormalSum{g(rng), g(rng), g(rng), 0};
+    normals[v] = glm::normalize(glm::vec3(g(rng), g(rng), g(rng)));
+  }
+  std::vector<uint32_t> order(V);
+  std::iota(order.begin(), order.end(), 0u);
+  uint32_t width = 0;
+  const std::vector<uint64_t> codes = normal_residuals(normals, order, sum, bits, width);
+  std::vector<uint8_t> planes;
+  put_planes(planes, codes, 2, width);
+  std::vector<glm::vec3> whole;
+  decode_predicted_normals(sum, V, planes.data(), width, bits, whole);
+  for (uint32_t first = 0; first < V; first += 4) {
+    const std::vector<uint64_t> group(codes.begin() + 2 * first, codes.begin() + 2 * (first + 4));
+    std::vector<uint8_t> group_planes;
+    put_planes(group_planes, group, 2, width);
+    std::vector<glm::vec3> alone;
+    decode_predicted_normals(std::span(sum).subspan(first, 4), 4, group_planes.data(), width, bits, alone);
+    for (uint32_t v = 0; v < 4; ++v)
+      for (int a = 0; a < 3; ++a)
+        EXPECT_EQ(std::bit_cast<uint32_t>(alone[v][a]), std::bit_cast<uint32_t>(whole[first + v][a]))
+            << first + v;
+  }
+}
+
 TEST(PredictedNormals, AWellPredictedNormalStoresZeros) {
   // Normals equal to their (unnormalized) predictions code as (0, 0) in their frames, whatever their length.
   std::mt19937 rng(5);
