@@ -34,8 +34,9 @@ inline constexpr std::array<uint8_t, 8> kMagic = {0x89, 'L', 'O', 'D', 'S', '\r'
 // kPlanePrediction), position residuals coded in two streams (page_parts.hpp, the split form); 10: positions
 // predicted by the average of the parallelograms the traversal joins (predictive_node.hpp,
 // kMultiParallelogram); 11: closed vertices' normals derived at every DAG level, not level 0 only
-// (derived_normals.hpp; the encoder's choice, decoders unchanged).
-inline constexpr uint32_t kFormatVersion = 11;
+// (derived_normals.hpp; the encoder's choice, decoders unchanged); 12: index records without vertex counts,
+// a node's own sphere coded against its parents' (index.hpp).
+inline constexpr uint32_t kFormatVersion = 12;
 inline constexpr size_t kHeaderSize = 64;
 
 // Hard limits a reader enforces before allocating: no valid writer output exceeds them.

@@ -14,10 +14,10 @@ namespace lodstream::package {
 
 namespace {
 
-// Smallest serialized node record (index.hpp, "Node records"): head, 3 field deltas, triangles, vertices, the
-// object count and the two pair codes, with both link lists implied and page, offset, size and cluster
-// those of the previous record's bytes (bit 5).
-constexpr size_t kMinNodeRecordBytes = 9;
+// Smallest serialized node record (index.hpp, "Node records"): head, 3 field deltas, triangles, the object
+// count and the two pair codes, with both link lists implied and page, offset, size and cluster those of the
+// previous record's bytes (bit 5).
+constexpr size_t kMinNodeRecordBytes = 8;
 
 // An error bound: non-negative, +infinity allowed (nothing replaces the node), NaN rejected.
 float read_error(ByteReader& r) {
@@ -92,7 +92,6 @@ enum Field : size_t {
   kLocation,      // page, offset
   kSize,          // size, cluster
   kTriangles,     // triangle count
-  kVertices,      // vertex count
   kChildren,      // children list
   kParents,       // parents list
   kObjects,       // objects list
@@ -159,8 +158,16 @@ struct RecordRun {
       return nullptr;
     return &done[n.parents[0] - first_id];
   }
+  // The exponent and centre a compact pair is coded against: the parents' sphere `base` when given (a node's
+  // own sphere lies inside its parents', so its centre is a few grid steps from theirs and its radius a
+  // power of two or so below: the exponent is coded against ilogb of the parents' radius), else the run's
+  // previous compact pair.
+  std::pair<int, glm::vec3> reference(const Sphere* base) const {
+    if (!base) return {exponent, center};
+    return {std::isnormal(base->radius) ? std::ilogb(base->radius) : exponent, base->center};
+  }
   // Writes `p` compactly and returns true when it decodes back bit for bit.
-  bool write_compact(FieldWriters& w, const ErrorPair& p) {
+  bool write_compact(FieldWriters& w, const ErrorPair& p, const Sphere* base) {
     const uint32_t error_bits = std::bit_cast<uint32_t>(p.error);
     if ((error_bits & 0xFFu) != 0 || !std::isfinite(p.sphere.radius) || !std::isfinite(p.sphere.center.x) ||
         !std::isfinite(p.sphere.center.y) || !std::isfinite(p.sphere.center.z))
@@ -180,13 +187,14 @@ struct RecordRun {
     ByteWriter& error = w[kPairError];
     error.u8(uint8_t(error_bits >> 8)), error.u8(uint8_t(error_bits >> 16)),
         error.u8(uint8_t(error_bits >> 24));
-    w[kPairExponent].svarint(e - exponent);
-    for (int a = 0; a < 3; ++a) w[kPairCentre].svarint(k[a] - grid_reference(center[a], e));
+    const auto [reference_exponent, reference_center] = reference(base);
+    w[kPairExponent].svarint(e - reference_exponent);
+    for (int a = 0; a < 3; ++a) w[kPairCentre].svarint(k[a] - grid_reference(reference_center[a], e));
     w[kPairRadius].varint(uint64_t(k[3]));
     exponent = e, center = p.sphere.center;
     return true;
   }
-  ErrorPair read_compact(FieldReaders& r) {
+  ErrorPair read_compact(FieldReaders& r, const Sphere* base) {
     ErrorPair p;
     ByteReader& error = r[kPairError];
     uint32_t error_bits = uint32_t(error.u8()) << 8;
@@ -194,15 +202,16 @@ struct RecordRun {
     error_bits |= uint32_t(error.u8()) << 24;
     p.error = std::bit_cast<float>(error_bits);
     if (std::isnan(p.error) || p.error < 0.0f) error.fail("invalid error bound");
+    const auto [reference_exponent, reference_center] = reference(base);
     const int64_t de = r[kPairExponent].svarint();
-    if (de < kMinPairExponent - exponent || de > kMaxPairExponent - exponent)
+    if (de < kMinPairExponent - reference_exponent || de > kMaxPairExponent - reference_exponent)
       r[kPairExponent].fail("sphere exponent out of range");
-    const int e = exponent + int(de);
+    const int e = reference_exponent + int(de);
     for (int a = 0; a < 3; ++a) {
-      const int64_t delta = r[kPairCentre].svarint(), base = grid_reference(center[a], e);
-      if (delta < -kMaxPairInteger - base || delta > kMaxPairInteger - base)
+      const int64_t delta = r[kPairCentre].svarint(), grid = grid_reference(reference_center[a], e);
+      if (delta < -kMaxPairInteger - grid || delta > kMaxPairInteger - grid)
         r[kPairCentre].fail("sphere centre out of range");
-      p.sphere.center[a] = float(std::ldexp(double(base + delta), e));
+      p.sphere.center[a] = float(std::ldexp(double(grid + delta), e));
     }
     const uint64_t radius = r[kPairRadius].varint();
     if (radius > uint64_t(kMaxPairInteger)) r[kPairRadius].fail("sphere radius out of range");
@@ -216,13 +225,13 @@ struct RecordRun {
   // Pair code: `skip` = a literal (error f32, sphere 4 f32), skip + 1 = a compact pair, both joining the
   // table; skip + 1 + k (k >= 1) = the k-th latest pair of the table; codes below `skip` are taken by the
   // caller.
-  void write_pair(FieldWriters& w, const ErrorPair& p, uint64_t skip) {
+  void write_pair(FieldWriters& w, const ErrorPair& p, uint64_t skip, const Sphere* base) {
     const auto it = std::find(pairs.rbegin(), pairs.rend(), p);
     if (it != pairs.rend()) {
       w[kPairCode].varint(skip + 2 + uint64_t(it - pairs.rbegin()));
       return;
     }
-    if (write_compact(w, p)) {  // writes nothing when it returns false
+    if (write_compact(w, p, base)) {  // writes nothing when it returns false
       w[kPairCode].varint(skip + 1);
     } else {
       w[kPairCode].varint(skip);
@@ -232,14 +241,14 @@ struct RecordRun {
     }
     pairs.push_back(p);
   }
-  ErrorPair read_pair(FieldReaders& r, uint64_t code) {
+  ErrorPair read_pair(FieldReaders& r, uint64_t code, const Sphere* base) {
     if (code > 1) {
       if (code - 1 > pairs.size()) r[kPairCode].fail("error pair reference out of range");
       return pairs[pairs.size() - (code - 1)];
     }
     ErrorPair p;
     if (code == 1) {
-      p = read_compact(r);
+      p = read_compact(r, base);
     } else {
       p.error = read_error(r[kPairError]);
       for (int a = 0; a < 3; ++a) p.sphere.center[a] = r[kPairCentre].finite_f32("sphere centre");
@@ -271,17 +280,17 @@ void write_node(FieldWriters& w, const NodeRecord& n, uint32_t id, RecordRun& ru
     w[kSize].varint(n.size);
     w[kSize].varint(n.cluster);
   }
-  w[kTriangles].varint(n.triangles), w[kVertices].varint(n.vertices);
+  w[kTriangles].varint(n.triangles);
   if (!same_children) write_ids(w[kChildren], n.children, id);
   if (!same_parents) write_ids(w[kParents], n.parents, id);
   write_ids(w[kObjects], n.objects, 0);
-  run.write_pair(w, own_pair(n), 0);
   const NodeRecord* parent = run.first_parent(n);
   if (parent && own_pair(*parent) == parent_pair(n)) {
     w[kPairCode].varint(0);
   } else {
-    run.write_pair(w, parent_pair(n), 1);
+    run.write_pair(w, parent_pair(n), 1, nullptr);
   }
+  run.write_pair(w, own_pair(n), 0, n.parents.empty() ? nullptr : &n.parent_sphere);
 }
 
 NodeRecord read_node(FieldReaders& r, const RootIndex& root, uint32_t id, RecordRun& run) {
@@ -317,12 +326,9 @@ NodeRecord read_node(FieldReaders& r, const RootIndex& root, uint32_t id, Record
   if (n.cluster >= kMaxRecordClusters)
     r[kSize].fail("node " + std::to_string(id) + ": cluster index of its record out of range");
   n.triangles = r[kTriangles].index(uint64_t(UINT32_MAX) + 1, "triangle count");
-  n.vertices = r[kVertices].index(uint64_t(UINT32_MAX) + 1, "vertex count");
   n.children = head & kSameChildren ? prev.children : read_ids(r[kChildren], id, root.node_count, "child");
   n.parents = head & kSameParents ? prev.parents : read_ids(r[kParents], id, root.node_count, "parent");
   n.objects = read_ids(r[kObjects], 0, root.scene.objects.size(), "object");
-  const ErrorPair own = run.read_pair(r, r[kPairCode].varint());
-  n.error = own.error, n.sphere = own.sphere;
   const uint64_t code = r[kPairCode].varint();
   ErrorPair parents;
   if (code == 0) {
@@ -331,9 +337,12 @@ NodeRecord read_node(FieldReaders& r, const RootIndex& root, uint32_t id, Record
       r[kPairCode].fail("node " + std::to_string(id) + ": parents' pair refers to a record outside this run");
     parents = own_pair(*parent);
   } else {
-    parents = run.read_pair(r, code - 1);
+    parents = run.read_pair(r, code - 1, nullptr);
   }
   n.parent_error = parents.error, n.parent_sphere = parents.sphere;
+  const ErrorPair own =
+      run.read_pair(r, r[kPairCode].varint(), n.parents.empty() ? nullptr : &n.parent_sphere);
+  n.error = own.error, n.sphere = own.sphere;
   return n;
 }
 

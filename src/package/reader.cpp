@@ -213,11 +213,9 @@ DecodedNode PackageReader::decode_node(uint32_t id, std::span<const uint8_t> pag
     last.valid = true, last.page = n.page, last.offset = n.offset, last.size = n.size;
   }
   DecodedNode decoded = extract_cluster(last.decoded, n.cluster, what);
-  if (decoded.mesh.triangle_count() != n.triangles || decoded.mesh.vertex_count() != n.vertices) {
-    throw Error(what + ": record says " + std::to_string(n.triangles) + " triangles / " +
-                std::to_string(n.vertices) + " vertices, its bytes hold " +
-                std::to_string(decoded.mesh.triangle_count()) + " / " +
-                std::to_string(decoded.mesh.vertex_count()));
+  if (decoded.mesh.triangle_count() != n.triangles) {
+    throw Error(what + ": record says " + std::to_string(n.triangles) + " triangles, its bytes hold " +
+                std::to_string(decoded.mesh.triangle_count()));
   }
   decoded.mesh.material = n.material;
   return decoded;
