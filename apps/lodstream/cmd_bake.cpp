@@ -671,8 +671,10 @@ int run_bake(const BakeArgs& args) {
     n.parent_sphere = stored_sphere(c.parent_sphere, c.parent_error, grid);
     if (c.group != hierarchy::kNoGroup)
       for (uint32_t k : dag.groups[c.group].children) n.children.push_back(ids[k]);
-    if (c.parent_group != hierarchy::kNoGroup)
+    if (c.parent_group != hierarchy::kNoGroup) {
       for (uint32_t k : dag.groups[c.parent_group].clusters) n.parents.push_back(ids[k]);
+      std::sort(n.parents.begin(), n.parents.end());  // as the index derives them (index.hpp)
+    }
   });
 
   // Encode, in parallel a batch of page groups at a time, and write (serial). Records: within a page group,

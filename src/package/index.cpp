@@ -4,6 +4,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <unordered_map>
 
 #include "core/error.hpp"
 #include "package/bytes.hpp"
@@ -148,9 +149,23 @@ struct RecordRun {
   int exponent = 0;
   glm::vec3 center{0.0f};
 
+  // Child id -> the records of this run so far whose children list holds it, in id order.
+  std::unordered_map<uint32_t, std::vector<uint32_t>> parents_of;
+
   const NodeRecord& previous() const {
     static const NodeRecord none;  // every field 0
     return done.empty() ? none : done.back();
+  }
+  // Record `id` is done: its children gain it as a parent. Cost: O(its children).
+  void add_links(const NodeRecord& n, uint32_t id) {
+    for (uint32_t c : n.children) parents_of[c].push_back(id);
+  }
+  // The parents a record's head may imply (kDerivedParents): the records before it in this run whose
+  // children list holds `id` (a DAG node's parents are the nodes its group was simplified into, each of which
+  // lists that group as its children), or nullptr when none does.
+  const std::vector<uint32_t>* derived_parents(uint32_t id) const {
+    const auto it = parents_of.find(id);
+    return it == parents_of.end() ? nullptr : &it->second;
   }
   // The parents' pair can be taken from parents[0] when that record is already in this run.
   const NodeRecord* first_parent(const NodeRecord& n) const {
@@ -260,17 +275,20 @@ struct RecordRun {
   }
 };
 
-enum : uint8_t { kSameChildren = 8, kSameParents = 16, kSameRecord = 32 };
+enum : uint8_t { kSameChildren = 8, kSameParents = 16, kSameRecord = 32, kDerivedParents = 64 };
 
 void write_node(FieldWriters& w, const NodeRecord& n, uint32_t id, RecordRun& run) {
   const NodeRecord& prev = run.previous();
   const bool same_children = !run.done.empty() && n.children == prev.children;
   const bool same_parents = !run.done.empty() && n.parents == prev.parents;
+  const std::vector<uint32_t>* derived = run.derived_parents(id);
+  const bool derived_parents = !same_parents && derived && *derived == n.parents;
   const bool same_record = !run.done.empty() && n.page == prev.page && n.offset == prev.offset &&
                            n.size == prev.size && n.cluster == prev.cluster + 1;
   w[kHead].u8(static_cast<uint8_t>(uint8_t(n.kind) | uint8_t(n.encoding) << 2 |
                                    (same_children ? kSameChildren : 0) | (same_parents ? kSameParents : 0) |
-                                   (same_record ? kSameRecord : 0)));
+                                   (same_record ? kSameRecord : 0) |
+                                   (derived_parents ? kDerivedParents : 0)));
   w[kDeltas].svarint(int64_t(n.representation) - prev.representation);
   w[kDeltas].svarint(int64_t(n.material) - prev.material);
   w[kDeltas].svarint(int64_t(n.level) - prev.level);
@@ -282,7 +300,7 @@ void write_node(FieldWriters& w, const NodeRecord& n, uint32_t id, RecordRun& ru
   }
   w[kTriangles].varint(n.triangles);
   if (!same_children) write_ids(w[kChildren], n.children, id);
-  if (!same_parents) write_ids(w[kParents], n.parents, id);
+  if (!same_parents && !derived_parents) write_ids(w[kParents], n.parents, id);
   write_ids(w[kObjects], n.objects, 0);
   const NodeRecord* parent = run.first_parent(n);
   if (parent && own_pair(*parent) == parent_pair(n)) {
@@ -297,8 +315,11 @@ NodeRecord read_node(FieldReaders& r, const RootIndex& root, uint32_t id, Record
   const NodeRecord& prev = run.previous();
   NodeRecord n;
   const uint8_t head = r[kHead].u8();
-  if (head & ~uint8_t(3 | 4 | kSameChildren | kSameParents | kSameRecord))
+  if (head & ~uint8_t(3 | 4 | kSameChildren | kSameParents | kSameRecord | kDerivedParents))
     r[kHead].fail("node " + std::to_string(id) + ": unknown record flags");
+  const std::vector<uint32_t>* derived = run.derived_parents(id);
+  if ((head & kDerivedParents) && (!derived || (head & kSameParents)))
+    r[kHead].fail("node " + std::to_string(id) + ": implied parents that no record of this run lists");
   n.kind = NodeKind(head & 3), n.encoding = NodeEncoding((head >> 2) & 1);
   if ((head & (kSameChildren | kSameParents | kSameRecord)) && run.done.empty())
     r[kHead].fail("node " + std::to_string(id) + ": refers to a previous record that this run does not have");
@@ -327,7 +348,13 @@ NodeRecord read_node(FieldReaders& r, const RootIndex& root, uint32_t id, Record
     r[kSize].fail("node " + std::to_string(id) + ": cluster index of its record out of range");
   n.triangles = r[kTriangles].index(uint64_t(UINT32_MAX) + 1, "triangle count");
   n.children = head & kSameChildren ? prev.children : read_ids(r[kChildren], id, root.node_count, "child");
-  n.parents = head & kSameParents ? prev.parents : read_ids(r[kParents], id, root.node_count, "parent");
+  if (head & kSameParents) {
+    n.parents = prev.parents;
+  } else if (head & kDerivedParents) {
+    n.parents = *derived;
+  } else {
+    n.parents = read_ids(r[kParents], id, root.node_count, "parent");
+  }
   n.objects = read_ids(r[kObjects], 0, root.scene.objects.size(), "object");
   const uint64_t code = r[kPairCode].varint();
   ErrorPair parents;
@@ -369,6 +396,7 @@ std::vector<NodeRecord> read_nodes(ByteReader& r, const RootIndex& root, uint32_
   for (uint32_t i = 0; i < count; ++i) {
     run.done = nodes;
     nodes.push_back(read_node(fields, root, first_id + i, run));
+    run.add_links(nodes.back(), first_id + i);
   }
   for (ByteReader& f : fields.f) f.expect_end();
   return nodes;
@@ -384,6 +412,7 @@ std::array<std::vector<uint8_t>, kIndexFields> serialize_node_fields(std::span<c
   for (size_t i = 0; i < nodes.size(); ++i) {
     run.done = nodes.first(i);
     write_node(fields, nodes[i], first_id + uint32_t(i), run);
+    run.add_links(nodes[i], first_id + uint32_t(i));
   }
   std::array<std::vector<uint8_t>, kIndexFields> out;
   for (size_t f = 0; f < kFields; ++f) out[f] = std::move(fields[f].bytes);

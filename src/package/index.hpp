@@ -10,7 +10,10 @@
 // order: heads; representation, material and level deltas; page and offset; size and cluster; triangle
 // counts; children; parents; objects; pair codes; pair errors; compact pairs' exponents;
 // sphere centres; sphere radii. A record is: u8 head (kind in bits 0-1, encoding in bit 2, bit 3 = children
-// and bit 4 = parents equal to the previous record's and not stored); svarint deltas of representation,
+// and bit 4 = parents equal to the previous record's and not stored, bit 5 = page, offset and size the
+// previous record's and cluster its next, bit 6 = parents not stored: those records earlier in the run whose
+// children list holds this id, in id order, as a DAG's are: 0.56 -> 0.13 B a record on refined_elephant);
+// svarint deltas of representation,
 // material, level and page from the previous record's; svarint offset minus the previous record's end when on
 // the same page (else minus 0); varint size and triangles; the children, parents and objects id
 // lists (varint count, then each id as an svarint delta from the previous id + 1, the first of a link list

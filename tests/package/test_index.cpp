@@ -168,6 +168,29 @@ TEST(IndexRecords, ARecordStoresNoVertexCount) {
   expect_same(parse_nodes(serialize_nodes(in, 0), tables(), 0, 2, "run"), in);
 }
 
+TEST(IndexRecords, ParentsThatListARecordAsTheirChildAreNotStored) {
+  // A DAG's links: records 0 and 1 were simplified from group {2, 3, 4}, whose parents they are; 3 and 4
+  // from {5, 6}. Only record 2's list would be stored were it not implied (3's and 4's equal the previous
+  // record's), and 5's (6's equals 5's); record 0's is empty. Record 7's parent is record 2 though record 2
+  // does not list it as a child: it is stored.
+  std::vector<NodeRecord> in = records(0, 8);
+  for (NodeRecord& r : in) r.children.clear(), r.parents.clear(), r.parent_error = INFINITY;
+  in[0].children = in[1].children = {2, 3, 4};
+  in[3].children = in[4].children = {5, 6};
+  in[2].parents = in[3].parents = in[4].parents = {0, 1};
+  in[5].parents = in[6].parents = {3, 4};
+  in[7].parents = {2};
+  for (NodeRecord& r : in)
+    if (!r.parents.empty())
+      r.parent_error = in[r.parents[0]].error, r.parent_sphere = in[r.parents[0]].sphere;
+  EXPECT_EQ(field_bytes(in, "parents"), 1u + 2u);  // record 0's empty list (count 0) and record 7's
+  expect_same(parse_nodes(serialize_nodes(in, 0), tables(), 0, 8, "run"), in);
+  // Parents listed in another order than the ids' are stored.
+  in[2].parents = in[3].parents = in[4].parents = {1, 0};
+  EXPECT_EQ(field_bytes(in, "parents"), 1u + 3u + 2u);
+  expect_same(parse_nodes(serialize_nodes(in, 0), tables(), 0, 8, "run"), in);
+}
+
 TEST(IndexRecords, AnOwnSphereIsCodedAgainstItsParentsSphere) {
   // Siblings of two groups interleaved (as a DAG's page order leaves them), each group inside its parents'
   // sphere of radius 8 at (+-1000, +-1000, +-1000): each own centre lies within 2 units (32 grid steps of
@@ -275,7 +298,8 @@ TEST(IndexRecords, HostileReferencesAreErrors) {
       {"the next cluster of a record the run does not have", one_record(32, 0, 1, false)},
       {"cluster index past the most a record holds", one_record(0, 0, 1, false, kMaxRecordClusters)},
       {"huge cluster index", one_record(0, 0, 1, false, uint64_t(1) << 40)},
-      {"unknown record flag", one_record(64, 0, 1, false)},
+      {"unknown record flag", one_record(128, 0, 1, false)},
+      {"parents implied but no record of the run lists it", one_record(64, 0, 1, false)},
   };
   expect_one_line_errors(cases, root);
 }
