@@ -27,15 +27,34 @@ float read_error(ByteReader& r) {
   return e;
 }
 
-void write_range(ByteWriter& w, const Range& range) {
-  w.u64(range.offset), w.u32(range.size), w.u32(range.raw_size), w.u64(range.checksum);
+// A table of byte ranges (pages, blobs, index pages): each as svarint offset minus the previous range's end
+// (0 for ranges stored one after another, as the writer stores each table's), varint size and raw size,
+// u64 checksum: 11 bytes a range, not 24 (refined_elephant's root index 730 -> 631 B stored).
+constexpr size_t kMinRangeBytes = 11;
+void write_ranges(ByteWriter& w, std::span<const Range> ranges) {
+  w.varint(ranges.size());
+  uint64_t end = 0;
+  for (const Range& range : ranges) {
+    w.svarint(int64_t(range.offset - end)), w.varint(range.size), w.varint(range.raw_size),
+        w.u64(range.checksum);
+    end = range.offset + range.size;
+  }
 }
-Range read_range(ByteReader& r, uint32_t max_raw, const char* what) {
-  Range range;
-  range.offset = r.u64(), range.size = r.u32(), range.raw_size = r.u32(), range.checksum = r.u64();
-  if (range.raw_size > max_raw)
-    r.fail(std::string(what) + " raw size " + std::to_string(range.raw_size) + " exceeds the limit");
-  return range;
+std::vector<Range> read_ranges(ByteReader& r, uint32_t max_raw, const char* what) {
+  std::vector<Range> ranges(r.count(kMinRangeBytes, what));
+  uint64_t end = 0;
+  for (Range& range : ranges) {
+    const int64_t delta = r.svarint();  // offsets below 2^63: checked before adding so that nothing overflows
+    if (delta < -int64_t(end) || delta > INT64_MAX - int64_t(end))
+      r.fail(std::string(what) + " offset out of range");
+    range.offset = uint64_t(int64_t(end) + delta);
+    range.size = r.index(uint64_t(UINT32_MAX) + 1, "range size");
+    range.raw_size = r.index(uint64_t(max_raw) + 1, "raw size");
+    range.checksum = r.u64();
+    if (range.size > uint64_t(INT64_MAX) - range.offset) r.fail(std::string(what) + " range out of range");
+    end = range.offset + range.size;
+  }
+  return ranges;
 }
 
 // A list of node ids (index.hpp, "Node records"): varint count, then each id as an svarint delta from the
@@ -425,10 +444,8 @@ std::vector<uint8_t> serialize_root(const RootIndex& root) {
   w.u32(root.node_count);
   w.u64(root.scene.input_triangles);
   w.string(root.scene.metadata);
-  w.varint(root.pages.size());
-  for (const Range& p : root.pages) write_range(w, p);
-  w.varint(root.blobs.size());
-  for (const Range& b : root.blobs) write_range(w, b);
+  write_ranges(w, root.pages);
+  write_ranges(w, root.blobs);
   w.varint(root.scene.materials.size());
   for (const PackageMaterial& m : root.scene.materials) {
     w.string(m.material.name);
@@ -455,11 +472,10 @@ std::vector<uint8_t> serialize_root(const RootIndex& root) {
     }
     w.varint(o.representation);
   }
-  w.varint(root.index_pages.size());
-  for (const IndexPage& p : root.index_pages) {
-    write_range(w, p.range);
-    w.varint(p.first_node), w.varint(p.node_count);
-  }
+  std::vector<Range> index_ranges;
+  for (const IndexPage& p : root.index_pages) index_ranges.push_back(p.range);
+  write_ranges(w, index_ranges);
+  for (const IndexPage& p : root.index_pages) w.varint(p.first_node), w.varint(p.node_count);
   w.varint(root.root_nodes.size());
   write_nodes(w, root.root_nodes, 0);
   return std::move(w.bytes);
@@ -477,10 +493,8 @@ RootIndex parse_root(std::span<const uint8_t> raw, const std::string& context) {
   root.node_count = r.u32();
   root.scene.input_triangles = r.u64();
   root.scene.metadata = r.string("metadata");
-  root.pages.resize(r.count(24, "page"));
-  for (Range& p : root.pages) p = read_range(r, kMaxPageRawBytes, "page");
-  root.blobs.resize(r.count(24, "blob"));
-  for (Range& b : root.blobs) b = read_range(r, UINT32_MAX, "blob");
+  root.pages = read_ranges(r, kMaxPageRawBytes, "page");
+  root.blobs = read_ranges(r, UINT32_MAX, "blob");
   root.scene.materials.resize(r.count(19, "material"));
   for (PackageMaterial& m : root.scene.materials) {
     m.material.name = r.string("material name");
@@ -511,9 +525,11 @@ RootIndex parse_root(std::span<const uint8_t> raw, const std::string& context) {
     }
     o.representation = r.index(root.scene.representations.size(), "representation");
   }
-  root.index_pages.resize(r.count(26, "index page"));
-  for (IndexPage& p : root.index_pages) {
-    p.range = read_range(r, kMaxIndexPageRawBytes, "index page");
+  const std::vector<Range> index_ranges = read_ranges(r, kMaxIndexPageRawBytes, "index page");
+  root.index_pages.resize(index_ranges.size());
+  for (size_t i = 0; i < index_ranges.size(); ++i) {
+    IndexPage& p = root.index_pages[i];
+    p.range = index_ranges[i];
     p.first_node = r.index(uint64_t(UINT32_MAX) + 1, "first node");
     p.node_count = r.index(uint64_t(UINT32_MAX) + 1, "node count");
   }
