@@ -16,8 +16,10 @@
 // svarint deltas of representation,
 // material, level and page from the previous record's; svarint offset minus the previous record's end when on
 // the same page (else minus 0); varint size and triangles; the children, parents and objects id
-// lists (varint count, then each id as an svarint delta from the previous id + 1, the first of a link list
-// from the record's own id, of objects from 0); then the parents' and the own (error, sphere) pairs, which
+// lists (varint count, then each id as an svarint delta from the previous id + 1, the first of a parents
+// list from the record's own id, of objects from 0; a children list is varint 2k + 1 for the k-th latest
+// distinct children list of the run, else 2 x count and the deltas, the first from the end of the run's
+// latest such list, or the record's own id); then the parents' and the own (error, sphere) pairs, which
 // siblings share: a pair is a literal (f32 error, f32 centre x y z, f32 radius) or a compact pair, either of
 // which joins the run's table of distinct pairs, or a reference to the k-th latest pair of that table; the
 // parents' pair may also be "the own pair of parents[0]" when that record is earlier in the run. A compact

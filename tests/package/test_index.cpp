@@ -191,6 +191,17 @@ TEST(IndexRecords, ParentsThatListARecordAsTheirChildAreNotStored) {
   expect_same(parse_nodes(serialize_nodes(in, 0), tables(), 0, 8, "run"), in);
 }
 
+TEST(IndexRecords, AChildrenListSeenEarlierInTheRunIsAReference) {
+  // Lists A = {10, 11, 12} and B = {13, 14} alternate (siblings whose records are not consecutive): A takes
+  // 4 bytes (2 x 3, first id 10 past record 0's id, two zeros), B 3 (2 x 2, first right after A's end, a
+  // zero), each repetition 1 (a reference).
+  std::vector<NodeRecord> in = records(0, 6);
+  for (size_t i = 0; i < in.size(); ++i)
+    in[i].children = i % 2 ? std::vector<uint32_t>{13, 14} : std::vector<uint32_t>{10, 11, 12};
+  EXPECT_EQ(field_bytes(in, "children"), 4u + 3u + 4u);
+  expect_same(parse_nodes(serialize_nodes(in, 0), tables(), 0, 6, "run"), in);
+}
+
 TEST(IndexRecords, AnOwnSphereIsCodedAgainstItsParentsSphere) {
   // Siblings of two groups interleaved (as a DAG's page order leaves them), each group inside its parents'
   // sphere of radius 8 at (+-1000, +-1000, +-1000): each own centre lies within 2 units (32 grid steps of
@@ -301,6 +312,14 @@ TEST(IndexRecords, HostileReferencesAreErrors) {
       {"unknown record flag", one_record(128, 0, 1, false)},
       {"parents implied but no record of the run lists it", one_record(64, 0, 1, false)},
   };
+  // A children list referring to a list the run does not have, and one longer than the stream.
+  for (uint64_t code : {uint64_t(1), uint64_t(2) << 40}) {
+    Fields f = record_fields(0, false);
+    f[kChildren] = ByteWriter();
+    f[kChildren].varint(code);
+    f[kPairCode].varint(1), literal(f, INFINITY, 0.0f), f[kPairCode].varint(0), literal(f, 1.0f, 1.0f);
+    expect_one_line_errors({{"children list", run_bytes(f)}}, root);
+  }
   expect_one_line_errors(cases, root);
 }
 
