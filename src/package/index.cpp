@@ -4,8 +4,8 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <functional>
 #include <optional>
-#include <unordered_map>
 
 #include "core/error.hpp"
 #include "package/bytes.hpp"
@@ -178,8 +178,10 @@ struct RecordRun {
   int exponent = 0;
   glm::vec3 center{0.0f};
 
-  // Child id -> the records of this run so far whose children list holds it, in id order.
-  std::unordered_map<uint32_t, std::vector<uint32_t>> parents_of;
+  // (child, record) for every child listed by the run's records so far and not yet reached, a min-heap:
+  // records come in id order, so a child's links are taken when it comes (and dropped when it was before).
+  std::vector<std::pair<uint32_t, uint32_t>> links;
+  std::vector<uint32_t> derived;  // derived_parents' answer
   // The distinct non-empty children lists the run stored, in order, and where the next one is expected to
   // start: after the latest (a DAG's groups are runs of consecutive ids, often stored in order).
   std::vector<std::vector<uint32_t>> child_lists;
@@ -219,16 +221,25 @@ struct RecordRun {
     child_lists.push_back(children);
     next_child = children.back() + 1;  // ids < limit <= 2^32: no wrap
   }
-  // Record `id` is done: its children gain it as a parent. Cost: O(its children).
+  // Record `id` is done: its children gain it as a parent. Cost: O(its children x log links).
   void add_links(const NodeRecord& n, uint32_t id) {
-    for (uint32_t c : n.children) parents_of[c].push_back(id);
+    for (uint32_t c : n.children) {
+      links.emplace_back(c, id);
+      std::push_heap(links.begin(), links.end(), std::greater<>());
+    }
   }
   // The parents a record's head may imply (kDerivedParents): the records before it in this run whose
   // children list holds `id` (a DAG node's parents are the nodes its group was simplified into, each of which
-  // lists that group as its children), or nullptr when none does.
-  const std::vector<uint32_t>* derived_parents(uint32_t id) const {
-    const auto it = parents_of.find(id);
-    return it == parents_of.end() ? nullptr : &it->second;
+  // lists that group as its children), in id order, or nullptr when none does. Called once per record, in id
+  // order. Cost: O(links taken x log links).
+  const std::vector<uint32_t>* derived_parents(uint32_t id) {
+    derived.clear();
+    while (!links.empty() && links.front().first <= id) {
+      if (links.front().first == id) derived.push_back(links.front().second);
+      std::pop_heap(links.begin(), links.end(), std::greater<>());
+      links.pop_back();
+    }
+    return derived.empty() ? nullptr : &derived;
   }
   // The parents' pair can be taken from parents[0] when that record is already in this run.
   const NodeRecord* first_parent(const NodeRecord& n) const {
