@@ -8,18 +8,17 @@
 // its own stream, so that zstd models each field apart (elephant_1m's index pages: 16.7 B per node in format
 // 4, 10.3 with compact pairs and field streams): a run is 13 varint stream sizes, then the streams, in this
 // order: heads; representation, material and level deltas; page and offset; size and cluster; triangle
-// counts; children; parents; objects; pair codes; pair errors; compact pairs' exponents;
-// sphere centres; sphere radii. A record is: u8 head (kind in bits 0-1, encoding in bit 2, bit 3 = children
-// and bit 4 = parents equal to the previous record's and not stored, bit 5 = page, offset and size the
-// previous record's and cluster its next, bit 6 = parents not stored: those records earlier in the run whose
-// children list holds this id, in id order, as a DAG's are: 0.56 -> 0.13 B a record on refined_elephant);
-// svarint deltas of representation,
-// material, level and page from the previous record's; svarint offset minus the previous record's end when on
-// the same page (else minus 0); varint size and triangles; the children, parents and objects id
-// lists (varint count, then each id as an svarint delta from the previous id + 1, the first of a parents
-// list from the record's own id, of objects from 0; a children list is varint 2k + 1 for the k-th latest
-// distinct children list of the run, else 2 x count and the deltas, the first from the end of the run's
-// latest such list, or the record's own id); then the parents' and the own (error, sphere) pairs, which
+// counts; children; parents; objects; pair codes; pair errors; compact pairs' exponents; sphere centres;
+// sphere radii. A record is: u8 head (kind in bits 0-1, encoding in bit 2, bit 3 = children and bit 4 =
+// parents equal to the previous record's and not stored, bit 5 = page, offset and size the previous record's
+// and cluster its next, bit 6 = parents not stored, being the records earlier in the run whose children list
+// holds this id, in id order, as a DAG's are: 0.56 -> 0.13 B a record on refined_elephant); svarint deltas of
+// representation, material, level and page from the previous record's; svarint offset minus the previous
+// record's end when on the same page (else minus 0); varint size and triangles; the children, parents and
+// objects id lists (varint count, then each id as an svarint delta from the previous id + 1, the first of a
+// parents list from the record's own id, of objects from 0; a children list is varint 2k + 1 for the k-th
+// latest distinct children list of the run, else 2 x count and the deltas, the first from the end of the
+// run's latest such list, or the record's own id); then the parents' and the own (error, sphere) pairs, which
 // siblings share: a pair is a literal (f32 error, f32 centre x y z, f32 radius) or a compact pair, either of
 // which joins the run's table of distinct pairs, or a reference to the k-th latest pair of that table; the
 // parents' pair may also be "the own pair of parents[0]" when that record is earlier in the run. A compact
