@@ -159,10 +159,8 @@ WrittenPackage write_package(const Meshlets& m, const std::vector<std::vector<ui
   scene.representations.push_back(rep);
   scene.objects.push_back({"mesh", glm::mat4(1.0f), 0});
   std::vector<NodeRecord> records(m.chunks.size());
-  for (uint32_t id = 0; id < m.chunks.size(); ++id) {
+  for (uint32_t id = 0; id < m.chunks.size(); ++id)
     records[id].triangles = uint32_t(m.chunks[id].triangle_count());
-    records[id].vertices = uint32_t(m.chunks[id].vertex_count());
-  }
   if (records_form) {
     for (uint32_t r = 0; r < nodes.size(); ++r) {
       std::vector<uint32_t> ids;

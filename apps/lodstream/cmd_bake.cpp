@@ -222,11 +222,10 @@ std::pair<uint32_t, uint32_t> page_group_precision(const hierarchy::ClusterDag& 
 // (page_group_precision), every vertex locked in any of them exactly. A vertex thus decodes alike in every
 // record of its page group and locked vertices everywhere, so cuts stay crack-free. Against one record per
 // precision this rounds a coarse cluster's free vertices finer than its error allows and stores coarse
-// normals at the page group's largest bits. `vertices[c]` receives cluster c's distinct vertices (what a
-// reader's cluster holds: welding also merges identical vertices within a cluster).
+// normals at the page group's largest bits.
 std::vector<uint8_t> encode_record(const NodeCodec& codec, const hierarchy::ClusterDag& dag,
                                    std::span<const uint32_t> clusters, std::pair<uint32_t, uint32_t> stored,
-                                   const PositionGrid& grid, std::span<uint32_t> vertices) {
+                                   const PositionGrid& grid) {
   std::vector<const Mesh*> meshes;
   std::vector<std::span<const uint8_t>> locked;
   NodeGeometry geometry;
@@ -236,7 +235,6 @@ std::vector<uint8_t> encode_record(const NodeCodec& codec, const hierarchy::Clus
     locked.push_back(dag.clusters[c].locked);
   }
   const RecordMesh record = weld_record(meshes, locked);
-  std::copy(record.cluster_vertices.begin(), record.cluster_vertices.end(), vertices.begin());
   geometry.mesh = &record.mesh;
   if (geometry.position_shift > 0) geometry.locked = record.locked;
   if (clusters.size() > 1) geometry.cluster_triangles = record.cluster_triangles;
@@ -288,12 +286,6 @@ std::vector<std::vector<uint32_t>> join_groups(const hierarchy::ClusterDag& dag,
   }
   return page_groups;
 }
-
-// A record encoded during the build (DagOptions::inputs_final): its bytes and each cluster's vertices.
-struct EncodedRecord {
-  std::vector<uint8_t> bytes;
-  std::vector<uint32_t> vertices;
-};
 
 Sphere float_sphere(const schedule::WorldSphere& w) {
   return {glm::vec3(w.center), std::nextafter(float(w.radius), INFINITY)};
@@ -413,7 +405,7 @@ int run_bake(const BakeArgs& args) {
   std::vector<PositionGrid> grids(scene.meshes.size());
   const NodeCodec& codec = node_codec(args.codec);
   // Records encoded during the build, by mesh and by their first cluster (DagOptions::inputs_final).
-  std::vector<std::vector<EncodedRecord>> early(scene.meshes.size());
+  std::vector<std::vector<std::vector<uint8_t>>> early(scene.meshes.size());
   // By mesh and group: its page group continues with the next group's input clusters (join_groups).
   std::vector<std::vector<uint8_t>> joins(scene.meshes.size());
   std::atomic<size_t> done_triangles{0};
@@ -450,7 +442,7 @@ int run_bake(const BakeArgs& args) {
       if (done_here > reported) report(done_here - reported), reported = done_here;
     };
     options.inputs_final = [&, m](const hierarchy::ClusterDag& dag, std::span<const uint32_t> groups) {
-      std::vector<EncodedRecord>& out = early[m];
+      std::vector<std::vector<uint8_t>>& out = early[m];
       out.resize(dag.clusters.size());
       const std::vector<std::vector<uint32_t>> page_groups =
           join_groups(dag, groups, codec.max_record_clusters(), joins[m]);
@@ -459,11 +451,9 @@ int run_bake(const BakeArgs& args) {
         const auto stored = page_group_precision(dag, children, grids[m], args);
         size_t first = 0;
         for (uint32_t count : record_runs(children.size(), codec.max_record_clusters())) {
-          EncodedRecord& r = out[children[first]];
-          r.vertices.resize(count);
-          r.bytes = encode_record(codec, dag, std::span(children).subspan(first, count), stored, grids[m],
-                                  r.vertices);
-          r.bytes.shrink_to_fit();  // kept until the pages are written: no growth slack
+          std::vector<uint8_t>& bytes = out[children[first]];
+          bytes = encode_record(codec, dag, std::span(children).subspan(first, count), stored, grids[m]);
+          bytes.shrink_to_fit();  // kept until the pages are written: no growth slack
           first += count;
         }
       });
@@ -639,7 +629,6 @@ int run_bake(const BakeArgs& args) {
       n.material = h.mesh.material;
       n.level = h.level;
       n.triangles = uint32_t(h.mesh.triangle_count());
-      n.vertices = uint32_t(h.mesh.vertex_count());
       n.error = h.error;
       n.sphere = h.sphere;
       if (h.parent != hierarchy::kNoHlodNode) {
@@ -661,7 +650,6 @@ int run_bake(const BakeArgs& args) {
       n.material = s.mesh.material;
       n.level = steps - 1 - k;  // 0 = the finest step
       n.triangles = uint32_t(s.mesh.triangle_count());
-      n.vertices = uint32_t(s.mesh.vertex_count());
       n.error = s.error;  // the prefix's bound; the finest grid's rounding is not counted (as DAG level 0)
       n.sphere = n.parent_sphere = pm.sphere;
       if (k > 0) n.parent_error = pm.steps[k - 1].error, n.parents = {ids[k - 1]};
@@ -677,15 +665,16 @@ int run_bake(const BakeArgs& args) {
     n.material = c.mesh.material;
     n.level = c.level;
     n.triangles = uint32_t(c.mesh.triangle_count());
-    n.vertices = uint32_t(c.mesh.vertex_count());
     n.error = stored_error(c.error, grid);
     n.sphere = stored_sphere(c.sphere, c.error, grid);
     n.parent_error = stored_error(c.parent_error, grid);
     n.parent_sphere = stored_sphere(c.parent_sphere, c.parent_error, grid);
     if (c.group != hierarchy::kNoGroup)
       for (uint32_t k : dag.groups[c.group].children) n.children.push_back(ids[k]);
-    if (c.parent_group != hierarchy::kNoGroup)
+    if (c.parent_group != hierarchy::kNoGroup) {
       for (uint32_t k : dag.groups[c.parent_group].clusters) n.parents.push_back(ids[k]);
+      std::sort(n.parents.begin(), n.parents.end());  // as the index derives them (index.hpp)
+    }
   });
 
   // Encode, in parallel a batch of page groups at a time, and write (serial). Records: within a page group,
@@ -745,16 +734,14 @@ int run_bake(const BakeArgs& args) {
         return;
       }
       const uint32_t m = order[id].mesh;
-      EncodedRecord record;
-      if (order[id].cluster < early[m].size()) record = std::move(early[m][order[id].cluster]);
-      if (record.bytes.empty()) {  // not encoded during the build (the roots)
+      std::vector<uint8_t> bytes;
+      if (order[id].cluster < early[m].size()) bytes = std::move(early[m][order[id].cluster]);
+      if (bytes.empty()) {  // not encoded during the build (the roots)
         std::vector<uint32_t> clusters;
         for (size_t k = 0; k < batch[r].count; ++k) clusters.push_back(order[id + k].cluster);
-        record.vertices.resize(batch[r].count);
-        record.bytes = encode_record(codec, dags[m], clusters, batch[r].stored, grids[m], record.vertices);
+        bytes = encode_record(codec, dags[m], clusters, batch[r].stored, grids[m]);
       }
-      encoded[r] = std::move(record.bytes);
-      for (size_t k = 0; k < batch[r].count; ++k) records[id + k].vertices = record.vertices[k];
+      encoded[r] = std::move(bytes);
     });
     for (size_t r = 0; r < batch.size(); ++r) {
       if (batch[r].count == 0) {

@@ -4,6 +4,8 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <functional>
+#include <optional>
 
 #include "core/error.hpp"
 #include "package/bytes.hpp"
@@ -14,10 +16,10 @@ namespace lodstream::package {
 
 namespace {
 
-// Smallest serialized node record (index.hpp, "Node records"): head, 3 field deltas, triangles, vertices, the
-// object count and the two pair codes, with both link lists implied and page, offset, size and cluster
-// those of the previous record's bytes (bit 5).
-constexpr size_t kMinNodeRecordBytes = 9;
+// Smallest serialized node record (index.hpp, "Node records"): head, 3 field deltas, triangles, the object
+// count and the two pair codes, with both link lists implied and page, offset, size and cluster those of the
+// previous record's bytes (bit 5).
+constexpr size_t kMinNodeRecordBytes = 8;
 
 // An error bound: non-negative, +infinity allowed (nothing replaces the node), NaN rejected.
 float read_error(ByteReader& r) {
@@ -26,26 +28,50 @@ float read_error(ByteReader& r) {
   return e;
 }
 
-void write_range(ByteWriter& w, const Range& range) {
-  w.u64(range.offset), w.u32(range.size), w.u32(range.raw_size), w.u64(range.checksum);
+// A table of byte ranges (pages, blobs, index pages): each as svarint offset minus the previous range's end
+// (0 for ranges stored one after another, as the writer stores each table's), varint size and raw size,
+// u64 checksum: 11 bytes a range, not 24 (refined_elephant's root index 730 -> 631 B stored).
+constexpr size_t kMinRangeBytes = 11;
+void write_ranges(ByteWriter& w, std::span<const Range> ranges) {
+  w.varint(ranges.size());
+  uint64_t end = 0;
+  for (const Range& range : ranges) {
+    w.svarint(int64_t(range.offset - end)), w.varint(range.size), w.varint(range.raw_size),
+        w.u64(range.checksum);
+    end = range.offset + range.size;
+  }
 }
-Range read_range(ByteReader& r, uint32_t max_raw, const char* what) {
-  Range range;
-  range.offset = r.u64(), range.size = r.u32(), range.raw_size = r.u32(), range.checksum = r.u64();
-  if (range.raw_size > max_raw)
-    r.fail(std::string(what) + " raw size " + std::to_string(range.raw_size) + " exceeds the limit");
-  return range;
+std::vector<Range> read_ranges(ByteReader& r, uint32_t max_raw, const char* what) {
+  std::vector<Range> ranges(r.count(kMinRangeBytes, what));
+  uint64_t end = 0;
+  for (Range& range : ranges) {
+    const int64_t delta = r.svarint();  // offsets below 2^63: checked before adding so that nothing overflows
+    if (delta < -int64_t(end) || delta > INT64_MAX - int64_t(end))
+      r.fail(std::string(what) + " offset out of range");
+    range.offset = uint64_t(int64_t(end) + delta);
+    range.size = r.index(uint64_t(UINT32_MAX) + 1, "range size");
+    range.raw_size = r.index(uint64_t(max_raw) + 1, "raw size");
+    range.checksum = r.u64();
+    if (range.size > uint64_t(INT64_MAX) - range.offset) r.fail(std::string(what) + " range out of range");
+    end = range.offset + range.size;
+  }
+  return ranges;
 }
 
 // A list of node ids (index.hpp, "Node records"): varint count, then each id as an svarint delta from the
 // previous one plus 1 (the first from `base`), so that runs of consecutive ids are runs of zero bytes.
-void write_ids(ByteWriter& w, const std::vector<uint32_t>& ids, uint32_t base) {
-  w.varint(ids.size());
+void write_id_deltas(ByteWriter& w, const std::vector<uint32_t>& ids, uint32_t base) {
   int64_t previous = int64_t(base) - 1;
   for (uint32_t id : ids) w.svarint(int64_t(id) - previous - 1), previous = id;
 }
-std::vector<uint32_t> read_ids(ByteReader& r, uint32_t base, uint64_t limit, const char* what) {
-  std::vector<uint32_t> ids(r.count(1, what));
+void write_ids(ByteWriter& w, const std::vector<uint32_t>& ids, uint32_t base) {
+  w.varint(ids.size());
+  write_id_deltas(w, ids, base);
+}
+// `count` ids written by write_id_deltas, each < limit.
+std::vector<uint32_t> read_id_deltas(ByteReader& r, size_t count, uint32_t base, uint64_t limit,
+                                     const char* what) {
+  std::vector<uint32_t> ids(count);
   int64_t previous = int64_t(base) - 1;
   for (uint32_t& id : ids) {
     const int64_t delta = r.svarint();  // checked before adding so that nothing overflows
@@ -55,6 +81,10 @@ std::vector<uint32_t> read_ids(ByteReader& r, uint32_t base, uint64_t limit, con
     previous = id;
   }
   return ids;
+}
+std::vector<uint32_t> read_ids(ByteReader& r, uint32_t base, uint64_t limit, const char* what) {
+  const size_t count = r.count(1, what);
+  return read_id_deltas(r, count, base, limit, what);
 }
 
 // previous + delta, which must be < limit.
@@ -92,7 +122,6 @@ enum Field : size_t {
   kLocation,      // page, offset
   kSize,          // size, cluster
   kTriangles,     // triangle count
-  kVertices,      // vertex count
   kChildren,      // children list
   kParents,       // parents list
   kObjects,       // objects list
@@ -149,9 +178,68 @@ struct RecordRun {
   int exponent = 0;
   glm::vec3 center{0.0f};
 
+  // (child, record) for every child listed by the run's records so far and not yet reached, a min-heap:
+  // records come in id order, so a child's links are taken when it comes (and dropped when it was before).
+  std::vector<std::pair<uint32_t, uint32_t>> links;
+  std::vector<uint32_t> derived;  // derived_parents' answer
+  // The distinct non-empty children lists the run stored, in order, and where the next one is expected to
+  // start: after the latest (a DAG's groups are runs of consecutive ids, often stored in order).
+  std::vector<std::vector<uint32_t>> child_lists;
+  std::optional<uint32_t> next_child;
+
   const NodeRecord& previous() const {
     static const NodeRecord none;  // every field 0
     return done.empty() ? none : done.back();
+  }
+  // A children list (index.hpp): varint 2k + 1 for the k-th latest of child_lists, else 2 x count, then the
+  // ids as write_id_deltas from next_child (the record's id for the run's first list). Siblings' lists repeat
+  // apart when their parents' records are not consecutive (refined_elephant: 120 references to 158 lists).
+  void write_children(ByteWriter& w, const std::vector<uint32_t>& children, uint32_t id) {
+    const auto it = std::find(child_lists.rbegin(), child_lists.rend(), children);
+    if (!children.empty() && it != child_lists.rend()) {
+      w.varint(2 * uint64_t(it - child_lists.rbegin()) + 1);
+      return;
+    }
+    w.varint(2 * uint64_t(children.size()));
+    write_id_deltas(w, children, next_child.value_or(id));
+    add_child_list(children);
+  }
+  std::vector<uint32_t> read_children(ByteReader& r, uint32_t id, uint64_t limit) {
+    const uint64_t code = r.varint();
+    if (code & 1) {
+      if ((code - 1) / 2 >= child_lists.size()) r.fail("children list reference out of range");
+      return child_lists[child_lists.size() - 1 - (code - 1) / 2];
+    }
+    if (code / 2 > r.remaining()) r.fail("impossible child count " + std::to_string(code / 2));
+    std::vector<uint32_t> children =
+        read_id_deltas(r, size_t(code / 2), next_child.value_or(id), limit, "child");
+    add_child_list(children);
+    return children;
+  }
+  void add_child_list(const std::vector<uint32_t>& children) {
+    if (children.empty()) return;
+    child_lists.push_back(children);
+    next_child = children.back() + 1;  // ids < limit <= 2^32: no wrap
+  }
+  // Record `id` is done: its children gain it as a parent. Cost: O(its children x log links).
+  void add_links(const NodeRecord& n, uint32_t id) {
+    for (uint32_t c : n.children) {
+      links.emplace_back(c, id);
+      std::push_heap(links.begin(), links.end(), std::greater<>());
+    }
+  }
+  // The parents a record's head may imply (kDerivedParents): the records before it in this run whose
+  // children list holds `id` (a DAG node's parents are the nodes its group was simplified into, each of which
+  // lists that group as its children), in id order, or nullptr when none does. Called once per record, in id
+  // order. Cost: O(links taken x log links).
+  const std::vector<uint32_t>* derived_parents(uint32_t id) {
+    derived.clear();
+    while (!links.empty() && links.front().first <= id) {
+      if (links.front().first == id) derived.push_back(links.front().second);
+      std::pop_heap(links.begin(), links.end(), std::greater<>());
+      links.pop_back();
+    }
+    return derived.empty() ? nullptr : &derived;
   }
   // The parents' pair can be taken from parents[0] when that record is already in this run.
   const NodeRecord* first_parent(const NodeRecord& n) const {
@@ -159,8 +247,16 @@ struct RecordRun {
       return nullptr;
     return &done[n.parents[0] - first_id];
   }
+  // The exponent and centre a compact pair is coded against: the parents' sphere `base` when given (a node's
+  // own sphere lies inside its parents', so its centre is a few grid steps from theirs and its radius a
+  // power of two or so below: the exponent is coded against ilogb of the parents' radius), else the run's
+  // previous compact pair.
+  std::pair<int, glm::vec3> reference(const Sphere* base) const {
+    if (!base) return {exponent, center};
+    return {std::isnormal(base->radius) ? std::ilogb(base->radius) : exponent, base->center};
+  }
   // Writes `p` compactly and returns true when it decodes back bit for bit.
-  bool write_compact(FieldWriters& w, const ErrorPair& p) {
+  bool write_compact(FieldWriters& w, const ErrorPair& p, const Sphere* base) {
     const uint32_t error_bits = std::bit_cast<uint32_t>(p.error);
     if ((error_bits & 0xFFu) != 0 || !std::isfinite(p.sphere.radius) || !std::isfinite(p.sphere.center.x) ||
         !std::isfinite(p.sphere.center.y) || !std::isfinite(p.sphere.center.z))
@@ -180,13 +276,14 @@ struct RecordRun {
     ByteWriter& error = w[kPairError];
     error.u8(uint8_t(error_bits >> 8)), error.u8(uint8_t(error_bits >> 16)),
         error.u8(uint8_t(error_bits >> 24));
-    w[kPairExponent].svarint(e - exponent);
-    for (int a = 0; a < 3; ++a) w[kPairCentre].svarint(k[a] - grid_reference(center[a], e));
+    const auto [reference_exponent, reference_center] = reference(base);
+    w[kPairExponent].svarint(e - reference_exponent);
+    for (int a = 0; a < 3; ++a) w[kPairCentre].svarint(k[a] - grid_reference(reference_center[a], e));
     w[kPairRadius].varint(uint64_t(k[3]));
     exponent = e, center = p.sphere.center;
     return true;
   }
-  ErrorPair read_compact(FieldReaders& r) {
+  ErrorPair read_compact(FieldReaders& r, const Sphere* base) {
     ErrorPair p;
     ByteReader& error = r[kPairError];
     uint32_t error_bits = uint32_t(error.u8()) << 8;
@@ -194,15 +291,16 @@ struct RecordRun {
     error_bits |= uint32_t(error.u8()) << 24;
     p.error = std::bit_cast<float>(error_bits);
     if (std::isnan(p.error) || p.error < 0.0f) error.fail("invalid error bound");
+    const auto [reference_exponent, reference_center] = reference(base);
     const int64_t de = r[kPairExponent].svarint();
-    if (de < kMinPairExponent - exponent || de > kMaxPairExponent - exponent)
+    if (de < kMinPairExponent - reference_exponent || de > kMaxPairExponent - reference_exponent)
       r[kPairExponent].fail("sphere exponent out of range");
-    const int e = exponent + int(de);
+    const int e = reference_exponent + int(de);
     for (int a = 0; a < 3; ++a) {
-      const int64_t delta = r[kPairCentre].svarint(), base = grid_reference(center[a], e);
-      if (delta < -kMaxPairInteger - base || delta > kMaxPairInteger - base)
+      const int64_t delta = r[kPairCentre].svarint(), grid = grid_reference(reference_center[a], e);
+      if (delta < -kMaxPairInteger - grid || delta > kMaxPairInteger - grid)
         r[kPairCentre].fail("sphere centre out of range");
-      p.sphere.center[a] = float(std::ldexp(double(base + delta), e));
+      p.sphere.center[a] = float(std::ldexp(double(grid + delta), e));
     }
     const uint64_t radius = r[kPairRadius].varint();
     if (radius > uint64_t(kMaxPairInteger)) r[kPairRadius].fail("sphere radius out of range");
@@ -216,13 +314,13 @@ struct RecordRun {
   // Pair code: `skip` = a literal (error f32, sphere 4 f32), skip + 1 = a compact pair, both joining the
   // table; skip + 1 + k (k >= 1) = the k-th latest pair of the table; codes below `skip` are taken by the
   // caller.
-  void write_pair(FieldWriters& w, const ErrorPair& p, uint64_t skip) {
+  void write_pair(FieldWriters& w, const ErrorPair& p, uint64_t skip, const Sphere* base) {
     const auto it = std::find(pairs.rbegin(), pairs.rend(), p);
     if (it != pairs.rend()) {
       w[kPairCode].varint(skip + 2 + uint64_t(it - pairs.rbegin()));
       return;
     }
-    if (write_compact(w, p)) {  // writes nothing when it returns false
+    if (write_compact(w, p, base)) {  // writes nothing when it returns false
       w[kPairCode].varint(skip + 1);
     } else {
       w[kPairCode].varint(skip);
@@ -232,14 +330,14 @@ struct RecordRun {
     }
     pairs.push_back(p);
   }
-  ErrorPair read_pair(FieldReaders& r, uint64_t code) {
+  ErrorPair read_pair(FieldReaders& r, uint64_t code, const Sphere* base) {
     if (code > 1) {
       if (code - 1 > pairs.size()) r[kPairCode].fail("error pair reference out of range");
       return pairs[pairs.size() - (code - 1)];
     }
     ErrorPair p;
     if (code == 1) {
-      p = read_compact(r);
+      p = read_compact(r, base);
     } else {
       p.error = read_error(r[kPairError]);
       for (int a = 0; a < 3; ++a) p.sphere.center[a] = r[kPairCentre].finite_f32("sphere centre");
@@ -251,17 +349,20 @@ struct RecordRun {
   }
 };
 
-enum : uint8_t { kSameChildren = 8, kSameParents = 16, kSameRecord = 32 };
+enum : uint8_t { kSameChildren = 8, kSameParents = 16, kSameRecord = 32, kDerivedParents = 64 };
 
 void write_node(FieldWriters& w, const NodeRecord& n, uint32_t id, RecordRun& run) {
   const NodeRecord& prev = run.previous();
   const bool same_children = !run.done.empty() && n.children == prev.children;
   const bool same_parents = !run.done.empty() && n.parents == prev.parents;
+  const std::vector<uint32_t>* derived = run.derived_parents(id);
+  const bool derived_parents = !same_parents && derived && *derived == n.parents;
   const bool same_record = !run.done.empty() && n.page == prev.page && n.offset == prev.offset &&
                            n.size == prev.size && n.cluster == prev.cluster + 1;
   w[kHead].u8(static_cast<uint8_t>(uint8_t(n.kind) | uint8_t(n.encoding) << 2 |
                                    (same_children ? kSameChildren : 0) | (same_parents ? kSameParents : 0) |
-                                   (same_record ? kSameRecord : 0)));
+                                   (same_record ? kSameRecord : 0) |
+                                   (derived_parents ? kDerivedParents : 0)));
   w[kDeltas].svarint(int64_t(n.representation) - prev.representation);
   w[kDeltas].svarint(int64_t(n.material) - prev.material);
   w[kDeltas].svarint(int64_t(n.level) - prev.level);
@@ -271,25 +372,28 @@ void write_node(FieldWriters& w, const NodeRecord& n, uint32_t id, RecordRun& ru
     w[kSize].varint(n.size);
     w[kSize].varint(n.cluster);
   }
-  w[kTriangles].varint(n.triangles), w[kVertices].varint(n.vertices);
-  if (!same_children) write_ids(w[kChildren], n.children, id);
-  if (!same_parents) write_ids(w[kParents], n.parents, id);
+  w[kTriangles].varint(n.triangles);
+  if (!same_children) run.write_children(w[kChildren], n.children, id);
+  if (!same_parents && !derived_parents) write_ids(w[kParents], n.parents, id);
   write_ids(w[kObjects], n.objects, 0);
-  run.write_pair(w, own_pair(n), 0);
   const NodeRecord* parent = run.first_parent(n);
   if (parent && own_pair(*parent) == parent_pair(n)) {
     w[kPairCode].varint(0);
   } else {
-    run.write_pair(w, parent_pair(n), 1);
+    run.write_pair(w, parent_pair(n), 1, nullptr);
   }
+  run.write_pair(w, own_pair(n), 0, n.parents.empty() ? nullptr : &n.parent_sphere);
 }
 
 NodeRecord read_node(FieldReaders& r, const RootIndex& root, uint32_t id, RecordRun& run) {
   const NodeRecord& prev = run.previous();
   NodeRecord n;
   const uint8_t head = r[kHead].u8();
-  if (head & ~uint8_t(3 | 4 | kSameChildren | kSameParents | kSameRecord))
+  if (head & ~uint8_t(3 | 4 | kSameChildren | kSameParents | kSameRecord | kDerivedParents))
     r[kHead].fail("node " + std::to_string(id) + ": unknown record flags");
+  const std::vector<uint32_t>* derived = run.derived_parents(id);
+  if ((head & kDerivedParents) && (!derived || (head & kSameParents)))
+    r[kHead].fail("node " + std::to_string(id) + ": implied parents that no record of this run lists");
   n.kind = NodeKind(head & 3), n.encoding = NodeEncoding((head >> 2) & 1);
   if ((head & (kSameChildren | kSameParents | kSameRecord)) && run.done.empty())
     r[kHead].fail("node " + std::to_string(id) + ": refers to a previous record that this run does not have");
@@ -317,12 +421,15 @@ NodeRecord read_node(FieldReaders& r, const RootIndex& root, uint32_t id, Record
   if (n.cluster >= kMaxRecordClusters)
     r[kSize].fail("node " + std::to_string(id) + ": cluster index of its record out of range");
   n.triangles = r[kTriangles].index(uint64_t(UINT32_MAX) + 1, "triangle count");
-  n.vertices = r[kVertices].index(uint64_t(UINT32_MAX) + 1, "vertex count");
-  n.children = head & kSameChildren ? prev.children : read_ids(r[kChildren], id, root.node_count, "child");
-  n.parents = head & kSameParents ? prev.parents : read_ids(r[kParents], id, root.node_count, "parent");
+  n.children = head & kSameChildren ? prev.children : run.read_children(r[kChildren], id, root.node_count);
+  if (head & kSameParents) {
+    n.parents = prev.parents;
+  } else if (head & kDerivedParents) {
+    n.parents = *derived;
+  } else {
+    n.parents = read_ids(r[kParents], id, root.node_count, "parent");
+  }
   n.objects = read_ids(r[kObjects], 0, root.scene.objects.size(), "object");
-  const ErrorPair own = run.read_pair(r, r[kPairCode].varint());
-  n.error = own.error, n.sphere = own.sphere;
   const uint64_t code = r[kPairCode].varint();
   ErrorPair parents;
   if (code == 0) {
@@ -331,9 +438,12 @@ NodeRecord read_node(FieldReaders& r, const RootIndex& root, uint32_t id, Record
       r[kPairCode].fail("node " + std::to_string(id) + ": parents' pair refers to a record outside this run");
     parents = own_pair(*parent);
   } else {
-    parents = run.read_pair(r, code - 1);
+    parents = run.read_pair(r, code - 1, nullptr);
   }
   n.parent_error = parents.error, n.parent_sphere = parents.sphere;
+  const ErrorPair own =
+      run.read_pair(r, r[kPairCode].varint(), n.parents.empty() ? nullptr : &n.parent_sphere);
+  n.error = own.error, n.sphere = own.sphere;
   return n;
 }
 
@@ -360,6 +470,7 @@ std::vector<NodeRecord> read_nodes(ByteReader& r, const RootIndex& root, uint32_
   for (uint32_t i = 0; i < count; ++i) {
     run.done = nodes;
     nodes.push_back(read_node(fields, root, first_id + i, run));
+    run.add_links(nodes.back(), first_id + i);
   }
   for (ByteReader& f : fields.f) f.expect_end();
   return nodes;
@@ -375,6 +486,7 @@ std::array<std::vector<uint8_t>, kIndexFields> serialize_node_fields(std::span<c
   for (size_t i = 0; i < nodes.size(); ++i) {
     run.done = nodes.first(i);
     write_node(fields, nodes[i], first_id + uint32_t(i), run);
+    run.add_links(nodes[i], first_id + uint32_t(i));
   }
   std::array<std::vector<uint8_t>, kIndexFields> out;
   for (size_t f = 0; f < kFields; ++f) out[f] = std::move(fields[f].bytes);
@@ -387,10 +499,8 @@ std::vector<uint8_t> serialize_root(const RootIndex& root) {
   w.u32(root.node_count);
   w.u64(root.scene.input_triangles);
   w.string(root.scene.metadata);
-  w.varint(root.pages.size());
-  for (const Range& p : root.pages) write_range(w, p);
-  w.varint(root.blobs.size());
-  for (const Range& b : root.blobs) write_range(w, b);
+  write_ranges(w, root.pages);
+  write_ranges(w, root.blobs);
   w.varint(root.scene.materials.size());
   for (const PackageMaterial& m : root.scene.materials) {
     w.string(m.material.name);
@@ -417,11 +527,10 @@ std::vector<uint8_t> serialize_root(const RootIndex& root) {
     }
     w.varint(o.representation);
   }
-  w.varint(root.index_pages.size());
-  for (const IndexPage& p : root.index_pages) {
-    write_range(w, p.range);
-    w.varint(p.first_node), w.varint(p.node_count);
-  }
+  std::vector<Range> index_ranges;
+  for (const IndexPage& p : root.index_pages) index_ranges.push_back(p.range);
+  write_ranges(w, index_ranges);
+  for (const IndexPage& p : root.index_pages) w.varint(p.first_node), w.varint(p.node_count);
   w.varint(root.root_nodes.size());
   write_nodes(w, root.root_nodes, 0);
   return std::move(w.bytes);
@@ -439,10 +548,8 @@ RootIndex parse_root(std::span<const uint8_t> raw, const std::string& context) {
   root.node_count = r.u32();
   root.scene.input_triangles = r.u64();
   root.scene.metadata = r.string("metadata");
-  root.pages.resize(r.count(24, "page"));
-  for (Range& p : root.pages) p = read_range(r, kMaxPageRawBytes, "page");
-  root.blobs.resize(r.count(24, "blob"));
-  for (Range& b : root.blobs) b = read_range(r, UINT32_MAX, "blob");
+  root.pages = read_ranges(r, kMaxPageRawBytes, "page");
+  root.blobs = read_ranges(r, UINT32_MAX, "blob");
   root.scene.materials.resize(r.count(19, "material"));
   for (PackageMaterial& m : root.scene.materials) {
     m.material.name = r.string("material name");
@@ -473,9 +580,11 @@ RootIndex parse_root(std::span<const uint8_t> raw, const std::string& context) {
     }
     o.representation = r.index(root.scene.representations.size(), "representation");
   }
-  root.index_pages.resize(r.count(26, "index page"));
-  for (IndexPage& p : root.index_pages) {
-    p.range = read_range(r, kMaxIndexPageRawBytes, "index page");
+  const std::vector<Range> index_ranges = read_ranges(r, kMaxIndexPageRawBytes, "index page");
+  root.index_pages.resize(index_ranges.size());
+  for (size_t i = 0; i < index_ranges.size(); ++i) {
+    IndexPage& p = root.index_pages[i];
+    p.range = index_ranges[i];
     p.first_node = r.index(uint64_t(UINT32_MAX) + 1, "first node");
     p.node_count = r.index(uint64_t(UINT32_MAX) + 1, "node count");
   }

@@ -6,23 +6,29 @@
 // Node records: the root index's records and each index page's are one run each, coded against the run's
 // previous record (zeros before the first) so that each run decodes on its own. Each field of the records is
 // its own stream, so that zstd models each field apart (elephant_1m's index pages: 16.7 B per node in format
-// 4, 10.3 with compact pairs and field streams): a run is 14 varint stream sizes, then the streams, in this
+// 4, 10.3 with compact pairs and field streams): a run is 13 varint stream sizes, then the streams, in this
 // order: heads; representation, material and level deltas; page and offset; size and cluster; triangle
-// counts; vertex counts; children; parents; objects; pair codes; pair errors; compact pairs' exponents;
-// sphere centres; sphere radii. A record is: u8 head (kind in bits 0-1, encoding in bit 2, bit 3 = children
-// and bit 4 = parents equal to the previous record's and not stored); svarint deltas of representation,
-// material, level and page from the previous record's; svarint offset minus the previous record's end when on
-// the same page (else minus 0); varint size, triangles and vertices; the children, parents and objects id
-// lists (varint count, then each id as an svarint delta from the previous id + 1, the first of a link list
-// from the record's own id, of objects from 0); then the own and the parents' (error, sphere) pairs, which
+// counts; children; parents; objects; pair codes; pair errors; compact pairs' exponents; sphere centres;
+// sphere radii. A record is: u8 head (kind in bits 0-1, encoding in bit 2, bit 3 = children and bit 4 =
+// parents equal to the previous record's and not stored, bit 5 = page, offset and size the previous record's
+// and cluster its next, bit 6 = parents not stored, being the records earlier in the run whose children list
+// holds this id, in id order, as a DAG's are: 0.56 -> 0.13 B a record on refined_elephant); svarint deltas of
+// representation, material, level and page from the previous record's; svarint offset minus the previous
+// record's end when on the same page (else minus 0); varint size and triangles; the children, parents and
+// objects id lists (varint count, then each id as an svarint delta from the previous id + 1, the first of a
+// parents list from the record's own id, of objects from 0; a children list is varint 2k + 1 for the k-th
+// latest distinct children list of the run, else 2 x count and the deltas, the first from the end of the
+// run's latest such list, or the record's own id); then the parents' and the own (error, sphere) pairs, which
 // siblings share: a pair is a literal (f32 error, f32 centre x y z, f32 radius) or a compact pair, either of
 // which joins the run's table of distinct pairs, or a reference to the k-th latest pair of that table; the
 // parents' pair may also be "the own pair of parents[0]" when that record is earlier in the run. A compact
 // pair holds an error whose low 8 bits are zero (3 bytes) and a sphere whose centre and radius are integers
-// times a common 2^E (svarint E and centre integers coded against the run's previous compact pair, varint
-// radius): what the writer's rounding (pair_rounding.hpp) makes of every pair, in about 8 bytes instead
-// of 20. Exact floats throughout (a pair is compact only when it decodes back bit for bit): verify compares a
-// node's parents' pair with its parents' own pair bit for bit.
+// times a common 2^E (svarint E, centre integers, varint radius): what the writer's rounding
+// (pair_rounding.hpp) makes of every pair, in about 8 bytes instead of 20. The own pair of a node with
+// parents codes E against ilogb of the parents' radius and its centre against the parents' centre (it lies
+// inside the parents' sphere); any other compact pair codes both against the run's previous compact pair.
+// Exact floats throughout (a pair is compact only when it decodes back bit for bit): verify compares a node's
+// parents' pair with its parents' own pair bit for bit.
 #pragma once
 
 #include <array>
@@ -63,7 +69,10 @@ struct NodeRecord {
   // it is cluster `cluster` (< kMaxRecordClusters; 0 for a node stored alone). The clusters of one record
   // share page, offset and size. Filled in by the writer.
   uint32_t page = 0, offset = 0, size = 0, cluster = 0;
-  uint32_t triangles = 0, vertices = 0;
+  // Its triangles (what a cut's triangle budget counts before any geometry arrives). Its vertex count is not
+  // stored: only the decoder needs it, and the node's bytes hold it (0.73 B a record after zstd on
+  // refined_elephant, 9 % of its index).
+  uint32_t triangles = 0;
   float error = 0.0f;
   Sphere sphere;
   float parent_error = std::numeric_limits<float>::infinity();
@@ -132,11 +141,11 @@ RootIndex parse_root(std::span<const uint8_t> raw, const std::string& context);
 std::vector<uint8_t> serialize_nodes(std::span<const NodeRecord> nodes, uint32_t first_id);
 // The field streams of a run of records (the header comment's order), as serialize_nodes stores them after
 // their sizes: where a run's bytes go. Cost: one serialization.
-inline constexpr size_t kIndexFields = 14;
+inline constexpr size_t kIndexFields = 13;
 inline constexpr const char* kIndexFieldNames[kIndexFields] = {
-    "record heads",  "record deltas",  "record locations", "record sizes", "triangle counts",
-    "vertex counts", "children",       "parents",          "objects",      "pair codes",
-    "pair errors",   "pair exponents", "sphere centres",   "sphere radii"};
+    "record heads",   "record deltas",  "record locations", "record sizes", "triangle counts",
+    "children",       "parents",        "objects",          "pair codes",   "pair errors",
+    "pair exponents", "sphere centres", "sphere radii"};
 std::array<std::vector<uint8_t>, kIndexFields> serialize_node_fields(std::span<const NodeRecord> nodes,
                                                                      uint32_t first_id);
 // Parses exactly `count` records of ids first_id.. and validates each against `root`.

@@ -44,12 +44,14 @@ PairKey key(float error, const Sphere& s) {
 // The grids tried for a sphere, coarsest first: a finer one grows it less, so it fits where its parents'
 // sphere is tight around it (the exact sphere always fits, the parents' rounded sphere being larger by a
 // step), at a byte or two more.
-constexpr int kGridBits[] = {kSphereGridBits, kSphereGridBits + 3, kSphereGridBits + 6, kSphereGridBits + 9};
+// A pair of error 0 (a finest node's own) starts at kZeroErrorSphereGridBits.
+constexpr int kGridBits[] = {kZeroErrorSphereGridBits, kSphereGridBits, kSphereGridBits + 3,
+                             kSphereGridBits + 6, kSphereGridBits + 9};
 
 struct PairGraph {
   std::vector<Sphere> exact, final;
   std::vector<std::vector<uint32_t>> parents;  // the pairs that are this pair's parents' pair somewhere
-  std::vector<uint8_t> keep_exact, state;      // state: 0 to do, 1 in progress, 2 done
+  std::vector<uint8_t> keep_exact, zero_error, state;  // state: 0 to do, 1 in progress, 2 done
 
   // final[p]: rounded on the coarsest grid of kGridBits whose rounded sphere lies inside every parents'
   // pair's final sphere, else exact. Parents' pairs are decided first (recursion depth: the number of
@@ -61,6 +63,7 @@ struct PairGraph {
     final[p] = exact[p];
     for (int bits : kGridBits) {
       if (keep_exact[p]) break;
+      if (bits < kSphereGridBits && !zero_error[p]) continue;
       const Sphere s = round_sphere_out(exact[p], bits);
       bool inside = true;
       for (uint32_t q : parents[p])
@@ -81,7 +84,9 @@ void round_pairs(std::span<NodeRecord> nodes) {
   std::map<PairKey, uint32_t> ids;
   auto id = [&](float error, const Sphere& s) {
     const auto [it, added] = ids.try_emplace(key(error, s), uint32_t(g.exact.size()));
-    if (added) g.exact.push_back(s), g.parents.emplace_back(), g.keep_exact.push_back(0);
+    if (added)
+      g.exact.push_back(s), g.parents.emplace_back(), g.keep_exact.push_back(0),
+          g.zero_error.push_back(error == 0.0f);
     return it->second;
   };
   std::vector<std::pair<uint32_t, uint32_t>> node_pairs(nodes.size());

@@ -221,11 +221,9 @@ DecodedNode PackageReader::decode_node(uint32_t id, std::span<const uint8_t> pag
   // extract_cluster reads its context only to refuse a cluster the record does not hold.
   const bool held = n.cluster < record_clusters(last.decoded);
   DecodedNode decoded = extract_cluster(last.decoded, n.cluster, held ? node_context_ : context());
-  if (decoded.mesh.triangle_count() != n.triangles || decoded.mesh.vertex_count() != n.vertices) {
-    throw Error(context() + ": record says " + std::to_string(n.triangles) + " triangles / " +
-                std::to_string(n.vertices) + " vertices, its bytes hold " +
-                std::to_string(decoded.mesh.triangle_count()) + " / " +
-                std::to_string(decoded.mesh.vertex_count()));
+  if (decoded.mesh.triangle_count() != n.triangles) {
+    throw Error(context() + ": record says " + std::to_string(n.triangles) + " triangles, its bytes hold " +
+                std::to_string(decoded.mesh.triangle_count()));
   }
   decoded.mesh.material = n.material;
   return decoded;

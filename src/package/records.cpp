@@ -83,7 +83,6 @@ RecordMesh weld_record(std::span<const Mesh* const> clusters,
   Mesh& out = r.mesh;
   out.indices.reserve(corners);
   std::vector<uint32_t> welded(total);
-  std::vector<uint8_t> seen;
   for (size_t k = 0, base = 0; k < clusters.size(); base += clusters[k]->vertex_count(), ++k) {
     const Mesh& m = *clusters[k];
     out.material = m.material;
@@ -101,14 +100,7 @@ RecordMesh weld_record(std::span<const Mesh* const> clusters,
       }
       if (k < locked.size() && !locked[k].empty() && locked[k][v]) r.locked[welded[i]] = 1;
     }
-    seen.assign(out.positions.size(), 0);
-    uint32_t distinct = 0;
-    for (uint32_t v : m.indices) {
-      const uint32_t w = welded[base + v];
-      out.indices.push_back(w);
-      distinct += seen[w] == 0, seen[w] = 1;
-    }
-    r.cluster_vertices.push_back(distinct);
+    for (uint32_t v : m.indices) out.indices.push_back(welded[base + v]);
     r.cluster_triangles.push_back(uint32_t(m.triangle_count()));
   }
   return r;

@@ -29,7 +29,6 @@ struct RecordMesh {
   Mesh mesh;                                // the clusters' triangles in cluster order, welded vertices
   std::vector<uint8_t> locked;              // per vertex: locked in any cluster that holds it
   std::vector<uint32_t> cluster_triangles;  // per cluster (NodeGeometry::cluster_triangles)
-  std::vector<uint32_t> cluster_vertices;   // per cluster: its distinct vertices (extract_cluster's count)
 };
 
 // Welds `clusters` (meshes with the same attributes; `locked[c]` per vertex of cluster c, or empty) on

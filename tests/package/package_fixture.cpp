@@ -94,7 +94,6 @@ TestPackage write_test_package(const std::filesystem::path& file, uint32_t codec
     for (size_t i = 0; i < chunks.size(); ++i) {
       const uint32_t id = uint32_t(t.records.size());
       const uint32_t shift = uint32_t(i % 4);
-      uint32_t vertices = uint32_t(chunks[i].vertex_count());
       if (!records) {
         NodeGeometry g;
         g.mesh = &chunks[i];
@@ -121,8 +120,6 @@ TestPackage write_test_package(const std::filesystem::path& file, uint32_t codec
         g.normal_bits = 12;
         g.cluster_triangles = record.cluster_triangles;
         writer.add_record(ids, node_codec(codec).encode(g, rep.grid));
-        for (size_t k = group; k < i; ++k) t.records[first + k].vertices = record.cluster_vertices[k - group];
-        vertices = record.cluster_vertices.back();
       }
       if (i % 3 == 2) writer.end_group();
 
@@ -132,7 +129,6 @@ TestPackage write_test_package(const std::filesystem::path& file, uint32_t codec
       n.material = chunks[i].material;
       n.level = shift;
       n.triangles = uint32_t(chunks[i].triangle_count());
-      n.vertices = vertices;
       Bounds b = chunks[i].bounds();
       n.sphere = {b.center(), 0.5f * b.diagonal()};
       n.error = 0.001f * float(shift);

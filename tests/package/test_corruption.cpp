@@ -240,7 +240,6 @@ TEST_P(Corruption, HostileRootIndicesAreErrors) {
       {"negative radius", [](RootIndex& r) { r.root_nodes[0].sphere.radius = -1.0f; }},
       {"infinite centre", [](RootIndex& r) { r.root_nodes[0].sphere.center.x = INFINITY; }},
       {"wrong triangle count", [](RootIndex& r) { r.root_nodes[0].triangles += 1; }},
-      {"wrong vertex count", [](RootIndex& r) { r.root_nodes[1].vertices = 1u << 30; }},
       {"cluster past its record's", [](RootIndex& r) { r.root_nodes[0].cluster = kMaxRecordClusters - 1; }},
       {"NaN transform", [](RootIndex& r) { r.scene.objects[0].transform[1][1] = std::nanf(""); }},
       {"object representation", [](RootIndex& r) { r.scene.objects[0].representation = 2; }},
@@ -281,6 +280,32 @@ TEST_P(Corruption, HugeCountsInHandWrittenRootsAreErrors) {
   long_string.bytes.resize(long_string.bytes.size() - 1);
   long_string.varint(UINT32_MAX);  // metadata of 4 GiB
   EXPECT_EQ(outcome(with_raw_root(long_string.bytes)), Outcome::error);
+}
+
+TEST_P(Corruption, ARangeStoredAfterTheLastTakesElevenBytes) {
+  // Offset 0 bytes past the previous range's end (1 byte), size and raw size below 128 (1 byte each), u64
+  // checksum.
+  RootIndex r = root;
+  const size_t before = serialize_root(r).size();
+  const Range& last = r.pages.back();
+  r.pages.push_back(Range{last.offset + last.size, 100, 120, 0x0123456789abcdefull});
+  EXPECT_EQ(serialize_root(r).size() - before, 11u);
+}
+
+TEST_P(Corruption, HandWrittenRangesOutsideTheFileAreErrors) {
+  for (const auto& [offset, size] :
+       {std::pair<int64_t, uint64_t>{-1, 10}, {INT64_MAX, 10}, {5, UINT64_MAX}}) {
+    ByteWriter w;
+    w.u32(root.codec);
+    w.u32(root.node_count);
+    w.u64(0);
+    w.string("");
+    w.varint(1);  // one page
+    w.svarint(offset), w.varint(size), w.varint(10), w.u64(0);
+    std::string message;
+    EXPECT_EQ(outcome(with_raw_root(w.bytes), &message), Outcome::error) << offset << " " << size;
+    EXPECT_NE(message.find("range"), std::string::npos) << message;
+  }
 }
 
 TEST_P(Corruption, CorruptedPagesReceivedFromElsewhereAreErrorsOrValidMeshes) {

@@ -6,6 +6,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <string_view>
 
 #include "core/error.hpp"
 #include "package/bytes.hpp"
@@ -46,7 +47,7 @@ std::vector<NodeRecord> records(uint32_t first, uint32_t n) {
     r.page = i / 6 % 4;  // back to page 0 after page 3: pages need not increase
     r.offset = (i % 6) * 100 + (i % 3 == 0 ? 7 : 0);
     r.size = 90 + i;
-    r.triangles = 120 + i, r.vertices = 70 + 2 * i;
+    r.triangles = 120 + i;
     r.error = 0.5f + float(i / 2) * 0.125f;
     r.sphere = {{float(i / 2), -1.5f, 2.0f}, 3.0f + float(i / 2)};
     if (i % 4 == 3 && i + 4 < n) r.children = {id + 4, id + 5, id + 6};
@@ -75,7 +76,6 @@ void expect_same(const std::vector<NodeRecord>& a, const std::vector<NodeRecord>
     EXPECT_EQ(a[i].size, b[i].size);
     EXPECT_EQ(a[i].cluster, b[i].cluster);
     EXPECT_EQ(a[i].triangles, b[i].triangles);
-    EXPECT_EQ(a[i].vertices, b[i].vertices);
     EXPECT_EQ(a[i].error, b[i].error);
     EXPECT_EQ(a[i].sphere.center, b[i].sphere.center);
     EXPECT_EQ(a[i].sphere.radius, b[i].sphere.radius);
@@ -143,6 +143,84 @@ TEST(IndexRecords, TheClustersOfARecordShareItsBytesAndStoreThemOnce) {
   expect_same(parse_nodes(raw, tables(), 0, 12, "run"), in);
 }
 
+// The bytes of field `name` (kIndexFieldNames) of the run of records `in` from id 0.
+size_t field_bytes(const std::vector<NodeRecord>& in, std::string_view name) {
+  const auto fields = serialize_node_fields(in, 0);
+  for (size_t f = 0; f < kIndexFields; ++f)
+    if (kIndexFieldNames[f] == name) return fields[f].size();
+  ADD_FAILURE() << "no field " << name;
+  return 0;
+}
+
+TEST(IndexRecords, ARecordStoresNoVertexCount) {
+  // Record 1 repeats record 0 (the next cluster of its bytes, its links and pairs, no objects): it stores
+  // head, 3 deltas, triangles, object count and 2 pair codes, 8 bytes (kMinNodeRecordBytes).
+  std::vector<NodeRecord> in = records(0, 2);
+  in[0].objects.clear();
+  in[1] = in[0];
+  in[1].cluster = in[0].cluster + 1;
+  auto total = [](const std::vector<NodeRecord>& r) {
+    size_t bytes = 0;
+    for (const std::vector<uint8_t>& f : serialize_node_fields(r, 0)) bytes += f.size();
+    return bytes;
+  };
+  EXPECT_EQ(total(in) - total({in[0]}), 8u);
+  expect_same(parse_nodes(serialize_nodes(in, 0), tables(), 0, 2, "run"), in);
+}
+
+TEST(IndexRecords, ParentsThatListARecordAsTheirChildAreNotStored) {
+  // A DAG's links: records 0 and 1 were simplified from group {2, 3, 4}, whose parents they are; 3 and 4
+  // from {5, 6}. Only record 2's list would be stored were it not implied (3's and 4's equal the previous
+  // record's), and 5's (6's equals 5's); record 0's is empty. Record 7's parent is record 2 though record 2
+  // does not list it as a child: it is stored.
+  std::vector<NodeRecord> in = records(0, 8);
+  for (NodeRecord& r : in) r.children.clear(), r.parents.clear(), r.parent_error = INFINITY;
+  in[0].children = in[1].children = {2, 3, 4};
+  in[3].children = in[4].children = {5, 6};
+  in[2].parents = in[3].parents = in[4].parents = {0, 1};
+  in[5].parents = in[6].parents = {3, 4};
+  in[7].parents = {2};
+  for (NodeRecord& r : in)
+    if (!r.parents.empty())
+      r.parent_error = in[r.parents[0]].error, r.parent_sphere = in[r.parents[0]].sphere;
+  EXPECT_EQ(field_bytes(in, "parents"), 1u + 2u);  // record 0's empty list (count 0) and record 7's
+  expect_same(parse_nodes(serialize_nodes(in, 0), tables(), 0, 8, "run"), in);
+  // Parents listed in another order than the ids' are stored.
+  in[2].parents = in[3].parents = in[4].parents = {1, 0};
+  EXPECT_EQ(field_bytes(in, "parents"), 1u + 3u + 2u);
+  expect_same(parse_nodes(serialize_nodes(in, 0), tables(), 0, 8, "run"), in);
+}
+
+TEST(IndexRecords, AChildrenListSeenEarlierInTheRunIsAReference) {
+  // Lists A = {10, 11, 12} and B = {13, 14} alternate (siblings whose records are not consecutive): A takes
+  // 4 bytes (2 x 3, first id 10 past record 0's id, two zeros), B 3 (2 x 2, first right after A's end, a
+  // zero), each repetition 1 (a reference).
+  std::vector<NodeRecord> in = records(0, 6);
+  for (size_t i = 0; i < in.size(); ++i)
+    in[i].children = i % 2 ? std::vector<uint32_t>{13, 14} : std::vector<uint32_t>{10, 11, 12};
+  EXPECT_EQ(field_bytes(in, "children"), 4u + 3u + 4u);
+  expect_same(parse_nodes(serialize_nodes(in, 0), tables(), 0, 6, "run"), in);
+}
+
+TEST(IndexRecords, AnOwnSphereIsCodedAgainstItsParentsSphere) {
+  // Siblings of two groups interleaved (as a DAG's page order leaves them), each group inside its parents'
+  // sphere of radius 8 at (+-1000, +-1000, +-1000): each own centre lies within 2 units (32 grid steps of
+  // 2^-4) of its parents' centre, one svarint byte a coordinate; against the previous compact pair (the
+  // other group's, 2000 units away) it would take 3.
+  std::vector<NodeRecord> in = records(0, 8);
+  for (uint32_t i = 0; i < 8; ++i) {
+    NodeRecord& r = in[i];
+    const float side = i % 2 ? -1000.0f : 1000.0f;
+    r.children.clear(), r.objects.clear();
+    r.parents = {40u + i % 2};
+    r.parent_error = 2.0f, r.parent_sphere = {{side, side, side}, 8.0f};
+    r.error = 1.0f, r.sphere = {{side + 0.25f * float(i), side - 0.125f * float(i), side + 1.5f}, 4.0f};
+  }
+  // Two parents' pairs (3 coordinates of up to 3 bytes each), 8 own pairs of 3 bytes.
+  EXPECT_LE(field_bytes(in, "sphere centres"), 2 * 9 + 8 * 3u);
+  expect_same(parse_nodes(serialize_nodes(in, 0), tables(), 0, 8, "run"), in);
+}
+
 // A hand-written run's field streams, in the order of index.hpp ("Node records").
 enum Field : size_t {
   kHead,
@@ -150,7 +228,6 @@ enum Field : size_t {
   kLocation,
   kSize,
   kTriangles,
-  kVertices,
   kChildren,
   kParents,
   kObjects,
@@ -182,7 +259,7 @@ Fields record_fields(uint8_t head, bool with_parent, uint64_t cluster = 0) {
   for (int field = 0; field < 3; ++field) f[kDeltas].svarint(0);  // representation, material, level
   if (!(head & 32))
     f[kLocation].svarint(0), f[kLocation].svarint(0), f[kSize].varint(10), f[kSize].varint(cluster);
-  f[kTriangles].varint(1), f[kVertices].varint(3);
+  f[kTriangles].varint(1);
   if (!(head & 8)) f[kChildren].varint(0);  // no children
   if (!(head & 16)) {
     f[kParents].varint(with_parent ? 1 : 0);
@@ -192,14 +269,14 @@ Fields record_fields(uint8_t head, bool with_parent, uint64_t cluster = 0) {
   return f;
 }
 
-// The hand-written run: one record with the given head, list and pair codes.
+// The hand-written run: one record with the given head, list and pair codes (parents' first).
 std::vector<uint8_t> one_record(uint8_t head, uint64_t own_code, uint64_t parent_code, bool with_parent,
                                 uint64_t cluster = 0) {
   Fields f = record_fields(head, with_parent, cluster);
-  f[kPairCode].varint(own_code);
-  if (own_code == 0) literal(f, 1.0f, 1.0f);
   f[kPairCode].varint(parent_code);
   if (parent_code == 1) literal(f, INFINITY, 0.0f);
+  f[kPairCode].varint(own_code);
+  if (own_code == 0) literal(f, 1.0f, 1.0f);
   return run_bytes(f);
 }
 
@@ -223,7 +300,7 @@ TEST(IndexRecords, HostileReferencesAreErrors) {
   // The hand-written record itself parses.
   EXPECT_NO_THROW(parse_nodes(one_record(0, 0, 1, false), root, 5, 1, "run"));
   const std::vector<std::pair<const char*, std::vector<uint8_t>>> cases = {
-      {"own pair refers past the table", one_record(0, 2, 1, false)},
+      {"own pair refers past the table", one_record(0, 3, 1, false)},
       {"parents' pair refers past the table", one_record(0, 0, 4, false)},
       {"parents' pair from a parent before the run", one_record(0, 0, 0, true)},
       {"parents' pair from a node without parents", one_record(0, 0, 0, false)},
@@ -232,8 +309,17 @@ TEST(IndexRecords, HostileReferencesAreErrors) {
       {"the next cluster of a record the run does not have", one_record(32, 0, 1, false)},
       {"cluster index past the most a record holds", one_record(0, 0, 1, false, kMaxRecordClusters)},
       {"huge cluster index", one_record(0, 0, 1, false, uint64_t(1) << 40)},
-      {"unknown record flag", one_record(64, 0, 1, false)},
+      {"unknown record flag", one_record(128, 0, 1, false)},
+      {"parents implied but no record of the run lists it", one_record(64, 0, 1, false)},
   };
+  // A children list referring to a list the run does not have, and one longer than the stream.
+  for (uint64_t code : {uint64_t(1), uint64_t(2) << 40}) {
+    Fields f = record_fields(0, false);
+    f[kChildren] = ByteWriter();
+    f[kChildren].varint(code);
+    f[kPairCode].varint(1), literal(f, INFINITY, 0.0f), f[kPairCode].varint(0), literal(f, 1.0f, 1.0f);
+    expect_one_line_errors({{"children list", run_bytes(f)}}, root);
+  }
   expect_one_line_errors(cases, root);
 }
 
@@ -300,13 +386,13 @@ struct Compact {
 std::vector<uint8_t> compact_record(const Compact& c) {
   Fields f = record_fields(0, false);
   f[kPairCode].varint(1);
+  literal(f, INFINITY, 0.0f);
+  f[kPairCode].varint(1);
   f[kPairError].u8(uint8_t(c.error_top)), f[kPairError].u8(uint8_t(c.error_top >> 8));
   f[kPairError].u8(uint8_t(c.error_top >> 16));
   f[kPairExponent].svarint(c.exponent);
   for (int64_t k : c.centre) f[kPairCentre].svarint(k);
   f[kPairRadius].varint(c.radius);
-  f[kPairCode].varint(1);
-  literal(f, INFINITY, 0.0f);
   return run_bytes(f);
 }
 

@@ -84,6 +84,39 @@ std::vector<NodeRecord> nested(int levels) {
   return nodes;
 }
 
+TEST(PairRounding, APairOfErrorZeroIsRoundedOnTheCoarserGrid) {
+  // Two finest nodes (error 0) under one parents' pair, and that parents' own node: the finest nodes' own
+  // spheres on the grid of 2^(ilogb r - kZeroErrorSphereGridBits), the parents' on 2^(ilogb r -
+  // kSphereGridBits); each contains its exact sphere and lies inside its parents'.
+  std::vector<NodeRecord> nodes(3);
+  const Sphere parents{{0.1234567f, -0.7654321f, 0.3141593f}, 0.9876543f};
+  nodes[0].error = 0.01f, nodes[0].sphere = parents, nodes[0].children = {1, 2};
+  nodes[0].parents = {7}, nodes[0].parent_error = 0.5f, nodes[0].parent_sphere = {{0.0f, 0.0f, 0.0f}, 4.0f};
+  const Sphere exact[2] = {{{0.2345678f, -0.6543219f, 0.1111111f}, 0.4321987f},
+                           {{-0.1357913f, -0.8642097f, 0.5f}, 0.3333333f}};
+  for (int i = 1; i <= 2; ++i) {
+    NodeRecord& n = nodes[size_t(i)];
+    n.error = 0.0f, n.sphere = exact[i - 1], n.parents = {0};
+    n.parent_error = nodes[0].error, n.parent_sphere = parents;
+  }
+  round_pairs(nodes);
+  auto on_grid = [](const Sphere& s, int exponent) {
+    for (int a = 0; a < 3; ++a)
+      if (std::ldexp(double(s.center[a]), -exponent) !=
+          std::floor(std::ldexp(double(s.center[a]), -exponent)))
+        return false;
+    return true;
+  };
+  for (int i = 1; i <= 2; ++i) {
+    const NodeRecord& n = nodes[size_t(i)];
+    EXPECT_TRUE(on_grid(n.sphere, std::ilogb(exact[i - 1].radius) - kZeroErrorSphereGridBits)) << i;
+    EXPECT_TRUE(sphere_contains(n.sphere, exact[i - 1], 0.0)) << i;
+    EXPECT_TRUE(sphere_contains(n.parent_sphere, n.sphere, 0.0)) << i;
+  }
+  EXPECT_TRUE(on_grid(nodes[0].sphere, std::ilogb(parents.radius) - kSphereGridBits));
+  EXPECT_FALSE(on_grid(nodes[0].sphere, std::ilogb(parents.radius) - kZeroErrorSphereGridBits));
+}
+
 TEST(PairRounding, TightlyNestedPairsKeepEveryInvariant) {
   const std::vector<NodeRecord> exact = nested(12);
   std::vector<NodeRecord> nodes = exact;

@@ -127,7 +127,6 @@ TEST_P(RoundTrip, RecordsLoadOnDemand) {
     EXPECT_EQ(n.material, e.material);
     EXPECT_EQ(n.level, e.level);
     EXPECT_EQ(n.triangles, e.triangles);
-    EXPECT_EQ(n.vertices, e.vertices);
     EXPECT_EQ(n.error, e.error);
     EXPECT_EQ(n.parent_error, e.parent_error);
     EXPECT_EQ(n.sphere.center, e.sphere.center);

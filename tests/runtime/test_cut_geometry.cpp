@@ -67,7 +67,6 @@ struct GeometryPackage {
       const auto [x0, x1] = dag.intervals[i];
       const Mesh mesh = strip(x0, x1, int(x1 - x0) * int(i % 3 + 1));
       dag.records[i].triangles = uint32_t(mesh.triangle_count());
-      dag.records[i].vertices = uint32_t(mesh.vertex_count());
       dag.records[i].material = i % 2;
       package::NodeGeometry geometry;
       geometry.mesh = &mesh;
