@@ -37,7 +37,8 @@ inline constexpr std::array<uint8_t, 8> kMagic = {0x89, 'L', 'O', 'D', 'S', '\r'
 // (derived_normals.hpp; the encoder's choice, decoders unchanged); 12: traversal symbols stored as their
 // kind's rank in the gate's context of decoded triangles (traversal_connectivity.hpp, ranked symbols); index
 // records without vertex counts, a node's own sphere coded against its parents', parents implied by the run's
-// children lists, repeated children lists as references, range tables as offset deltas and varints (index.hpp).
+// children lists, repeated children lists as references, range tables as offset deltas and varints
+// (index.hpp).
 inline constexpr uint32_t kFormatVersion = 12;
 inline constexpr size_t kHeaderSize = 64;
 
