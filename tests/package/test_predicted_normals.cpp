@@ -27,13 +27,19 @@ double angle(glm::vec3 a, glm::vec3 b) {
   return std::atan2(glm::length(glm::cross(x, y)), glm::dot(x, y));
 }
 
+// The encoder's codes of `normals` (in their own order) against `sum`, and their plane width.
+std::vector<uint64_t> encode(std::span<const glm::vec3> normals, std::span<const NormalSum> sum,
+                             uint32_t bits, uint32_t& width) {
+  std::vector<uint32_t> order(normals.size());
+  std::iota(order.begin(), order.end(), 0u);
+  return normal_residuals(normals, order, sum, bits, width);
+}
+
 // The decoder's normals from the encoder's codes against `sum`.
 std::vector<glm::vec3> round_trip(std::span<const glm::vec3> normals, std::span<const NormalSum> sum,
                                   uint32_t bits) {
-  std::vector<uint32_t> order(normals.size());
-  std::iota(order.begin(), order.end(), 0u);
   uint32_t width = 0;
-  const std::vector<uint64_t> codes = normal_residuals(normals, order, sum, bits, width);
+  const std::vector<uint64_t> codes = encode(normals, sum, bits, width);
   std::vector<uint8_t> planes;
   put_planes(planes, codes, 2, width);
   std::vector<glm::vec3> decoded;
@@ -85,10 +91,8 @@ TEST(PredictedNormals, EightLanesDecodeTheBitsOfFour) {
     sum[v] = v % 7 == 0 ? NormalSum{0, 0, -0.0f, 0} : NormalSum{g(rng), g(rng), g(rng), 0};
     normals[v] = glm::normalize(glm::vec3(g(rng), g(rng), g(rng)));
   }
-  std::vector<uint32_t> order(V);
-  std::iota(order.begin(), order.end(), 0u);
   uint32_t width = 0;
-  const std::vector<uint64_t> codes = normal_residuals(normals, order, sum, bits, width);
+  const std::vector<uint64_t> codes = encode(normals, sum, bits, width);
   std::vector<uint8_t> planes;
   put_planes(planes, codes, 2, width);
   std::vector<glm::vec3> whole;
