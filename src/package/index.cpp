@@ -467,9 +467,23 @@ std::vector<NodeRecord> read_nodes(ByteReader& r, const RootIndex& root, uint32_
   std::vector<NodeRecord> nodes;  // grown as records parse (no reserve: a hostile count allocates nothing)
   RecordRun run;
   run.first_id = first_id;
+  // Repeated lists (the head's same-children / same-parents flags, children list references, implied
+  // parents) cost a byte or none each, so a hostile run could expand a few KB into records x list length
+  // ids. The run's links (children and parents ids) are bounded by kMaxLinksPerRecord a record plus one a
+  // byte of the run: linear in its size. A DAG record lists its group's clusters (4-8, rarely more) and the
+  // clusters its group became; an HLOD node its BVH children.
+  constexpr uint64_t kMaxLinksPerRecord = 64;
+  const uint64_t max_links = kMaxLinksPerRecord * count + r.position();
+  uint64_t links = 0;
   for (uint32_t i = 0; i < count; ++i) {
     run.done = nodes;
     nodes.push_back(read_node(fields, root, first_id + i, run));
+    links += nodes.back().children.size() + nodes.back().parents.size();
+    if (links > max_links)
+      throw Error(std::string(context) + ": node " + std::to_string(first_id + i) +
+                  ": the run's records list " + std::to_string(links) + " links, more than its " +
+                  std::to_string(count) + " records and bytes can hold (at most " +
+                  std::to_string(max_links) + ")");
     run.add_links(nodes.back(), first_id + i);
   }
   for (ByteReader& f : fields.f) f.expect_end();

@@ -6,6 +6,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <numeric>
 #include <string_view>
 
 #include "core/error.hpp"
@@ -335,6 +336,30 @@ std::vector<NodeRecord> distinct_pairs(uint32_t n) {
       r.parent_error = 10.0f + std::sqrt(f), r.parent_sphere = {r.sphere.center, 33.3f + f};
   }
   return out;
+}
+
+// A run whose records all repeat one long children list (a byte or none each) would expand a few KB into
+// records x list length ids: the parser bounds a run's links by 64 a record plus one a byte of the run.
+TEST(IndexRecords, ARunThatRepeatsALongListIsAnError) {
+  RootIndex root = tables();
+  root.node_count = 5000;
+  auto run_listing = [](uint32_t list_length) {
+    std::vector<NodeRecord> in = distinct_pairs(200);
+    std::vector<uint32_t> list(list_length);
+    std::iota(list.begin(), list.end(), 300u);
+    for (NodeRecord& r : in) r.children = list;
+    return in;
+  };
+  const std::vector<NodeRecord> modest = run_listing(40);  // 8,000 links: under 64 x 200
+  expect_same(parse_nodes(serialize_nodes(modest, 0), root, 0, 200, "run"), modest);
+  const std::vector<uint8_t> amplified = serialize_nodes(run_listing(1000), 0);
+  EXPECT_LT(amplified.size(), 20000u);  // 200,000 links from under 20 KB
+  try {
+    parse_nodes(amplified, root, 0, 200, "hostile.lods: index page");
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("links"), std::string::npos) << e.what();
+  }
 }
 
 TEST(IndexRecords, RoundedPairsAreCompactAndComeBackBitForBit) {
