@@ -392,7 +392,9 @@ NodeRecord read_node(FieldReaders& r, const RootIndex& root, uint32_t id, Record
   if (head & ~uint8_t(3 | 4 | kSameChildren | kSameParents | kSameRecord | kDerivedParents))
     r[kHead].fail("node " + std::to_string(id) + ": unknown record flags");
   const std::vector<uint32_t>* derived = run.derived_parents(id);
-  if ((head & kDerivedParents) && (!derived || (head & kSameParents)))
+  if ((head & kDerivedParents) && (head & kSameParents))
+    r[kHead].fail("node " + std::to_string(id) + ": parents both implied and the previous record's");
+  if ((head & kDerivedParents) && !derived)
     r[kHead].fail("node " + std::to_string(id) + ": implied parents that no record of this run lists");
   n.kind = NodeKind(head & 3), n.encoding = NodeEncoding((head >> 2) & 1);
   if ((head & (kSameChildren | kSameParents | kSameRecord)) && run.done.empty())
@@ -470,8 +472,9 @@ std::vector<NodeRecord> read_nodes(ByteReader& r, const RootIndex& root, uint32_
   // Repeated lists (the head's same-children / same-parents flags, children list references, implied
   // parents) cost a byte or none each, so a hostile run could expand a few KB into records x list length
   // ids. The run's links (children and parents ids) are bounded by kMaxLinksPerRecord a record plus one a
-  // byte of the run: linear in its size. A DAG record lists its group's clusters (4-8, rarely more) and the
-  // clusters its group became; an HLOD node its BVH children.
+  // byte read up to the run's end (in the root index, the tables before it too): linear in its size. A DAG
+  // record lists its group's clusters (4-8, rarely more) and the clusters its group became; an HLOD node its
+  // BVH children.
   constexpr uint64_t kMaxLinksPerRecord = 64;
   const uint64_t max_links = kMaxLinksPerRecord * count + r.position();
   uint64_t links = 0;

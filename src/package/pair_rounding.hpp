@@ -32,11 +32,12 @@ namespace lodstream::package {
 inline constexpr int kSphereGridBits = 6;
 // The grid of a pair of error 0 (a finest node's own: drawn whenever its parents are not, so its sphere
 // serves frustum culling and screen-area weights, never a screen error); finer grids follow as for any pair.
-// Why 3 (sizeindex, measured on format 12: bake, render --pixel-error 1 from /tmp/endm's cameras): at 6 (as
-// any pair) / 4 / 3 / 2 refined_elephant's index pages are 7,583 / 6,869 / 6,769 / 6,765 B (at 2 most spheres
-// no longer fit their parents' and fall back to finer grids); at 3 the city's index 524,929 -> 433,663 B;
-// refined_elephant's near / mid / far cuts (67,076 / 33,522 / 18,138 triangles) and the city's city_0 / 12 /
-// 24 cuts (91,686 / 189,764 / 212,549) and PSNR unchanged. Growth of a finest sphere: at most about 3 x 2^-3.
+// Why 3 (sizeindex, measured on format 12: bake, render --pixel-error 1 from bench/compare-binaries'
+// cameras): at 6 (as any pair) / 4 / 3 / 2 refined_elephant's index pages are 7,583 / 6,869 / 6,769 / 6,765 B
+// (at 2 most spheres no longer fit their parents' and fall back to finer grids); at 3 the city's index
+// 524,929 -> 433,663 B; refined_elephant's near / mid / far cuts (67,076 / 33,522 / 18,138 triangles) and the
+// city's city_0 / 12 / 24 cuts (91,686 / 189,764 / 212,549) and PSNR unchanged. Growth of a finest sphere: at
+// most about 3 x 2^-3.
 inline constexpr int kZeroErrorSphereGridBits = 3;
 
 // e rounded up to a float whose low 8 mantissa bits are zero (16 significant bits): relative change below

@@ -153,16 +153,16 @@ constexpr RankTables kRankTables = [] {
   return t;
 }();
 
-// The context of a gate a -> b from the triangles decoded at a and b (counts wrapping at 2^8 alike in encoder
-// and decoder).
-inline uint32_t gate_context(uint32_t at_a, uint32_t at_b) {
-  return 8 * std::min(at_a, kRankedTriangles) + std::min(at_b, kRankedTriangles);
+// 8 x the context of a gate a -> b, the offset of its row in kind[] and rank[], from the triangles decoded at
+// a and b (byte counters, wrapping at 2^8 alike in encoder and decoder).
+inline uint32_t gate_row(uint8_t at_a, uint8_t at_b) {
+  return kRankTables.first[at_a] + kRankTables.second[at_b];
 }
 
-// The symbol byte of a triangle of cluster k across a gate of cluster `gate` whose context is `context`:
-// the kind's rank in bits 0-2 (traversal_connectivity.hpp).
-uint8_t tagged(TraversalSymbol symbol, uint32_t context, uint32_t k, uint32_t gate) {
-  return uint8_t(kRankTables.rank[8 * context + symbol] | (k == gate ? 0 : (k + 1) << 3));
+// The symbol byte of a triangle of cluster k across a gate of cluster `gate` whose row is `row`: the kind's
+// rank in bits 0-2 (traversal_connectivity.hpp).
+uint8_t tagged(TraversalSymbol symbol, uint32_t row, uint32_t k, uint32_t gate) {
+  return uint8_t(kRankTables.rank[row + symbol] | (k == gate ? 0 : (k + 1) << 3));
 }
 
 // Writes the triangles `from` (3 indices each) into `to` in the clusters' ranges, in their order within each
@@ -186,7 +186,7 @@ bool sort_by_cluster(const uint32_t* from, uint32_t* to, std::span<const uint8_t
 }  // namespace
 
 uint8_t traversal_rank(TraversalSymbol kind, uint32_t triangles_at_a, uint32_t triangles_at_b) {
-  return kRankTables.rank[8 * gate_context(triangles_at_a, triangles_at_b) + kind];
+  return kRankTables.rank[gate_row(uint8_t(triangles_at_a), uint8_t(triangles_at_b)) + kind];
 }
 
 TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
@@ -277,7 +277,7 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
       continue;
     }
     const Front::Edge g = front.edge(e);
-    const uint32_t context = gate_context(triangles_at[g.a], triangles_at[g.b]);
+    const uint32_t row = gate_row(triangles_at[g.a], triangles_at[g.b]);
     // The triangle across a -> b holds half-edge b -> a.
     const uint32_t a_in = code.order[g.a], b_in = code.order[g.b];
     const HalfEdge* across = nullptr;
@@ -289,7 +289,7 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
       }
     }
     if (!across) {
-      code.symbols.push_back(tagged(kBoundary, context, 0, 0));
+      code.symbols.push_back(tagged(kBoundary, row, 0, 0));
       ++e;  // the gate stays in its loop, processed
       continue;
     }
@@ -298,20 +298,20 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
     const uint32_t c_in = across->third;
     uint32_t c = decoded[c_in];
     if (c == kNone) {
-      code.symbols.push_back(tagged(kVertex, context, k, g.cluster));
+      code.symbols.push_back(tagged(kVertex, row, k, g.cluster));
       c = add_vertex(c_in, g.a, g.b, g.o);
       front.attach(e, c, k);
     } else if (front.closes(e) && c == front.left(e)) {
-      code.symbols.push_back(tagged(kEnd, context, k, g.cluster));
+      code.symbols.push_back(tagged(kEnd, row, k, g.cluster));
       front.close_loop(e);
     } else if (c == front.left(e)) {
-      code.symbols.push_back(tagged(kLeft, context, k, g.cluster));
+      code.symbols.push_back(tagged(kLeft, row, k, g.cluster));
       front.close_left(e, k);
     } else if (c == front.right(e)) {
-      code.symbols.push_back(tagged(kRight, context, k, g.cluster));
+      code.symbols.push_back(tagged(kRight, row, k, g.cluster));
       front.close_right(e, k);
     } else {
-      code.symbols.push_back(tagged(kSplit, context, k, g.cluster));
+      code.symbols.push_back(tagged(kSplit, row, k, g.cluster));
       put_varint(code.references, next - 1 - c);
       front.attach(e, c, k);
     }
@@ -422,8 +422,7 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     const Front::Edge& g = front.edge(e);
     const uint32_t a = g.a, b = g.b;
     const uint32_t byte = *symbol++;
-    const uint32_t kind =
-        kRankTables.kind[kRankTables.first[count[a]] + kRankTables.second[count[b]] + (byte & 7)];
+    const uint32_t kind = kRankTables.kind[gate_row(count[a], count[b]) + (byte & 7)];
     // Cluster code 0: the gate's cluster (below C, checked when its triangle was decoded), else code - 1.
     uint32_t k = g.cluster;
     if (byte >> 3) [[unlikely]] {

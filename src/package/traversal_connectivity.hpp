@@ -81,7 +81,7 @@ enum TraversalSymbol : uint8_t { kVertex = 0, kLeft = 1, kRight = 2, kBoundary =
 inline constexpr uint32_t kRankedTriangles = 7;
 
 // The rank (0..5) of `kind` at a gate a -> b whose vertices lie in the given numbers of decoded triangles
-// (ranked symbols, above). Cost: O(1), a table look-up.
+// (ranked symbols, above; counted modulo 2^8, as the codec counts them). Cost: O(1), a table look-up.
 uint8_t traversal_rank(TraversalSymbol kind, uint32_t triangles_at_a, uint32_t triangles_at_b);
 
 struct TraversalCode {

@@ -312,6 +312,7 @@ TEST(IndexRecords, HostileReferencesAreErrors) {
       {"huge cluster index", one_record(0, 0, 1, false, uint64_t(1) << 40)},
       {"unknown record flag", one_record(128, 0, 1, false)},
       {"parents implied but no record of the run lists it", one_record(64, 0, 1, false)},
+      {"parents both implied and the previous record's", one_record(64 | 16, 0, 1, false)},
   };
   // A children list referring to a list the run does not have, and one longer than the stream.
   for (uint64_t code : {uint64_t(1), uint64_t(2) << 40}) {
