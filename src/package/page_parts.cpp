@@ -9,7 +9,6 @@
 #include "package/format.hpp"
 #include "package/meshopt_codec.hpp"
 #include "package/residual_coder.hpp"
-#include "package/symbol_coder.hpp"
 
 namespace lodstream::package {
 
@@ -17,7 +16,7 @@ namespace {
 
 // NodeSizeBreakdown's parts, in its order.
 constexpr size_t kParts = 7;
-constexpr size_t kPositions = 1, kNormals = 2, kConnectivity = 5;
+constexpr size_t kPositions = 1, kNormals = 2;
 
 std::array<size_t, kParts> part_sizes(const NodeSizeBreakdown& b) {
   return {b.header, b.positions(), b.normals, b.attributes, b.locked, b.indices - b.tail, b.tail};
@@ -41,9 +40,9 @@ void put_varint(std::vector<uint8_t>& out, uint64_t v) {
   out.insert(out.end(), w.bytes.begin(), w.bytes.end());
 }
 
-// The residual and connectivity parts' forms (page_parts.hpp).
+// The residual parts' forms (page_parts.hpp).
 constexpr uint8_t kPlanesForm = 0, kCodedForm = 1, kSplitForm = 2;
-// The bits a residual or symbol the coded form must save over the zstd'd bytes (page_parts.hpp).
+// The bits a residual the coded form must save over the zstd'd bytes (page_parts.hpp).
 constexpr double kMinSavedBits = 0.2;
 
 // The bytes zstd at `level` / `min_match` stores `planes` in, estimated (page_parts.hpp): for levels above 1
@@ -140,8 +139,6 @@ std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<co
       }
       out[1 + p] = std::move(form);
     }
-  if (coded && !out[1 + kConnectivity].empty())
-    out[1 + kConnectivity] = connectivity_form(out[1 + kConnectivity], level, min_match);
   for (size_t p = 0; p < kParts; ++p) put_varint(out[0], out[1 + p].size());
   return out;
 }
@@ -150,17 +147,6 @@ std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<co
 
 bool residuals_coded(const NodeCodec& codec) {
   return codec.id() != MeshoptCodec::kId;
-}
-
-std::vector<uint8_t> connectivity_form(std::span<const uint8_t> plain, int level, int min_match) {
-  const std::optional<std::vector<uint8_t>> coded = encode_symbols(plain);
-  const bool keep_coded =
-      coded && 8 * (estimated_zstd_size(plain, level, min_match) - double(coded->size())) >=
-                   kMinSavedBits * double(plain.size());
-  std::vector<uint8_t> form = {keep_coded ? kCodedForm : kPlanesForm};
-  const std::span<const uint8_t> content = keep_coded ? std::span<const uint8_t>(*coded) : plain;
-  form.insert(form.end(), content.begin(), content.end());
-  return form;
 }
 
 std::vector<uint8_t> compress_page(std::span<const uint8_t> page, std::span<const uint32_t> node_sizes,
@@ -230,16 +216,9 @@ std::span<const uint8_t> decompress_page(std::span<const uint8_t> stored, uint32
         split = true, stream[p] = s.bytes(first, "residual stream"), split_rest = s.bytes(s.remaining(), "");
       }
     }
-  if (residuals_coded(codec) && !stream[kConnectivity].empty()) {
-    if (stream[kConnectivity][0] != kPlanesForm && stream[kConnectivity][0] != kCodedForm)
-      r.fail("invalid connectivity part form");
-    coded[kConnectivity] = stream[kConnectivity][0] == kCodedForm;
-    stream[kConnectivity] = stream[kConnectivity].subspan(1);
-  }
   ResidualDecoder positions(coded[kPositions] ? stream[kPositions] : std::span<const uint8_t>(), where),
       position_rest(split_rest, where),
       normals(coded[kNormals] ? stream[kNormals] : std::span<const uint8_t>(), where);
-  SymbolDecoder symbols(coded[kConnectivity] ? stream[kConnectivity] : std::span<const uint8_t>(), where);
   std::array<size_t, kParts> used{};  // bytes of each stream consumed
   ByteReader headers(stream[0], where);
   size_t at = 0;
@@ -250,9 +229,7 @@ std::span<const uint8_t> decompress_page(std::span<const uint8_t> stored, uint32
     const NodeSizeBreakdown b = codec.layout(stream[0].subspan(used[0]), node_size, where);
     const std::array<size_t, kParts> n = part_sizes(b);
     for (size_t p = 0; p < kParts; ++p) {
-      if (coded[p] && p == kConnectivity) {
-        symbols.symbols(n[p], page.data() + at);
-      } else if (coded[p]) {
+      if (coded[p]) {
         const std::optional<Planes> s =
             p == kPositions ? planes_of(n[p], b.position_low, 3) : planes_of(n[p], b.normal_low, 2);
         if (!s) headers.fail("node residuals not in byte planes");
@@ -271,7 +248,7 @@ std::span<const uint8_t> decompress_page(std::span<const uint8_t> stored, uint32
     }
     headers.bytes(n[0], "node header");
   }
-  positions.finish(), position_rest.finish(), normals.finish(), symbols.finish();
+  positions.finish(), position_rest.finish(), normals.finish();
   for (size_t p = 0; p < kParts; ++p)
     if (used[p] != stream[p].size() && !coded[p]) r.fail("page part streams hold bytes of no node");
   if (at != raw_size) r.fail("page part streams hold fewer bytes than the page");

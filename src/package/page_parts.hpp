@@ -31,6 +31,9 @@
 // when they are all traversal symbols and that saves kMinSavedBits a symbol over zstd (the decode costs
 // about 35 instructions a symbol). The references, varints that zstd compresses to about two thirds, stay
 // bytes in a block of their own. Measured (`lodstream bake --json`, format 6 -> 7): see symbol_coder.hpp.
+// Format 13: the connectivity part is the nodes' bytes again, no form byte: a record's symbols are a rANS
+// stream under fixed tables that the traversal decodes itself (traversal_connectivity.hpp), with no page
+// pass and no page tables (symbol_coder.hpp is gone; its figures are in git history, format 12).
 //
 // Format 9: the positions' residual part may also take the split form (2): varint size of the first stream,
 // then two streams of residual_coder.hpp, the first holding component 0 of every node's residuals (with the
@@ -67,13 +70,6 @@ namespace lodstream::package {
 
 // Whether pages of `codec` store their residuals coded (residual_coder.hpp): the byte-plane codecs 2 and 3.
 bool residuals_coded(const NodeCodec& codec);
-
-// A connectivity part of such a codec as a page stores it before zstd: the form byte, then the symbols
-// (`plain`: the nodes' connectivity streams, in page order) coded by symbol_coder.hpp when they are
-// traversal symbols and that saves kMinSavedBits a symbol over `plain` as zstd at `level` / `min_match`
-// stores it (estimated as for the residual parts), else `plain`. Cost: a symbol coding and a zstd level-1
-// compression of `plain`.
-std::vector<uint8_t> connectivity_form(std::span<const uint8_t> plain, int level, int min_match);
 
 // The stored bytes of a page of whole nodes (`node_sizes`, in page order, add up to page.size()): one zstd
 // frame at `level` / `min_match` (format.hpp's zstd_compress), by part when `codec` parses every node (for

@@ -1,8 +1,8 @@
-// What the package's two rANS coders share (residual_coder.hpp: residuals, symbol_coder.hpp: traversal
-// symbols): rANS (Duda 2013, "Asymmetric numeral systems: entropy coding combining speed of Huffman coding
-// with compression rate of arithmetic coding", arXiv:1311.2540) with 32-bit states kept in [2^16, 2^32) and
-// renormalized 16 bits at a time, so that a decode step reads at most once; static frequency tables adding
-// up to a power of two.
+// What the package's two rANS coders share (residual_coder.hpp: residuals, traversal_connectivity.hpp:
+// traversal symbols): rANS (Duda 2013, "Asymmetric numeral systems: entropy coding combining speed of Huffman
+// coding with compression rate of arithmetic coding", arXiv:1311.2540) with 32-bit states kept in [2^16,
+// 2^32) and renormalized 16 bits at a time, so that a decode step reads at most once; static frequency tables
+// adding up to a power of two.
 #pragma once
 
 #include <cstddef>

@@ -3,7 +3,6 @@
 #include <map>
 
 #include "package/format.hpp"
-#include "package/page_parts.hpp"
 
 namespace lodstream::package {
 
@@ -62,12 +61,7 @@ std::vector<LevelAccount> account_sizes(PackageReader& reader, const SizeAccount
     for (uint32_t p = 0; p < kNodeParts; ++p)
       for (size_t at = 0; at < l.bytes[p].size(); at += options.chunk) {
         const auto chunk = std::span(l.bytes[p]).subspan(at, std::min(options.chunk, l.bytes[p].size() - at));
-        l.account.parts[p].compressed +=
-            p == uint32_t(NodePart::connectivity) && residuals_coded(reader.codec())
-                ? zstd_compress(connectivity_form(chunk, options.zstd_level, options.min_match),
-                                options.zstd_level, options.min_match)
-                      .size()
-                : zstd_compress(chunk, options.zstd_level, options.min_match).size();
+        l.account.parts[p].compressed += zstd_compress(chunk, options.zstd_level, options.min_match).size();
       }
     out.push_back(l.account);
   }

@@ -18,7 +18,7 @@
 namespace lodstream::package {
 
 // connectivity: the nodes' connectivity streams (codec 3: the traversal's symbols), compressed as a page
-// stores them (page_parts.hpp: coded with context or zstd'd, whichever it keeps); references: the rest of
+// stores them (page_parts.hpp: zstd'd; codec 3's are rANS streams already); references: the rest of
 // the nodes' connectivity bytes (NodeSizeBreakdown::tail; codec 3: the traversal's references).
 enum class NodePart : uint32_t { header, positions, normals, attributes, locked, connectivity, references };
 inline constexpr uint32_t kNodeParts = 7;

@@ -2,10 +2,16 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "core/error.hpp"
 #include "package/bytes.hpp"
 #include "package/quantized_node.hpp"
+#include "package/rans.hpp"
+#include "package/traversal_tables.hpp"
 
 namespace lodstream::package {
 
@@ -117,52 +123,116 @@ void put_varint(std::vector<uint8_t>& out, uint32_t v) {
   out.push_back(uint8_t(v));
 }
 
-// The kinds by rank in each gate context 8 min(t_a, 7) + min(t_b, 7) (traversal_connectivity.hpp, ranked
-// symbols), most frequent first: measured on the bakes of horse and motorBike (format 11's traversals, every
-// level, 0.77 M gates); a context they never met (t_a or t_b 0: no gate has them) takes the first row.
-constexpr char kKindsByFrequency[64][7] = {
-    "021345", "021345", "021345", "021345", "021345", "021345", "021345", "021345",  // t_a 0
-    "021345", "035421", "034215", "034251", "032451", "203451", "023451", "023451",  // 1
-    "021345", "304125", "304125", "032415", "032415", "203415", "203415", "023415",  // 2
-    "021345", "304152", "304125", "032145", "023415", "203415", "320415", "302415",  // 3
-    "021345", "031452", "013425", "013245", "013245", "203415", "302145", "301425",  // 4
-    "021345", "103452", "103425", "103425", "310425", "321045", "301245", "304251",  // 5
-    "021345", "103452", "130425", "310425", "310425", "310245", "340125", "304125",  // 6
-    "021345", "013452", "301425", "350214", "304125", "350421", "304512", "350421",  // 7
-};
-struct RankTables {
-  uint8_t kind[64 * 8];  // kind[8 context + rank]; ranks 6 and 7 give 6, no kind (the decoder refuses it)
-  uint8_t rank[64 * 8];  // rank[8 context + kind]
-  // By a vertex's triangle count t (a byte): 64 min(t, 7) and 8 min(t, 7), the offsets of kind's entries for
-  // a gate's first and second vertex (two loads where a min took four instructions with its constant:
-  // refined_elephant's decode_traversal 19.90 -> 19.27 M instructions).
+constexpr uint32_t kKinds = 6, kScale = 1u << kTraversalScaleBits;
+
+// By a vertex's triangle count t (a byte): 16 x 8 min(t, 7) and 16 x min(t, 7), the offsets of a gate's
+// row of kTraversalClassStarts from its level's and previous class's first row, for the gate's first and
+// second vertex (two loads where a min took four instructions with its constant: refined_elephant's
+// decode_traversal 19.90 -> 19.27 M instructions, format 12).
+struct GateOffsets {
   uint16_t first[256], second[256];
 };
-constexpr RankTables kRankTables = [] {
-  RankTables t{};
+constexpr GateOffsets kGateOffsets = [] {
+  GateOffsets t{};
   for (uint32_t c = 0; c < 256; ++c)
-    t.first[c] = uint16_t(64 * std::min(c, kRankedTriangles)),
-    t.second[c] = uint16_t(8 * std::min(c, kRankedTriangles));
-  for (uint32_t c = 0; c < 64; ++c) {
-    t.kind[8 * c + 6] = t.kind[8 * c + 7] = 6;
-    for (uint32_t r = 0; r < 6; ++r) {
-      t.kind[8 * c + r] = uint8_t(kKindsByFrequency[c][r] - '0');
-      t.rank[8 * c + t.kind[8 * c + r]] = uint8_t(r);
-    }
-  }
+    t.first[c] = uint16_t(16 * 8 * std::min(c, kRankedTriangles)),
+    t.second[c] = uint16_t(16 * std::min(c, kRankedTriangles));
   return t;
 }();
 
-// 8 x the context of a gate a -> b, the offset of its row in kind[] and rank[], from the triangles decoded at
-// a and b (byte counters, wrapping at 2^8 alike in encoder and decoder).
-inline uint32_t gate_row(uint8_t at_a, uint8_t at_b) {
-  return kRankTables.first[at_a] + kRankTables.second[at_b];
+// The cluster codes 1..31, most recently coded first: a code is stored as its rank here (0..30), then moves
+// to the front; every record starts from kFirstClusterCodes.
+using RecentClusterCodes = std::array<uint8_t, 31>;
+constexpr RecentClusterCodes kFirstClusterCodes = {1,  2,  3,  4,  5,  6,  7,  8,  9,  10, 11,
+                                                   12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22,
+                                                   23, 24, 25, 26, 27, 28, 29, 30, 31};
+
+// Move-to-front (Bentley, Sleator, Tarjan & Wei 1986, "A locally adaptive data compression scheme", CACM
+// 29(4)) over the recent cluster codes: the code of rank r, which then moves to the front. Cost: a few
+// instructions for r < 16 (most ranks: the codes of bytes 0..r of one or two little-endian words move up a
+// byte, without a loop), a memmove above. Measured (format 12's page symbol pass, `bench decode --runs 1`
+// under callgrind, read_page): a byte loop for every rank from 8 took elephant_1m 257.20 M instructions,
+// refined_elephant 15.50 M (~180 a rank above 16, 14,172 of them in elephant_1m), these 255.92 / 15.37.
+uint32_t to_front(RecentClusterCodes& recent, uint32_t r) {
+  const uint8_t code = recent[r];
+  if (r < 8) [[likely]] {
+    uint64_t word;
+    std::memcpy(&word, recent.data(), 8);
+    const uint64_t moved = ~uint64_t(0) >> (56 - 8 * r);  // bytes 0..r
+    word = (word & ~moved) | ((word << 8) & moved) | code;
+    std::memcpy(recent.data(), &word, 8);
+    return code;
+  }
+  if (r < 16) {
+    uint64_t word[2];
+    std::memcpy(word, recent.data(), 16);
+    const uint64_t moved = ~uint64_t(0) >> (56 - 8 * (r - 8));  // bytes 8..r
+    word[1] = (word[1] & ~moved) | (((word[1] << 8) | (word[0] >> 56)) & moved);
+    word[0] = (word[0] << 8) | code;
+    std::memcpy(recent.data(), word, 16);
+    return code;
+  }
+  std::memmove(recent.data() + 1, recent.data(), r);
+  recent[0] = code;
+  return code;
 }
 
-// The symbol byte of a triangle of cluster k across a gate of cluster `gate` whose row is `row`: the kind's
-// rank in bits 0-2 (traversal_connectivity.hpp).
-uint8_t tagged(TraversalSymbol symbol, uint32_t row, uint32_t k, uint32_t gate) {
-  return uint8_t(kRankTables.rank[row + symbol] | (k == gate ? 0 : (k + 1) << 3));
+// The cluster ranks' decode table (rans.hpp's fill_slots entries, shift 16) and each slot's rank, and each
+// rank's start, from kClusterRankFrequencies (built once: 20 KB).
+struct RankTable {
+  uint32_t slot[kScale];
+  uint8_t rank[kScale];
+  uint16_t start[kClusterRanks];
+};
+const RankTable& rank_table() {
+  static const RankTable table = [] {
+    RankTable t;
+    for (uint32_t r = 0, at = 0; r < kClusterRanks; at += kClusterRankFrequencies[r++]) {
+      const uint32_t f = kClusterRankFrequencies[r];
+      t.start[r] = uint16_t(at);
+      rans::fill_slots(t.slot + at, f, f, 16);
+      std::memset(t.rank + at, int(r), f);
+    }
+    return t;
+  }();
+  return table;
+}
+
+// One rANS step (Duda 2013, eq. 9: D(x) = (s, f_s floor(x / 2^12) + x mod 2^12 - start_s)) under the class
+// row `starts` (kTraversalClassStarts): s is the class whose range holds the slot x mod 2^12, found by
+// comparing the slot with all 16 starts at once (the lanes whose start lies above it: the first is s + 1,
+// lanes 12-15 always); then x is read back up to kLow from the next 2 bytes at `at`. Cost: about 14
+// instructions, two loads of the row, no branch.
+inline __attribute__((always_inline)) uint32_t decode_class(uint32_t& x, const uint16_t* starts,
+                                                            const uint8_t* bytes, size_t& at) {
+  const uint32_t slot = x & (kScale - 1);
+#if defined(__SSE2__)
+  const __m128i s = _mm_set1_epi16(int16_t(slot));  // below 2^15: the signed compare is the unsigned one
+  const __m128i low = _mm_loadu_si128(reinterpret_cast<const __m128i*>(starts));
+  const __m128i high = _mm_loadu_si128(reinterpret_cast<const __m128i*>(starts + 8));
+  const uint32_t above =
+      uint32_t(_mm_movemask_epi8(_mm_packs_epi16(_mm_cmpgt_epi16(low, s), _mm_cmpgt_epi16(high, s))));
+  const uint32_t c = uint32_t(__builtin_ctz(above)) - 1;
+#else
+  uint32_t c = 0;
+  while (starts[c + 1] <= slot) ++c;
+#endif
+  const uint32_t start = starts[c];
+  x = (starts[c + 1] - start) * (x >> kTraversalScaleBits) + slot - start;
+  uint16_t next;
+  std::memcpy(&next, bytes + at, 2);
+  rans::renormalize(x, at, next);
+  return c;
+}
+
+// The cluster rank's step likewise, under rank_table().
+inline uint32_t decode_rank(uint32_t& x, const RankTable& table, const uint8_t* bytes, size_t& at) {
+  const size_t slot = x & (kScale - 1);
+  x = rans::step(x, table.slot, slot, kTraversalScaleBits);
+  uint16_t next;
+  std::memcpy(&next, bytes + at, 2);
+  rans::renormalize(x, at, next);
+  return table.rank[slot];
 }
 
 // Writes the triangles `from` (3 indices each) into `to` in the clusters' ranges, in their order within each
@@ -185,11 +255,31 @@ bool sort_by_cluster(const uint32_t* from, uint32_t* to, std::span<const uint8_t
 
 }  // namespace
 
-uint8_t traversal_rank(TraversalSymbol kind, uint32_t triangles_at_a, uint32_t triangles_at_b) {
-  return kRankTables.rank[gate_row(uint8_t(triangles_at_a), uint8_t(triangles_at_b)) + kind];
+uint32_t traversal_context(bool finest, uint32_t previous, uint32_t triangles_at_a, uint32_t triangles_at_b) {
+  return (finest ? 0 : 12 * 64) + 64 * previous +
+         (kGateOffsets.first[uint8_t(triangles_at_a)] + kGateOffsets.second[uint8_t(triangles_at_b)]) / 16;
 }
 
-TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
+std::vector<uint8_t> encode_traversal_steps(std::span<const TraversalStep> steps) {
+  if (steps.empty()) return {};
+  const RankTable& ranks = rank_table();
+  std::vector<uint8_t> reversed;
+  uint32_t x = rans::kLow;
+  for (size_t i = steps.size(); i-- > 0;) {  // the decoder's order reversed: a tagged class's rank first
+    const TraversalStep& s = steps[i];
+    if (s.symbol_class >= kKinds)
+      rans::encode(x, ranks.start[s.rank], kClusterRankFrequencies[s.rank], kTraversalScaleBits, reversed);
+    const uint16_t* row = kTraversalClassStarts[s.context];
+    rans::encode(x, row[s.symbol_class], row[s.symbol_class + 1] - row[s.symbol_class], kTraversalScaleBits,
+                 reversed);
+  }
+  ByteWriter w;
+  w.u32(x);
+  w.bytes.insert(w.bytes.end(), reversed.rbegin(), reversed.rend());
+  return std::move(w.bytes);
+}
+
+TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V, bool finest,
                                std::span<const uint32_t> cluster_triangles) {
   const uint32_t T = uint32_t(indices.size() / 3);
   const bool clustered = cluster_triangles.size() > 1;
@@ -251,8 +341,10 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
 
   thread_local std::vector<Front::Edge> edges;
   Front front(edges, T);
-  uint32_t scan = 0;  // triangles below it are encoded
-  uint32_t e = 0;     // the gate
+  uint32_t scan = 0;      // triangles below it are encoded
+  uint32_t e = 0;         // the gate
+  uint32_t previous = 0;  // the previous gate's class
+  RecentClusterCodes recent = kFirstClusterCodes;
   while (done < T) {
     e = front.gate(e);
     if (e == front.size()) {
@@ -277,7 +369,18 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
       continue;
     }
     const Front::Edge g = front.edge(e);
-    const uint32_t row = gate_row(triangles_at[g.a], triangles_at[g.b]);
+    const uint32_t context = traversal_context(finest, previous, triangles_at[g.a], triangles_at[g.b]);
+    // The gate's step: class `kind` (+ 6 with the rank of cluster k's code when k is not the gate's).
+    auto step = [&](TraversalSymbol kind, uint32_t k) {
+      uint8_t symbol_class = kind, rank = 0;
+      if (k != g.cluster) {
+        symbol_class += kKinds;
+        rank = uint8_t(std::find(recent.begin(), recent.end(), k + 1) - recent.begin());
+        to_front(recent, rank);
+      }
+      code.steps.push_back({uint16_t(context), symbol_class, rank});
+      previous = symbol_class;
+    };
     // The triangle across a -> b holds half-edge b -> a.
     const uint32_t a_in = code.order[g.a], b_in = code.order[g.b];
     const HalfEdge* across = nullptr;
@@ -289,7 +392,7 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
       }
     }
     if (!across) {
-      code.symbols.push_back(tagged(kBoundary, row, 0, 0));
+      step(kBoundary, g.cluster);
       ++e;  // the gate stays in its loop, processed
       continue;
     }
@@ -298,20 +401,20 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
     const uint32_t c_in = across->third;
     uint32_t c = decoded[c_in];
     if (c == kNone) {
-      code.symbols.push_back(tagged(kVertex, row, k, g.cluster));
+      step(kVertex, k);
       c = add_vertex(c_in, g.a, g.b, g.o);
       front.attach(e, c, k);
     } else if (front.closes(e) && c == front.left(e)) {
-      code.symbols.push_back(tagged(kEnd, row, k, g.cluster));
+      step(kEnd, k);
       front.close_loop(e);
     } else if (c == front.left(e)) {
-      code.symbols.push_back(tagged(kLeft, row, k, g.cluster));
+      step(kLeft, k);
       front.close_left(e, k);
     } else if (c == front.right(e)) {
-      code.symbols.push_back(tagged(kRight, row, k, g.cluster));
+      step(kRight, k);
       front.close_right(e, k);
     } else {
-      code.symbols.push_back(tagged(kSplit, row, k, g.cluster));
+      step(kSplit, k);
       put_varint(code.references, next - 1 - c);
       front.attach(e, c, k);
     }
@@ -326,6 +429,7 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
   if (clustered)
     sort_by_cluster(traversal_order.data(), code.indices.data(), std::span(emitted_cluster.data(), T),
                     cluster_triangles);
+  code.symbols = encode_traversal_steps(code.steps);
   return code;
 }
 
@@ -335,15 +439,32 @@ namespace {
 // without them).
 template <bool multi>
 void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> references, uint32_t T,
-                    uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where,
-                    std::span<const uint32_t> cluster_triangles, Parallelograms* extra) {
+                    uint32_t V, bool finest, uint32_t* indices, uint32_t* predictors,
+                    const std::string& where, std::span<const uint32_t> cluster_triangles,
+                    Parallelograms* extra) {
   ByteReader refs(references, where);
   auto fail = [&](const char* what) { throw Error(where + ": corrupted connectivity (" + what + ")"); };
   thread_local std::vector<Front::Edge> edges;
   Front front(edges, T);
   uint32_t next = 0;  // the next new vertex
-  const uint8_t* symbol = symbols.data();
-  const uint8_t* const symbols_end = symbol + symbols.size();
+  // The symbols' rANS stream (encode_traversal_steps), copied with 8 bytes of padding: a gate reads at most 4
+  // bytes and starts only at or before the stream's end. An empty stream holds no gate (at past its end).
+  thread_local std::vector<uint8_t> stream;
+  uint32_t x = 0;
+  size_t read = 1, end = 0;  // the next rANS read, and the stream's end
+  if (!symbols.empty()) {
+    if (symbols.size() < 4) fail("symbol stream shorter than its state");
+    rans::copy_padded(symbols, stream);
+    std::memcpy(&x, stream.data(), 4);
+    if (x < rans::kLow) fail("invalid symbol state");
+    read = 4, end = symbols.size();
+  }
+  const uint8_t* const bytes = stream.data();
+  const RankTable& ranks = rank_table();
+  RecentClusterCodes recent = kFirstClusterCodes;
+  // The rows of the node's level, and the offset of the previous class's (times 16 u16 a row).
+  const uint16_t* const level_rows = kTraversalClassStarts[finest ? 0 : 12 * 64];
+  uint32_t previous = 0;
   // Clusters of a record: each triangle goes straight to the next free place in its cluster's range of
   // `indices` (the ranges are consecutive, in cluster order, sized by `cluster_triangles`), so the triangles
   // of each cluster stay in traversal order, as the encoder's counting sort leaves them; C = 1 otherwise
@@ -418,15 +539,18 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
       --left;
       continue;
     }
-    if (symbol == symbols_end) fail("symbols end early");
+    if (read > end) fail("symbols end early");
     const Front::Edge& g = front.edge(e);
     const uint32_t a = g.a, b = g.b;
-    const uint32_t byte = *symbol++;
-    const uint32_t kind = kRankTables.kind[gate_row(count[a], count[b]) + (byte & 7)];
-    // Cluster code 0: the gate's cluster (below C, checked when its triangle was decoded), else code - 1.
+    const uint32_t symbol_class = decode_class(
+        x, level_rows + previous + kGateOffsets.first[count[a]] + kGateOffsets.second[count[b]], bytes, read);
+    previous = 16 * 64 * symbol_class;
+    uint32_t kind = symbol_class;
+    // Untagged: the gate's cluster (below C, checked when its triangle was decoded), else the code's - 1.
     uint32_t k = g.cluster;
-    if (byte >> 3) [[unlikely]] {
-      k = (byte >> 3) - 1;
+    if (symbol_class >= kKinds) [[unlikely]] {
+      kind -= kKinds;
+      k = to_front(recent, decode_rank(x, ranks, bytes, read)) - 1;
       if (k >= C) fail("cluster out of range");
     }
     uint32_t c;
@@ -472,11 +596,9 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
           front.attach(e, c, k);
           break;
         }
-        case kBoundary:
-          ++e;  // the gate stays in its loop, processed: the next one lies past it
+        default:  // kBoundary, the kind left
+          ++e;    // the gate stays in its loop, processed: the next one lies past it
           continue;
-        default:
-          fail("unknown symbol");
       }
       if constexpr (multi) join(a, b, g.o, c);  // the gate
     }
@@ -484,7 +606,11 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     --left;
     ++e;
   }
-  if (symbol != symbols_end) fail("symbols left over");
+  if (!symbols.empty()) {
+    // Past the end: the last gates decoded from the padding (a stream of fewer symbols than gates).
+    if (read > end) fail("symbols end early");
+    if (read != end || x != rans::kLow) fail("symbols left over");
+  }
   if (!refs.at_end()) fail("references left over");
   for (; next < V; ++next) {
     const uint32_t from = next > 0 ? next - 1 : V;
@@ -495,12 +621,15 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
 }  // namespace
 
 void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t> references, uint32_t T,
-                      uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where,
-                      std::span<const uint32_t> cluster_triangles, Parallelograms* extra) {
+                      uint32_t V, bool finest, uint32_t* indices, uint32_t* predictors,
+                      const std::string& where, std::span<const uint32_t> cluster_triangles,
+                      Parallelograms* extra) {
   if (extra)
-    decode_symbols<true>(symbols, references, T, V, indices, predictors, where, cluster_triangles, extra);
+    decode_symbols<true>(symbols, references, T, V, finest, indices, predictors, where, cluster_triangles,
+                         extra);
   else
-    decode_symbols<false>(symbols, references, T, V, indices, predictors, where, cluster_triangles, nullptr);
+    decode_symbols<false>(symbols, references, T, V, finest, indices, predictors, where, cluster_triangles,
+                          nullptr);
 }
 
 }  // namespace lodstream::package

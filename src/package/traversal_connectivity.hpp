@@ -36,7 +36,8 @@
 // into later clusters, no tags) gave 5,689,401 B, its connectivity 0.38 B/tri: it breaks the regular symbol
 // runs zstd finds.
 //
-// Ranked symbols (format 12): bits 0-2 of a symbol byte hold not the kind but its rank in the gate's
+// Ranked symbols (format 12; format 13 codes the kind itself under the same gate context, below): bits 0-2
+// of a symbol byte held not the kind but its rank in the gate's
 // context, the kinds ordered by their frequency after gates a -> b where a lies in min(t_a, 7) and b in
 // min(t_b, 7) decoded triangles (t counted as the triangles arrive, by encoder and decoder alike; a fixed
 // table of 64 orders, traversal_connectivity.cpp). A vertex that already holds most of a fan's triangles is
@@ -59,13 +60,21 @@
 // 19.90 M; counters that saturate at 7 21.10 M; 16-bit counters 20.41 M; each front edge carrying its
 // first vertex's wedge (no per-vertex array) 19.45 M for 247,901 B; contexts modulo 8 19.27 M for 247,694 B.
 //
+// Symbols decoded in the traversal (format 13): a record's symbols are one rANS stream (rans.hpp) under
+// fixed tables (traversal_tables.hpp: no tables stored, none built per page), each gate's class (kind, and
+// whether its triangle is tagged) coded under the context (level 0 or above, previous class, min(t_a, 7),
+// min(t_b, 7)) and a tagged class followed by its cluster code's move-to-front rank (format 8's scheme):
+// the decoder picks the context's row of cumulative frequencies, finds the class by comparing the slot with
+// all 16 at once and takes one rANS step, no division and no page pass. Measured offline first (tables learnt
+// on horse and motorBike, cross-entropy at 2^12, format 11's traversals): refined_elephant 0.871 -> 0.784
+// bits a symbol at level 0 and 2.104 -> 1.799 above (format 12: ranks under the previous rank, per page);
+// bunny 1.308 -> 1.142 and 2.183 -> 1.877. Figures of the packages: traversal_tables.hpp.
+//
 // On a manifold patch about half the symbols are kVertex and most others kLeft / kRight / kBoundary (border
-// edges), so zstd's entropy stage takes them to about 2 bits per triangle; a page codes them with the
-// previous symbol as context (symbol_coder.hpp), and stores the references apart (page_parts.hpp). Levels >=
-// 1 cost about twice level 0's bits per triangle (elephant_1m, format 6: 0.44-0.50 against 0.25 B/tri after
-// zstd): 1.25-1.45 symbols a triangle against 1.11 (kBoundary 0.25-0.45 against 0.11: the borders of smaller,
-// irregular clusters), kSplit 0.05 against 0.001, and kLeft and kRight about even where level 0 turns right
-// (0.43 kRight, 0.01 kLeft: less predictable). Decode: O(T), no search, no hash.
+// edges). Levels >= 1 cost about twice level 0's bits per triangle (elephant_1m, format 6: 0.44-0.50 against
+// 0.25 B/tri after zstd): 1.25-1.45 symbols a triangle against 1.11 (kBoundary 0.25-0.45 against 0.11: the
+// borders of smaller, irregular clusters), kSplit 0.05 against 0.001, and kLeft and kRight about even where
+// level 0 turns right (0.43 kRight, 0.01 kLeft: less predictable). Decode: O(T), no search, no hash.
 #pragma once
 
 #include <cstdint>
@@ -80,15 +89,28 @@ enum TraversalSymbol : uint8_t { kVertex = 0, kLeft = 1, kRight = 2, kBoundary =
 // Gate contexts count at most this many triangles at each of the gate's two vertices.
 inline constexpr uint32_t kRankedTriangles = 7;
 
-// The rank (0..5) of `kind` at a gate a -> b whose vertices lie in the given numbers of decoded triangles
-// (ranked symbols, above; counted modulo 2^8, as the codec counts them). Cost: O(1), a table look-up.
-uint8_t traversal_rank(TraversalSymbol kind, uint32_t triangles_at_a, uint32_t triangles_at_b);
+// A gate as coded: its class (kind, plus 6 when tagged), its context (traversal_tables.hpp) and, tagged, the
+// rank of its cluster code among the recent ones (move-to-front, starting from 1..31).
+struct TraversalStep {
+  uint16_t context;
+  uint8_t symbol_class, rank;
+};
+
+// The context of a gate of a node of level 0 (`finest`: position_shift 0) or above, after a gate of class
+// `previous` (0 for the first), whose vertices lie in the given numbers of decoded triangles (counted modulo
+// 2^8, as the codec counts them). Cost: O(1).
+uint32_t traversal_context(bool finest, uint32_t previous, uint32_t triangles_at_a, uint32_t triangles_at_b);
+
+// The rANS stream of `steps` (empty for none): u32 LE final state, then u16 LE reads. Cost: O(steps), a
+// division a step.
+std::vector<uint8_t> encode_traversal_steps(std::span<const TraversalStep> steps);
 
 struct TraversalCode {
-  std::vector<uint8_t> symbols;     // one per gate processed: its kind's rank, tagged (above)
-  std::vector<uint8_t> references;  // varints: three per piece start, one per split
-  std::vector<uint32_t> order;      // order[decoded vertex] = the input vertex
-  std::vector<uint32_t> indices;    // the input's triangles in decoded order and numbering, each rotated
+  std::vector<uint8_t> symbols;      // the steps' rANS stream (encode_traversal_steps)
+  std::vector<TraversalStep> steps;  // one per gate processed
+  std::vector<uint8_t> references;   // varints: three per piece start, one per split
+  std::vector<uint32_t> order;       // order[decoded vertex] = the input vertex
+  std::vector<uint32_t> indices;     // the input's triangles in decoded order and numbering, each rotated
   // Per decoded vertex v, (o1, o2, o): v is predicted as c[o1] + c[o2] - c[o], every corner below v or V
   // (standing for cmin); a single predictor x is (x, x, x).
   std::vector<uint32_t> predictors;
@@ -100,7 +122,8 @@ struct TraversalCode {
 // most 31 of them; the input's triangles are their consecutive ranges in order), or empty / one for a single
 // cluster. Cost: O(T + V) (times the vertex valence for the look-ups); its scratch (about 50 bytes per corner
 // and 8 per vertex) is kept per thread between calls.
-TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
+// `finest`: the node is of level 0 (traversal_context).
+TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V, bool finest,
                                std::span<const uint32_t> cluster_triangles = {});
 
 // The second parallelogram of the multi-parallelogram prediction (predictive_node.hpp), which the decoder
@@ -123,7 +146,8 @@ struct Parallelograms {
 // with `where`. With `extra`, also the second parallelograms above (the predictors of single-predictor
 // vertices replaced as said). Cost: O(T + V), one pass over the symbols.
 void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t> references, uint32_t T,
-                      uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where,
-                      std::span<const uint32_t> cluster_triangles = {}, Parallelograms* extra = nullptr);
+                      uint32_t V, bool finest, uint32_t* indices, uint32_t* predictors,
+                      const std::string& where, std::span<const uint32_t> cluster_triangles = {},
+                      Parallelograms* extra = nullptr);
 
 }  // namespace lodstream::package

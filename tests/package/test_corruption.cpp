@@ -221,7 +221,7 @@ TEST_P(Corruption, HostileRootIndicesAreErrors) {
       {"page overlaps the header", [](RootIndex& r) { r.pages[0].offset = 10; }},
       {"page raw size over the limit", [](RootIndex& r) { r.pages[0].raw_size = kMaxPageRawBytes + 1; }},
       {"page raw size lies", [](RootIndex& r) { r.pages[0].raw_size -= 1; }},
-      {"page checksum", [](RootIndex& r) { r.pages[2].checksum ^= 4; }},
+      {"page checksum", [](RootIndex& r) { r.pages.back().checksum ^= 4; }},
       {"blob past the end", [&](RootIndex& r) { r.blobs[0].offset = end; }},
       {"node outside its page",
        [](RootIndex& r) { r.root_nodes[0].offset = r.pages[r.root_nodes[0].page].raw_size; }},

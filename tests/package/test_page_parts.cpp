@@ -1,5 +1,5 @@
 // Data pages stored by part (package/page_parts.hpp): they round-trip, are smaller than whole pages for the
-// byte-plane codecs, codec 3's connectivity decodes from its coded form, pages of non-codec bytes stay
+// byte-plane codecs, pages of non-codec bytes stay
 // whole, and hostile regrouped bytes are errors.
 #include <gtest/gtest.h>
 
@@ -11,7 +11,6 @@
 #include "package/meshopt_codec.hpp"
 #include "package/page_parts.hpp"
 #include "package/predictive_codec.hpp"
-#include "package/symbol_coder.hpp"
 #include "package/traversal_codec.hpp"
 #include "package_fixture.hpp"
 #include "support/expect_error.hpp"
@@ -53,7 +52,7 @@ std::vector<uint8_t> content(std::span<const uint8_t> stored) {
   return zstd_decompress_at_most(stored, UINT32_MAX, "test");
 }
 
-// Where the form byte of part p (1 positions, 2 normals, 5 connectivity) of regrouped bytes lies
+// Where the form byte of part p (1 positions, 2 normals) of regrouped bytes lies
 // (page_parts.hpp: seven size varints, then the seven streams).
 size_t form_at(std::span<const uint8_t> regrouped, size_t p) {
   ByteReader r(regrouped, "test");
@@ -91,31 +90,6 @@ TEST_P(PageParts, RoundTripByPartAndNoLargerThanWhole) {
     // cannot: its residuals stay planes.
     EXPECT_EQ(residual_forms(content(stored)), std::make_pair(uint8_t(0), uint8_t(0)));
   }
-}
-
-// The regrouped bytes of the sphere's page by codec 3 with its connectivity part in the coded form
-// (symbol_coder.hpp; the writer keeps it on scans, where it is smaller, and not on the sphere, whose rings
-// zstd's matches find), and where that part's form byte lies.
-std::pair<std::vector<uint8_t>, size_t> coded_connectivity(const Page& page) {
-  const NodeCodec& codec = node_codec(TraversalCodec::kId);
-  const std::vector<uint8_t> plain = content(compress_page(page.bytes, page.node_sizes, codec, 9, 6));
-  ByteReader r(plain, "test");
-  uint64_t size[7];
-  for (uint64_t& s : size) s = r.varint();
-  const size_t at = form_at(plain, 5);
-  EXPECT_EQ(plain[at], 0u);
-  const std::optional<std::vector<uint8_t>> symbols =
-      encode_symbols(std::span(plain).subspan(at + 1, size[5] - 1));
-  EXPECT_TRUE(symbols);
-  size[5] = 1 + symbols->size();
-  ByteWriter w;
-  for (uint64_t s : size) w.varint(s);
-  const size_t out_at = w.bytes.size() + (at - r.position());
-  w.raw(std::span(plain).subspan(r.position(), at - r.position()));
-  w.u8(1);
-  w.raw(*symbols);
-  w.raw(std::span(plain).subspan(form_at(plain, 6)));
-  return {std::move(w.bytes), out_at};
 }
 
 TEST(PageParts, NoisyResidualsAreStoredCodedAndSmaller) {
@@ -221,25 +195,6 @@ TEST(PageParts, HostileRegroupedBytesAreErrorsOrPagesOfTheRightSize) {
     for (int k = 0; k < 1 + i % 4; ++k) bad[rng() % bad.size()] = uint8_t(rng());
     try {
       EXPECT_EQ(unpack(bad).size(), raw_size);  // bytes the codec itself checks when it decodes the nodes
-    } catch (const Error&) {
-    }
-  }
-
-  // The connectivity part in the coded form: a form byte of neither form or the other one, and bytes of its
-  // tables and rANS stream changed (an error, or a page of the right size as above).
-  const auto [coded, at] = coded_connectivity(page);
-  EXPECT_EQ(unpack(coded), page.bytes);
-  bad = coded;
-  bad[at] = 2;
-  expect_error(bad, "connectivity part form");
-  bad[at] = 0;  // the coded symbols taken for the nodes' bytes
-  expect_error(bad, "connectivity form swapped");
-  const size_t coded_size = form_at(coded, 6) - at;
-  for (int i = 0; i < 400; ++i) {
-    bad = coded;
-    for (int k = 0; k < 1 + i % 4; ++k) bad[at + 1 + rng() % (coded_size - 1)] = uint8_t(rng());
-    try {
-      EXPECT_EQ(unpack(bad).size(), raw_size);
     } catch (const Error&) {
     }
   }
