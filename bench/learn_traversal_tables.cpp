@@ -2,12 +2,13 @@
 // prints src/package/traversal_tables.cpp. Usage: bench_learn_traversal_tables PACKAGE.lods... (the bakes of
 // horse and motorBike: never the meshes the package is measured on). Each codec-3 record of every package is
 // decoded and its triangles traversed again (encode_traversal on the decoded order, the traversal the
-// writer stores up to where a record's first triangle lies), counting each gate's class by context and
-// each tagged class's cluster rank. A context's frequencies: its counts plus kPrior pseudo-counts spread as
-// the same gate context without the previous class, plus half a count a class; normalized to 2^12 with at
-// least 1 a class (rans::normalize). On stderr, per package: its gates at level 0 and above, and the bits a
-// gate they take under the tables built in (their cost before and after a new learning). Cost: a decode
-// and an encode of every record.
+// writer stores up to where a record's first triangle lies), counting each gate's class by context in the
+// table set of its record's level (0: level 0, 1: above) and each tagged class's cluster rank. A context's
+// frequencies: its counts plus kPrior pseudo-counts spread as the same gate context without the previous
+// class, plus half a count a class; normalized to 2^12 with at least 1 a class (rans::normalize). On stderr,
+// per package: its gates at level 0 and above, and the bits a gate of their streams under the tables built in
+// (the encoder's choice of set: their cost before and after a new learning). Cost: a decode and an encode of
+// every record.
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -17,8 +18,6 @@
 #include <vector>
 
 #include "core/error.hpp"
-#include "package/bytes.hpp"
-#include "package/node_header.hpp"
 #include "package/rans.hpp"
 #include "package/reader.hpp"
 #include "package/traversal_connectivity.hpp"
@@ -57,7 +56,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: %s PACKAGE.lods...\n", argv[0]);
     return 2;
   }
-  std::vector<std::vector<double>> counts(kTraversalContexts, std::vector<double>(kTraversalClasses));
+  std::vector<std::vector<double>> counts(2 * kTraversalContexts, std::vector<double>(kTraversalClasses));
   std::vector<double> ranks(kClusterRanks);
   size_t records = 0, gates = 0;
   try {
@@ -73,22 +72,16 @@ int main(int argc, char** argv) {
         if (!pages.count(n.page)) pages[n.page] = reader.read_page(n.page);
         const std::span<const uint8_t> bytes = reader.node_bytes(id, pages[n.page]);
         if (bytes.empty() || bytes[0] != kTraversalFormat) continue;  // codec 2's bytes: no traversal
-        ByteReader r(bytes, "record");
-        const NodeHeader header = NodeHeader::read(r, kTraversalFormat, 0xff, bytes.size());
         const Representation& rep = reader.scene().representations[n.representation];
         const DecodedNode decoded = reader.codec().decode(bytes, rep.grid, "record");
-        const TraversalCode code =
-            encode_traversal(decoded.mesh.indices, uint32_t(decoded.mesh.positions.size()), header.shift == 0,
-                             decoded.cluster_triangles);
+        const TraversalCode code = encode_traversal(
+            decoded.mesh.indices, uint32_t(decoded.mesh.positions.size()), decoded.cluster_triangles);
+        const uint32_t set = n.level > 0;
         for (const TraversalStep& s : code.steps) {
-          ++counts[s.context][s.symbol_class];
-          const uint16_t* row = kTraversalClassStarts[s.context];
-          double p = double(row[s.symbol_class + 1] - row[s.symbol_class]) / 4096;
-          if (s.symbol_class >= kTraversalClasses / 2)
-            ++ranks[s.rank], p *= double(kClusterRankFrequencies[s.rank]) / 4096;
-          bits[header.shift != 0] -= std::log2(p);
+          ++counts[kTraversalContexts * set + s.context][s.symbol_class];
+          if (s.symbol_class >= kTraversalClasses / 2) ++ranks[s.rank];
         }
-        level_gates[header.shift != 0] += code.steps.size();
+        bits[set] += 8 * double(code.symbols.size()), level_gates[set] += code.steps.size();
         ++records, gates += code.steps.size();
       }
       std::fprintf(stderr, "%s: level 0 %zu gates %.3f bits a gate, above %zu gates %.3f\n",
@@ -105,13 +98,13 @@ int main(int argc, char** argv) {
     std::printf("%s%s", i > 1 ? ", " : "", std::filesystem::path(argv[i]).filename().c_str());
   std::printf(
       "): do not edit.\n#include \"package/traversal_tables.hpp\"\n\nnamespace lodstream::package {\n\n");
-  std::printf("alignas(64) const uint16_t kTraversalClassStarts[kTraversalContexts][16] = {\n");
-  for (uint32_t c = 0; c < kTraversalContexts; ++c) {
-    // The same gate context (level, t_a, t_b) over every previous class.
+  std::printf("alignas(64) const uint16_t kTraversalClassStarts[2 * kTraversalContexts][16] = {\n");
+  for (uint32_t c = 0; c < 2 * kTraversalContexts; ++c) {
+    // The same gate context (set, t_a, t_b) over every previous class.
     std::vector<double> prior(kTraversalClasses);
     for (uint32_t previous = 0; previous < kTraversalClasses; ++previous)
       for (uint32_t s = 0; s < kTraversalClasses; ++s)
-        prior[s] += counts[c / (12 * 64) * 12 * 64 + previous * 64 + c % 64][s];
+        prior[s] += counts[c - c % kTraversalContexts + previous * 64 + c % 64][s];
     const std::vector<uint32_t> f = frequencies(counts[c], prior, kPrior);
     std::printf("    {0");
     for (uint32_t s = 0, at = 0; s < kTraversalClasses; ++s) std::printf(", %u", at += f[s]);

@@ -255,31 +255,33 @@ bool sort_by_cluster(const uint32_t* from, uint32_t* to, std::span<const uint8_t
 
 }  // namespace
 
-uint32_t traversal_context(bool finest, uint32_t previous, uint32_t triangles_at_a, uint32_t triangles_at_b) {
-  return (finest ? 0 : 12 * 64) + 64 * previous +
+uint32_t traversal_context(uint32_t previous, uint32_t triangles_at_a, uint32_t triangles_at_b) {
+  return 64 * previous +
          (kGateOffsets.first[uint8_t(triangles_at_a)] + kGateOffsets.second[uint8_t(triangles_at_b)]) / 16;
 }
 
-std::vector<uint8_t> encode_traversal_steps(std::span<const TraversalStep> steps) {
+std::vector<uint8_t> encode_traversal_steps(std::span<const TraversalStep> steps, uint32_t set) {
   if (steps.empty()) return {};
   const RankTable& ranks = rank_table();
+  const uint16_t(*const rows)[16] = kTraversalClassStarts + kTraversalContexts * set;
   std::vector<uint8_t> reversed;
   uint32_t x = rans::kLow;
   for (size_t i = steps.size(); i-- > 0;) {  // the decoder's order reversed: a tagged class's rank first
     const TraversalStep& s = steps[i];
     if (s.symbol_class >= kKinds)
       rans::encode(x, ranks.start[s.rank], kClusterRankFrequencies[s.rank], kTraversalScaleBits, reversed);
-    const uint16_t* row = kTraversalClassStarts[s.context];
+    const uint16_t* row = rows[s.context];
     rans::encode(x, row[s.symbol_class], row[s.symbol_class + 1] - row[s.symbol_class], kTraversalScaleBits,
                  reversed);
   }
+  rans::encode(x, kScale / 2 * set, kScale / 2, kTraversalScaleBits, reversed);  // the set, first
   ByteWriter w;
   w.u32(x);
   w.bytes.insert(w.bytes.end(), reversed.rbegin(), reversed.rend());
   return std::move(w.bytes);
 }
 
-TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V, bool finest,
+TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
                                std::span<const uint32_t> cluster_triangles) {
   const uint32_t T = uint32_t(indices.size() / 3);
   const bool clustered = cluster_triangles.size() > 1;
@@ -369,7 +371,7 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V, bo
       continue;
     }
     const Front::Edge g = front.edge(e);
-    const uint32_t context = traversal_context(finest, previous, triangles_at[g.a], triangles_at[g.b]);
+    const uint32_t context = traversal_context(previous, triangles_at[g.a], triangles_at[g.b]);
     // The gate's step: class `kind` (+ 6 with the rank of cluster k's code when k is not the gate's).
     auto step = [&](TraversalSymbol kind, uint32_t k) {
       uint8_t symbol_class = kind, rank = 0;
@@ -429,7 +431,10 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V, bo
   if (clustered)
     sort_by_cluster(traversal_order.data(), code.indices.data(), std::span(emitted_cluster.data(), T),
                     cluster_triangles);
-  code.symbols = encode_traversal_steps(code.steps);
+  // The smaller stream of the two table sets (traversal_tables.hpp).
+  code.symbols = encode_traversal_steps(code.steps, 0);
+  std::vector<uint8_t> other = encode_traversal_steps(code.steps, 1);
+  if (other.size() < code.symbols.size()) code.symbols = std::move(other);
   return code;
 }
 
@@ -439,9 +444,8 @@ namespace {
 // without them).
 template <bool multi>
 void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> references, uint32_t T,
-                    uint32_t V, bool finest, uint32_t* indices, uint32_t* predictors,
-                    const std::string& where, std::span<const uint32_t> cluster_triangles,
-                    Parallelograms* extra) {
+                    uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where,
+                    std::span<const uint32_t> cluster_triangles, Parallelograms* extra) {
   ByteReader refs(references, where);
   auto fail = [&](const char* what) { throw Error(where + ": corrupted connectivity (" + what + ")"); };
   thread_local std::vector<Front::Edge> edges;
@@ -462,8 +466,17 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
   const uint8_t* const bytes = stream.data();
   const RankTable& ranks = rank_table();
   RecentClusterCodes recent = kFirstClusterCodes;
-  // The rows of the node's level, and the offset of the previous class's (times 16 u16 a row).
-  const uint16_t* const level_rows = kTraversalClassStarts[finest ? 0 : 12 * 64];
+  // The rows of the stream's table set (its first step, at 1/2 each: the slot's top bit), and the offset of
+  // the previous class's (times 16 u16 a row).
+  const uint16_t* set_rows = kTraversalClassStarts[0];
+  if (read <= end) {
+    const uint32_t slot = x & (kScale - 1), set = slot >> (kTraversalScaleBits - 1);
+    x = kScale / 2 * (x >> kTraversalScaleBits) + slot - kScale / 2 * set;
+    uint16_t next;
+    std::memcpy(&next, bytes + read, 2);
+    rans::renormalize(x, read, next);
+    set_rows = kTraversalClassStarts[kTraversalContexts * set];
+  }
   uint32_t previous = 0;
   // Clusters of a record: each triangle goes straight to the next free place in its cluster's range of
   // `indices` (the ranges are consecutive, in cluster order, sized by `cluster_triangles`), so the triangles
@@ -543,7 +556,7 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     const Front::Edge& g = front.edge(e);
     const uint32_t a = g.a, b = g.b;
     const uint32_t symbol_class = decode_class(
-        x, level_rows + previous + kGateOffsets.first[count[a]] + kGateOffsets.second[count[b]], bytes, read);
+        x, set_rows + previous + kGateOffsets.first[count[a]] + kGateOffsets.second[count[b]], bytes, read);
     previous = 16 * 64 * symbol_class;
     uint32_t kind = symbol_class;
     // Untagged: the gate's cluster (below C, checked when its triangle was decoded), else the code's - 1.
@@ -621,15 +634,12 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
 }  // namespace
 
 void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t> references, uint32_t T,
-                      uint32_t V, bool finest, uint32_t* indices, uint32_t* predictors,
-                      const std::string& where, std::span<const uint32_t> cluster_triangles,
-                      Parallelograms* extra) {
+                      uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where,
+                      std::span<const uint32_t> cluster_triangles, Parallelograms* extra) {
   if (extra)
-    decode_symbols<true>(symbols, references, T, V, finest, indices, predictors, where, cluster_triangles,
-                         extra);
+    decode_symbols<true>(symbols, references, T, V, indices, predictors, where, cluster_triangles, extra);
   else
-    decode_symbols<false>(symbols, references, T, V, finest, indices, predictors, where, cluster_triangles,
-                          nullptr);
+    decode_symbols<false>(symbols, references, T, V, indices, predictors, where, cluster_triangles, nullptr);
 }
 
 }  // namespace lodstream::package

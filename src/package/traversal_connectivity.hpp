@@ -62,13 +62,14 @@
 //
 // Symbols decoded in the traversal (format 13): a record's symbols are one rANS stream (rans.hpp) under
 // fixed tables (traversal_tables.hpp: no tables stored, none built per page), each gate's class (kind, and
-// whether its triangle is tagged) coded under the context (level 0 or above, previous class, min(t_a, 7),
-// min(t_b, 7)) and a tagged class followed by its cluster code's move-to-front rank (format 8's scheme):
-// the decoder picks the context's row of cumulative frequencies, finds the class by comparing the slot with
-// all 16 at once and takes one rANS step, no division and no page pass. Measured offline first (tables learnt
-// on horse and motorBike, cross-entropy at 2^12, format 11's traversals): refined_elephant 0.871 -> 0.784
-// bits a symbol at level 0 and 2.104 -> 1.799 above (format 12: ranks under the previous rank, per page);
-// bunny 1.308 -> 1.142 and 2.183 -> 1.877. Figures of the packages: traversal_tables.hpp.
+// whether its triangle is tagged) coded under the context (previous class, min(t_a, 7), min(t_b, 7)) in
+// the table set the stream names (learnt on level 0 or above) and a tagged class followed by its cluster
+// code's move-to-front rank (format 8's scheme): the decoder picks the context's row of cumulative
+// frequencies, finds the class by comparing the slot with all 16 at once and takes one rANS step, no division
+// and no page pass. Measured offline first (tables learnt on horse and motorBike, cross-entropy at 2^12,
+// format 11's traversals): refined_elephant 0.871 -> 0.784 bits a symbol at level 0 and 2.104 -> 1.799 above
+// (format 12: ranks under the previous rank, per page); bunny 1.308 -> 1.142 and 2.183 -> 1.877. Figures of
+// the packages: traversal_tables.hpp.
 //
 // On a manifold patch about half the symbols are kVertex and most others kLeft / kRight / kBoundary (border
 // edges). Levels >= 1 cost about twice level 0's bits per triangle (elephant_1m, format 6: 0.44-0.50 against
@@ -96,14 +97,13 @@ struct TraversalStep {
   uint8_t symbol_class, rank;
 };
 
-// The context of a gate of a node of level 0 (`finest`: position_shift 0) or above, after a gate of class
-// `previous` (0 for the first), whose vertices lie in the given numbers of decoded triangles (counted modulo
-// 2^8, as the codec counts them). Cost: O(1).
-uint32_t traversal_context(bool finest, uint32_t previous, uint32_t triangles_at_a, uint32_t triangles_at_b);
+// The context of a gate after a gate of class `previous` (0 for the first), whose vertices lie in the given
+// numbers of decoded triangles (counted modulo 2^8, as the codec counts them). Cost: O(1).
+uint32_t traversal_context(uint32_t previous, uint32_t triangles_at_a, uint32_t triangles_at_b);
 
-// The rANS stream of `steps` (empty for none): u32 LE final state, then u16 LE reads. Cost: O(steps), a
-// division a step.
-std::vector<uint8_t> encode_traversal_steps(std::span<const TraversalStep> steps);
+// The rANS stream of `steps` under table set `set` (0 or 1, traversal_tables.hpp), empty for no steps: u32
+// LE final state, then u16 LE reads; its first step names the set. Cost: O(steps), a division a step.
+std::vector<uint8_t> encode_traversal_steps(std::span<const TraversalStep> steps, uint32_t set);
 
 struct TraversalCode {
   std::vector<uint8_t> symbols;      // the steps' rANS stream (encode_traversal_steps)
@@ -122,8 +122,8 @@ struct TraversalCode {
 // most 31 of them; the input's triangles are their consecutive ranges in order), or empty / one for a single
 // cluster. Cost: O(T + V) (times the vertex valence for the look-ups); its scratch (about 50 bytes per corner
 // and 8 per vertex) is kept per thread between calls.
-// `finest`: the node is of level 0 (traversal_context).
-TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V, bool finest,
+// The symbols' stream is the smaller of the two table sets'.
+TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
                                std::span<const uint32_t> cluster_triangles = {});
 
 // The second parallelogram of the multi-parallelogram prediction (predictive_node.hpp), which the decoder
@@ -146,8 +146,7 @@ struct Parallelograms {
 // with `where`. With `extra`, also the second parallelograms above (the predictors of single-predictor
 // vertices replaced as said). Cost: O(T + V), one pass over the symbols.
 void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t> references, uint32_t T,
-                      uint32_t V, bool finest, uint32_t* indices, uint32_t* predictors,
-                      const std::string& where, std::span<const uint32_t> cluster_triangles = {},
-                      Parallelograms* extra = nullptr);
+                      uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where,
+                      std::span<const uint32_t> cluster_triangles = {}, Parallelograms* extra = nullptr);
 
 }  // namespace lodstream::package

@@ -3,14 +3,16 @@
 // a gate under the table its context picks.
 //
 // A gate's class s = kind + 6 [tagged] (12 classes; tagged: the triangle's cluster is not the gate's) is
-// coded under context (level, previous class, t_a, t_b): level 0 for a node of position_shift 0, else 1;
-// the previous gate's class (0 before the first); min(t, 7) for the triangles decoded at the gate's two
-// vertices. A tagged class is followed by the move-to-front rank of its cluster code (symbol_coder's scheme
-// of format 8) under one order-0 table.
+// coded under context (previous class, t_a, t_b): the previous gate's class (0 before the first); min(t, 7)
+// for the triangles decoded at the gate's two vertices; in one of two table sets, learnt on the records of
+// level 0 and on those above, which the record's stream names first (a step at 1/2: the encoder keeps the
+// smaller stream; the decoder knows no level, and a node's position_shift 0 is no level 0: it covers most
+// of refined_elephant's level 1 and 2 records too). A tagged class is followed by the move-to-front rank of
+// its cluster code (symbol_coder's scheme of format 8) under one order-0 table.
 //
 // Learnt by bench/learn_traversal_tables.cpp (which prints traversal_tables.cpp) on the bakes of horse and
 // motorBike only, never on the meshes the package is measured on (refined_elephant, bunny, elephant_*):
-// each context's class counts plus 4 pseudo-counts spread as the context (level, t_a, t_b) without the
+// each context's class counts plus 4 pseudo-counts spread as the context (set, t_a, t_b) without the
 // previous class, plus half a count a class, normalized to 2^12 with at least 1 for every class (every
 // class stays codable in every context).
 #pragma once
@@ -20,13 +22,14 @@
 namespace lodstream::package {
 
 inline constexpr uint32_t kTraversalScaleBits = 12;
-inline constexpr uint32_t kTraversalClasses = 12, kTraversalContexts = 2 * 12 * 64;
+inline constexpr uint32_t kTraversalClasses = 12, kTraversalContexts = 12 * 64;
 inline constexpr uint32_t kClusterRanks = 31;
 
-// Per context ((level 12 + previous class) 64 + 8 min(t_a, 7) + min(t_b, 7)): the classes' cumulative
-// frequencies, starts[0] = 0, starts[12..15] = 2^12 (the decoder compares all 16 at once); class s has
-// frequency starts[s + 1] - starts[s] >= 1.
-extern const uint16_t kTraversalClassStarts[kTraversalContexts][16];
+// Per table set (0: learnt on level 0, 1: above) and context (previous class 64 + 8 min(t_a, 7) +
+// min(t_b, 7)), row kTraversalContexts set + context: the classes' cumulative frequencies, starts[0] = 0,
+// starts[12..15] = 2^12 (the decoder compares all 16 at once); class s has frequency starts[s + 1] -
+// starts[s] >= 1.
+extern const uint16_t kTraversalClassStarts[2 * kTraversalContexts][16];
 // The cluster codes' move-to-front ranks' frequencies (add up to 2^12, each >= 1).
 extern const uint16_t kClusterRankFrequencies[kClusterRanks];
 

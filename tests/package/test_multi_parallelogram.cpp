@@ -32,10 +32,10 @@ uint32_t flags_of(std::span<const uint8_t> node) {
 TEST(MultiParallelogram, TheTraversalJoinsTrianglesAcrossTheirSharedEdges) {
   const Mesh s = sphere(1.0f, 8, 16);
   const uint32_t V = uint32_t(s.vertex_count()), T = uint32_t(s.triangle_count());
-  const TraversalCode code = encode_traversal(s.indices, V, true);
+  const TraversalCode code = encode_traversal(s.indices, V);
   std::vector<uint32_t> indices(3 * size_t(T)), predictors(3 * size_t(V));
   Parallelograms extra;
-  decode_traversal(code.symbols, code.references, T, V, true, indices.data(), predictors.data(), "node", {},
+  decode_traversal(code.symbols, code.references, T, V, indices.data(), predictors.data(), "node", {},
                    &extra);
   EXPECT_EQ(indices, code.indices);  // the same triangles with or without the parallelograms
   // Directed edge -> the third corner of its triangle.
@@ -59,7 +59,7 @@ TEST(MultiParallelogram, TheTraversalJoinsTrianglesAcrossTheirSharedEdges) {
   EXPECT_GT(seconds, size_t(V) / 2);
   // Without the parallelograms, the encoder's predictors.
   std::vector<uint32_t> plain(3 * size_t(V));
-  decode_traversal(code.symbols, code.references, T, V, true, indices.data(), plain.data(), "node");
+  decode_traversal(code.symbols, code.references, T, V, indices.data(), plain.data(), "node");
   EXPECT_EQ(plain, code.predictors);
 }
 

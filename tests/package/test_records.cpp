@@ -177,10 +177,10 @@ TEST(Records, TheDecoderPlacesEachClusterInItsRangeAndRefusesOtherCounts) {
   const Record r = sphere_record(0);
   const RecordMesh& w = r.welded;
   const uint32_t T = uint32_t(w.mesh.triangle_count()), V = uint32_t(w.mesh.vertex_count());
-  const TraversalCode code = encode_traversal(w.mesh.indices, V, false, w.cluster_triangles);
+  const TraversalCode code = encode_traversal(w.mesh.indices, V, w.cluster_triangles);
   auto decode = [&](std::span<const uint32_t> counts) {
     std::vector<uint32_t> indices(3 * size_t(T) + 3, UINT32_MAX), predictors(3 * (size_t(V) + 1));
-    decode_traversal(code.symbols, code.references, T, V, false, indices.data(), predictors.data(), "node 5",
+    decode_traversal(code.symbols, code.references, T, V, indices.data(), predictors.data(), "node 5",
                      counts);
     EXPECT_EQ(indices.back(), UINT32_MAX) << "written past the triangles";
     indices.resize(3 * size_t(T));

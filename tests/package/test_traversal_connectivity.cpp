@@ -31,18 +31,18 @@ std::vector<uint32_t> holed_grid(int n, uint32_t seed) {
 
 TEST(TraversalConnectivity, EverySymbolKindDecodesToTheEncodersTriangles) {
   std::set<uint32_t> kinds;
-  auto round_trip = [&](const std::vector<uint32_t>& indices, uint32_t V, bool finest) {
+  auto round_trip = [&](const std::vector<uint32_t>& indices, uint32_t V) {
     const uint32_t T = uint32_t(indices.size() / 3);
-    const TraversalCode code = encode_traversal(indices, V, finest);
+    const TraversalCode code = encode_traversal(indices, V);
     for (const TraversalStep& s : code.steps) kinds.insert(s.symbol_class % 6);
     std::vector<uint32_t> decoded(3 * size_t(T)), predictors(3 * size_t(V));
-    decode_traversal(code.symbols, code.references, T, V, finest, decoded.data(), predictors.data(), "node");
+    decode_traversal(code.symbols, code.references, T, V, decoded.data(), predictors.data(), "node");
     EXPECT_EQ(decoded, code.indices);
     EXPECT_EQ(predictors, code.predictors);
   };
   const Mesh s = sphere(1.0f, 8, 16);
-  round_trip(s.indices, uint32_t(s.vertex_count()), true);
-  for (uint32_t seed = 0; seed < 8; ++seed) round_trip(holed_grid(12, seed), 13 * 13, seed % 2 == 0);
+  round_trip(s.indices, uint32_t(s.vertex_count()));
+  for (uint32_t seed = 0; seed < 8; ++seed) round_trip(holed_grid(12, seed), 13 * 13);
   EXPECT_EQ(kinds, (std::set<uint32_t>{kVertex, kLeft, kRight, kBoundary, kSplit, kEnd}));
 }
 
@@ -51,9 +51,27 @@ TEST(TraversalConnectivity, EverySymbolKindDecodesToTheEncodersTriangles) {
 // classes alike would take 3.6; sphere(16, 32) 0.68, its poles' fans of 32 included).
 TEST(TraversalConnectivity, RegularMeshesTakeUnderABitAGate) {
   for (const Mesh& m : {sphere(1.0f, 16, 32), grid(24)}) {
-    const TraversalCode code = encode_traversal(m.indices, uint32_t(m.vertex_count()), true);
+    const TraversalCode code = encode_traversal(m.indices, uint32_t(m.vertex_count()));
     const double bits = 8.0 * double(code.symbols.size()) / double(code.steps.size());
     EXPECT_LT(bits, 1.0) << code.symbols.size() << " B for " << code.steps.size() << " gates";
+  }
+}
+
+// Either table set decodes (the stream names its own), and the encoder keeps the smaller stream.
+TEST(TraversalConnectivity, EitherTableSetDecodesAndTheSmallerIsKept) {
+  for (uint32_t seed = 0; seed < 4; ++seed) {
+    const std::vector<uint32_t> indices = holed_grid(12, seed);
+    const uint32_t T = uint32_t(indices.size() / 3), V = 13 * 13;
+    const TraversalCode code = encode_traversal(indices, V);
+    size_t smaller = SIZE_MAX;
+    for (uint32_t set : {0u, 1u}) {
+      const std::vector<uint8_t> stream = encode_traversal_steps(code.steps, set);
+      smaller = std::min(smaller, stream.size());
+      std::vector<uint32_t> decoded(3 * size_t(T)), predictors(3 * size_t(V));
+      decode_traversal(stream, code.references, T, V, decoded.data(), predictors.data(), "node");
+      EXPECT_EQ(decoded, code.indices) << "set " << set;
+    }
+    EXPECT_EQ(code.symbols.size(), smaller);
   }
 }
 
@@ -62,7 +80,7 @@ TEST(TraversalConnectivity, RegularMeshesTakeUnderABitAGate) {
 TEST(TraversalConnectivity, HostileSymbolStreamsAreErrors) {
   const std::vector<uint32_t> indices = holed_grid(12, 3);
   const uint32_t T = uint32_t(indices.size() / 3), V = 13 * 13;
-  const TraversalCode code = encode_traversal(indices, V, false);
+  const TraversalCode code = encode_traversal(indices, V);
   std::mt19937 rng(5);
   size_t refused = 0;
   for (int i = 0; i < 600; ++i) {
@@ -72,7 +90,7 @@ TEST(TraversalConnectivity, HostileSymbolStreamsAreErrors) {
     for (int k = 0; k < 1 + i % 4; ++k) bad[rng() % bad.size()] = uint8_t(rng());
     std::vector<uint32_t> decoded(3 * size_t(T)), predictors(3 * size_t(V));
     try {
-      decode_traversal(bad, code.references, T, V, false, decoded.data(), predictors.data(), "node");
+      decode_traversal(bad, code.references, T, V, decoded.data(), predictors.data(), "node");
       for (uint32_t v : decoded) EXPECT_LT(v, V);
     } catch (const Error&) {
       ++refused;
@@ -88,7 +106,7 @@ TEST(TraversalConnectivity, EachCorruptionIsRefusedForItsReason) {
                    std::vector<uint32_t> clusters = {}) -> std::string {
     std::vector<uint32_t> indices(3 * size_t(T)), predictors(3 * size_t(V));
     try {
-      decode_traversal(symbols, refs, T, V, true, indices.data(), predictors.data(), "node 3", clusters);
+      decode_traversal(symbols, refs, T, V, indices.data(), predictors.data(), "node 3", clusters);
     } catch (const Error& e) {
       return e.what();
     }
@@ -111,10 +129,10 @@ TEST(TraversalConnectivity, EachCorruptionIsRefusedForItsReason) {
     uint32_t previous = 0;
     for (const Gate& g : gates) {
       const uint8_t symbol_class = uint8_t(g.kind + (g.tagged ? 6 : 0));
-      steps.push_back({uint16_t(traversal_context(true, previous, g.a, g.b)), symbol_class, g.rank});
+      steps.push_back({uint16_t(traversal_context(previous, g.a, g.b)), symbol_class, g.rank});
       previous = symbol_class;
     }
-    return encode_traversal_steps(steps);
+    return encode_traversal_steps(steps, 0);
   };
   EXPECT_EQ(reason({}, 1, 3), "decoded");
   EXPECT_EQ(reason(stream({{kVertex}}), 2, 4), "decoded");
