@@ -264,19 +264,20 @@ std::vector<uint8_t> encode_traversal_steps(std::span<const TraversalStep> steps
   if (steps.empty()) return {};
   const RankTable& ranks = rank_table();
   const uint16_t(*const rows)[16] = kTraversalClassStarts + kTraversalContexts * set;
-  std::vector<uint8_t> reversed;
-  uint32_t x = rans::kLow;
-  for (size_t i = steps.size(); i-- > 0;) {  // the decoder's order reversed: a tagged class's rank first
-    const TraversalStep& s = steps[i];
-    if (s.symbol_class >= kKinds)
-      rans::encode(x, ranks.start[s.rank], kClusterRankFrequencies[s.rank], kTraversalScaleBits, reversed);
+  // The coding steps in the decoder's order (start and frequency): the set, then each gate's class and a
+  // tagged class's rank; then rANS last step first, step i on state i mod 2.
+  std::vector<std::array<uint32_t, 2>> coded = {{kScale / 2 * set, kScale / 2}};
+  for (const TraversalStep& s : steps) {
     const uint16_t* row = rows[s.context];
-    rans::encode(x, row[s.symbol_class], row[s.symbol_class + 1] - row[s.symbol_class], kTraversalScaleBits,
-                 reversed);
+    coded.push_back({row[s.symbol_class], uint32_t(row[s.symbol_class + 1] - row[s.symbol_class])});
+    if (s.symbol_class >= kKinds) coded.push_back({ranks.start[s.rank], kClusterRankFrequencies[s.rank]});
   }
-  rans::encode(x, kScale / 2 * set, kScale / 2, kTraversalScaleBits, reversed);  // the set, first
+  std::vector<uint8_t> reversed;
+  uint32_t x[2] = {rans::kLow, rans::kLow};
+  for (size_t i = coded.size(); i-- > 0;)
+    rans::encode(x[i % 2], coded[i][0], coded[i][1], kTraversalScaleBits, reversed);
   ByteWriter w;
-  w.u32(x);
+  w.u32(x[0]), w.u32(x[1]);
   w.bytes.insert(w.bytes.end(), reversed.rbegin(), reversed.rend());
   return std::move(w.bytes);
 }
@@ -453,15 +454,18 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
   uint32_t next = 0;  // the next new vertex
   // The symbols' rANS stream (encode_traversal_steps), copied with 8 bytes of padding: a gate reads at most 4
   // bytes and starts only at or before the stream's end. An empty stream holds no gate (at past its end).
+  // Two states, each step on the one the step before did not take (x, then the two swap names): a gate's
+  // state is not the previous gate's, whose decode only picks its context's row, so that the steps of
+  // consecutive gates overlap in the CPU.
   thread_local std::vector<uint8_t> stream;
-  uint32_t x = 0;
+  uint32_t x = 0, y = 0;
   size_t read = 1, end = 0;  // the next rANS read, and the stream's end
   if (!symbols.empty()) {
-    if (symbols.size() < 4) fail("symbol stream shorter than its state");
+    if (symbols.size() < 8) fail("symbol stream shorter than its states");
     rans::copy_padded(symbols, stream);
-    std::memcpy(&x, stream.data(), 4);
-    if (x < rans::kLow) fail("invalid symbol state");
-    read = 4, end = symbols.size();
+    std::memcpy(&x, stream.data(), 4), std::memcpy(&y, stream.data() + 4, 4);
+    if (x < rans::kLow || y < rans::kLow) fail("invalid symbol state");
+    read = 8, end = symbols.size();
   }
   const uint8_t* const bytes = stream.data();
   const RankTable& ranks = rank_table();
@@ -475,6 +479,7 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     uint16_t next;
     std::memcpy(&next, bytes + read, 2);
     rans::renormalize(x, read, next);
+    std::swap(x, y);
     set_rows = kTraversalClassStarts[kTraversalContexts * set];
   }
   uint32_t previous = 0;
@@ -557,6 +562,7 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     const uint32_t a = g.a, b = g.b;
     const uint32_t symbol_class = decode_class(
         x, set_rows + previous + kGateOffsets.first[count[a]] + kGateOffsets.second[count[b]], bytes, read);
+    std::swap(x, y);
     previous = 16 * 64 * symbol_class;
     uint32_t kind = symbol_class;
     // Untagged: the gate's cluster (below C, checked when its triangle was decoded), else the code's - 1.
@@ -564,6 +570,7 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     if (symbol_class >= kKinds) [[unlikely]] {
       kind -= kKinds;
       k = to_front(recent, decode_rank(x, ranks, bytes, read)) - 1;
+      std::swap(x, y);
       if (k >= C) fail("cluster out of range");
     }
     uint32_t c;
@@ -622,7 +629,7 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
   if (!symbols.empty()) {
     // Past the end: the last gates decoded from the padding (a stream of fewer symbols than gates).
     if (read > end) fail("symbols end early");
-    if (read != end || x != rans::kLow) fail("symbols left over");
+    if (read != end || x != rans::kLow || y != rans::kLow) fail("symbols left over");
   }
   if (!refs.at_end()) fail("references left over");
   for (; next < V; ++next) {

@@ -101,8 +101,9 @@ struct TraversalStep {
 // numbers of decoded triangles (counted modulo 2^8, as the codec counts them). Cost: O(1).
 uint32_t traversal_context(uint32_t previous, uint32_t triangles_at_a, uint32_t triangles_at_b);
 
-// The rANS stream of `steps` under table set `set` (0 or 1, traversal_tables.hpp), empty for no steps: u32
-// LE final state, then u16 LE reads; its first step names the set. Cost: O(steps), a division a step.
+// The rANS stream of `steps` under table set `set` (0 or 1, traversal_tables.hpp), empty for no steps: two
+// interleaved states (step i on state i mod 2), u32 LE each, then u16 LE reads; its first step names the
+// set, then each gate's class and a tagged class's rank. Cost: O(steps), a division a step.
 std::vector<uint8_t> encode_traversal_steps(std::span<const TraversalStep> steps, uint32_t set);
 
 struct TraversalCode {

@@ -140,8 +140,8 @@ TEST(TraversalConnectivity, EachCorruptionIsRefusedForItsReason) {
   EXPECT_EQ(reason(stream({{kBoundary}}), 2, 4), corrupted("symbols end early"));
   EXPECT_EQ(reason(stream({{kVertex}}), 1, 4), corrupted("symbols left over"));
   // The rANS stream itself: too short for its state, a state below kLow, bytes left over or missing.
-  EXPECT_EQ(reason({1, 2, 3}, 2, 4), corrupted("symbol stream shorter than its state"));
-  EXPECT_EQ(reason({0, 0, 0, 0}, 2, 4), corrupted("invalid symbol state"));
+  EXPECT_EQ(reason({1, 2, 3, 4, 5, 6, 7}, 2, 4), corrupted("symbol stream shorter than its states"));
+  EXPECT_EQ(reason({0, 0, 1, 0, 0, 0, 0, 0}, 2, 4), corrupted("invalid symbol state"));
   std::vector<uint8_t> longer = stream({{kVertex}});
   longer.insert(longer.end(), {7, 7});
   EXPECT_EQ(reason(longer, 2, 4), corrupted("symbols left over"));
