@@ -25,9 +25,10 @@
 // each predicted from the vertex before it.
 //
 // Records of several clusters (NodeGeometry::cluster_triangles; C clusters, C <= 31): the traversal runs
-// over the whole record as over one mesh, and each triangle's cluster is tagged: bits 3-7 of its symbol are 0
-// when it is the cluster of the gate's triangle, else 1 + its cluster; a piece start's references begin with
-// a varint cluster. The encoder moves the triangles into the clusters' ranges after the traversal, in
+// over the whole record as over one mesh, and each triangle's cluster is tagged: untagged when it is the
+// cluster of the gate's triangle, else tagged with code 1 + its cluster (format 12: bits 3-7 of the symbol
+// byte; format 13: a tagged class, then the code's move-to-front rank); a piece start's references begin
+// with a varint cluster. The encoder moves the triangles into the clusters' ranges after the traversal, in
 // traversal order within each (a counting sort); the decoder puts each triangle straight into its cluster's
 // range (known from the counts), so a decoded record's cluster c is a consecutive range.
 // Measured on elephant_1m (bake, codec 3, records of mixed precision): 5,382,094 B, level-0 connectivity
@@ -37,10 +38,9 @@
 // runs zstd finds.
 //
 // Ranked symbols (format 12; format 13 codes the kind itself under the same gate context, below): bits 0-2
-// of a symbol byte held not the kind but its rank in the gate's
-// context, the kinds ordered by their frequency after gates a -> b where a lies in min(t_a, 7) and b in
-// min(t_b, 7) decoded triangles (t counted as the triangles arrive, by encoder and decoder alike; a fixed
-// table of 64 orders, traversal_connectivity.cpp). A vertex that already holds most of a fan's triangles is
+// of a symbol byte held not the kind but its rank in the gate's context, the kinds ordered by their
+// frequency after gates a -> b where a lies in min(t_a, 7) and b in min(t_b, 7) decoded triangles (t
+// counted as the triangles arrive, by encoder and decoder alike; a fixed table of 64 orders). A vertex that already holds most of a fan's triangles is
 // about to close it (the valence insight of Touma & Gotsman 1998 and Alliez & Desbrun 2001, "Valence-driven
 // connectivity encoding for 3D meshes"): at level 0 of refined_elephant a gate (2, 5) turns right 98 % of
 // the time, a gate (4, 3) takes a new vertex 97 %, a gate (5, 1) turns left 86 %, a gate (6, 6) is a
@@ -68,8 +68,14 @@
 // frequencies, finds the class by comparing the slot with all 16 at once and takes one rANS step, no division
 // and no page pass. Measured offline first (tables learnt on horse and motorBike, cross-entropy at 2^12,
 // format 11's traversals): refined_elephant 0.871 -> 0.784 bits a symbol at level 0 and 2.104 -> 1.799 above
-// (format 12: ranks under the previous rank, per page); bunny 1.308 -> 1.142 and 2.183 -> 1.877. Figures of
-// the packages: traversal_tables.hpp.
+// (format 12: ranks under the previous rank, per page); bunny 1.308 -> 1.142 and 2.183 -> 1.877 (tag ranks
+// not counted). Figures of the packages: traversal_tables.hpp. Decode (`bench decode --runs 1` under
+// callgrind, decode_node + read_page): refined_elephant 63.47 -> 64.55 M instructions (+1.7 %), elephant_1m
+// 968.5 -> 1,005.6 M (+3.8 %): the page pass is gone (SymbolDecoder 5.2 M and 83.8 M) but decode_traversal
+// takes ~45 instructions a gate where it took ~18 with the symbol bytes decoded (19.7 -> 27.1 M, 238.4 ->
+// 368.8 M; the extra live state costs spills in the front's stores too). Wall (10 interleaved `bench decode
+// --runs 9` of refined_elephant, load 5.4 on 2 cores, medians): format 12 20.90, one rANS state 21.16, two
+// 21.73 M triangles/s.
 //
 // On a manifold patch about half the symbols are kVertex and most others kLeft / kRight / kBoundary (border
 // edges). Levels >= 1 cost about twice level 0's bits per triangle (elephant_1m, format 6: 0.44-0.50 against
