@@ -154,7 +154,14 @@ __attribute__((target_clones("avx2", "default"))) void predicted_normals(
     const uint32_t base = all_inside ? 0 : first_vertex;
     std::swap(plain, sum);
     sum.resize(plain.size());
-    for (size_t v = 0; v < plain.size(); ++v) sum[v] = plain[v] + plain[v];
+    // Two sums a step (a count that is a multiple of 4), one AVX register in the AVX2 build (`bench decode
+    // --runs 1` under callgrind, predicted_normals: elephant_1m 154.9 -> 152.2 M instructions).
+    for (size_t v = 0; v < plain.size(); v += 2) {
+      Float8 two;
+      std::memcpy(&two, &plain[v], sizeof two);
+      two += two;
+      std::memcpy(&sum[v], &two, sizeof two);
+    }
     for (size_t i = 0; i + 2 < indices.size(); i += 3) {
       const uint32_t a = indices[i] - base, b = indices[i + 1] - base, c = indices[i + 2] - base;
       if (!all_inside && (a >= V || b >= V || c >= V)) continue;
