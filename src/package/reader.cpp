@@ -191,6 +191,12 @@ std::span<const uint8_t> PackageReader::record_bytes(uint32_t id, const NodeReco
 }
 
 DecodedNode PackageReader::decode_node(uint32_t id, std::span<const uint8_t> page) {
+  DecodedNode decoded;
+  decode_node(id, page, decoded);
+  return decoded;
+}
+
+void PackageReader::decode_node(uint32_t id, std::span<const uint8_t> page, DecodedNode& decoded) {
   const NodeRecord& n = node(id);
   // The error context, built in a buffer kept across calls (a string built anew took three allocations a
   // node), the numbers by to_chars (std::to_string's strings took ~5 M of elephant_1m's 19,860 nodes), and
@@ -220,13 +226,12 @@ DecodedNode PackageReader::decode_node(uint32_t id, std::span<const uint8_t> pag
   }
   // extract_cluster reads its context only to refuse a cluster the record does not hold.
   const bool held = n.cluster < record_clusters(last.decoded);
-  DecodedNode decoded = extract_cluster(last.decoded, n.cluster, held ? node_context_ : context());
+  extract_cluster(last.decoded, n.cluster, held ? node_context_ : context(), decoded);
   if (decoded.mesh.triangle_count() != n.triangles) {
     throw Error(context() + ": record says " + std::to_string(n.triangles) + " triangles, its bytes hold " +
                 std::to_string(decoded.mesh.triangle_count()));
   }
   decoded.mesh.material = n.material;
-  return decoded;
 }
 
 DecodedNode PackageReader::load_node(uint32_t id) {

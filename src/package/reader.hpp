@@ -66,6 +66,9 @@ class PackageReader {
   // buffers reused by the next), so decoding its clusters one after another (consecutive ids) decodes it
   // once.
   DecodedNode decode_node(uint32_t id, std::span<const uint8_t> page);
+  // The same into `out`, every field of which it overwrites, reusing out's buffers (extract_cluster's):
+  // a caller that decodes many nodes into one DecodedNode, or recycles those it drops, allocates once.
+  void decode_node(uint32_t id, std::span<const uint8_t> page, DecodedNode& out);
   // read_page + decode_node.
   DecodedNode load_node(uint32_t id);
   // Blob `blob` (an embedded texture file), read and checked.

@@ -19,19 +19,19 @@ void gather(const std::vector<T>& from, std::span<const uint32_t> order, std::ve
   to.assign(values.begin(), values.end());
 }
 
-// gather of positions and normals in one pass over `order`, into per-thread buffers then copied out (a
-// std::vector cannot be sized without value-initialising it): ~9 instructions a vertex for both plus the
-// copies, where two gathers took ~16 (elephant_1m's bench decode: extract_cluster 157.4 -> 149.8 M).
+// gather of positions and normals in one pass over `order`, straight into m's arrays (their capacity kept
+// across calls: a caller that extracts into one DecodedNode allocates once): ~9 instructions a vertex for
+// both, where two gathers took ~16 (elephant_1m's bench decode: extract_cluster 157.4 -> 149.8 M).
 // With `wide` (every entry of `order` below in's last vertex), a vertex a 16-byte load and store each:
-// lanes 0-2 are its x y z, lane 3 the next vertex's x, stored into the next place (or the buffers' spare
-// one), which the next vertex overwrites: 15 -> 11 instructions a vertex (`bench decode --runs 1` under
-// callgrind, decode_node: refined_elephant 46.29 -> 46.02 M, elephant_1m 695.8 -> 691.9 M).
-// Cost: O(order.size()).
+// lanes 0-2 are its x y z, lane 3 the next vertex's x, stored into the next place (the arrays' spare entry
+// for the last, dropped after), which the next vertex overwrites: 15 -> 11 instructions a vertex (`bench
+// decode --runs 1` under callgrind, decode_node: refined_elephant 46.29 -> 46.02 M, elephant_1m 695.8 ->
+// 691.9 M). Cost: O(order.size()).
 void gather_positions_normals(const Mesh& in, std::span<const uint32_t> order, bool wide, Mesh& m) {
-  thread_local std::vector<glm::vec3> positions, normals;
-  if (positions.size() <= order.size()) positions.resize(order.size() + 1), normals.resize(order.size() + 1);
+  // resize zero-fills only beyond the size the arrays had.
+  m.positions.resize(order.size() + 1), m.normals.resize(order.size() + 1);
   const glm::vec3 *p = in.positions.data(), *q = in.normals.data();
-  glm::vec3 *to_p = positions.data(), *to_q = normals.data();
+  glm::vec3 *to_p = m.positions.data(), *to_q = m.normals.data();
   if (wide) {
     for (size_t k = 0; k < order.size(); ++k) {
       std::memcpy(to_p + k, p + order[k], 16);
@@ -40,8 +40,7 @@ void gather_positions_normals(const Mesh& in, std::span<const uint32_t> order, b
   } else {
     for (size_t k = 0; k < order.size(); ++k) to_p[k] = p[order[k]], to_q[k] = q[order[k]];
   }
-  m.positions.assign(to_p, to_p + order.size());
-  m.normals.assign(to_q, to_q + order.size());
+  m.positions.pop_back(), m.normals.pop_back();
 }
 
 }  // namespace
@@ -107,12 +106,22 @@ RecordMesh weld_record(std::span<const Mesh* const> clusters,
 }
 
 DecodedNode extract_cluster(const DecodedNode& record, uint32_t cluster, const std::string& where) {
+  DecodedNode out;
+  extract_cluster(record, cluster, where, out);
+  return out;
+}
+
+void extract_cluster(const DecodedNode& record, uint32_t cluster, const std::string& where,
+                     DecodedNode& out) {
   const uint32_t clusters = record_clusters(record);
   if (cluster >= clusters) {
     throw Error(where + ": cluster " + std::to_string(cluster) + " out of range (its record holds " +
                 std::to_string(clusters) + ")");
   }
-  if (clusters == 1) return record;
+  if (clusters == 1) {
+    out = record;  // copy-assigned: out's buffers reused
+    return;
+  }
   size_t first = 0;  // the cluster's first triangle
   for (uint32_t c = 0; c < cluster; ++c) first += record.cluster_triangles[c];
   const size_t count = record.cluster_triangles[cluster];
@@ -122,9 +131,11 @@ DecodedNode extract_cluster(const DecodedNode& record, uint32_t cluster, const s
   thread_local std::vector<uint32_t> compact, used;  // used[cluster vertex] = record vertex
   if (compact.size() < in.positions.size()) compact.resize(in.positions.size(), UINT32_MAX);
   if (used.size() < in.positions.size()) used.resize(in.positions.size());
-  DecodedNode out;
   Mesh& m = out.mesh;
   m.material = in.material;
+  // What the cluster does not hold cleared (capacity kept); the rest overwritten below.
+  m.normals.clear(), m.uvs.clear(), m.colors.clear();
+  out.first_vertex = 0, out.vertex_data.clear(), out.extra.clear(), out.cluster_triangles.clear();
   // Copied, then renumbered in place: no value-initialisation of a buffer that is overwritten anyway.
   m.indices.assign(in.indices.begin() + std::ptrdiff_t(3 * first),
                    in.indices.begin() + std::ptrdiff_t(3 * (first + count)));  // < V: the codec checked them
@@ -160,7 +171,6 @@ DecodedNode extract_cluster(const DecodedNode& record, uint32_t cluster, const s
   if (in.has_colors()) gather(in.colors, order, m.colors);
   if (!record.vertex_data.empty()) gather(record.vertex_data, order, out.vertex_data);
   out.index_end = uint32_t(n);
-  return out;
 }
 
 }  // namespace lodstream::package

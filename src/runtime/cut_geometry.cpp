@@ -118,7 +118,9 @@ size_t CutGeometry::update(const schedule::Cut& cut, const PageSource& pages) {
     std::sort(ids.begin(), ids.end());
     for (uint32_t id : ids) {
       if (decoded_.count(id)) continue;  // an instanced node listed once per object
-      package::DecodedNode node = reader_->decode_node(id, bytes);
+      package::DecodedNode node;         // into an evicted node's buffers where one is spare: no allocation
+      if (!spare_.empty()) node = std::move(spare_.back()), spare_.pop_back();
+      reader_->decode_node(id, bytes, node);
       if (node.mesh.material >= materials_.size()) node.mesh.material = 0;
       decoded_.emplace(id, Decoded{std::move(node), frame_});
       ++decoded;
@@ -176,6 +178,7 @@ void CutGeometry::evict() {
     auto& map = is_prefix ? prefixes_ : decoded_;
     auto it = map.find(id);
     idle_triangles -= it->second.node.mesh.triangle_count();
+    if (!is_prefix && spare_.size() < kSpareNodes) spare_.push_back(std::move(it->second.node));
     map.erase(it);
   }
 }

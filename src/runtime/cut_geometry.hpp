@@ -129,6 +129,10 @@ class CutGeometry {
   uint64_t budget_, frame_ = 0, triangles_ = 0;
   std::unordered_map<uint32_t, Decoded> decoded_;
   std::unordered_map<uint32_t, Decoded> prefixes_;  // by last step
+  // Evicted nodes, whose buffers the next decodes reuse (PackageReader::decode_node into a DecodedNode), at
+  // most kSpareNodes: a cut change that drops and adds a few hundred clusters then allocates for the rest.
+  static constexpr size_t kSpareNodes = 64;
+  std::vector<package::DecodedNode> spare_;
   std::vector<CutItem> items_;
 };
 

@@ -260,5 +260,42 @@ TEST(Records, TheReaderGivesEachClusterInAnyOrder) {
   }
 }
 
+// Decoding every node into one DecodedNode (the bench's and a recycling client's path) gives each node as
+// decoding it alone does, whatever the node held before (fields a node lacks are cleared), and reuses its
+// buffers: after one pass over the nodes, the arrays are never reallocated.
+TEST(Records, DecodingIntoOneNodeReusesItsBuffers) {
+  const auto file = temp_dir() / "records_into.lods";
+  write_test_package(file, TraversalCodec::kId);
+  PackageReader reader = PackageReader::open(file), alone = PackageReader::open(file);
+  DecodedNode into;
+  for (uint32_t id = 0; id < reader.node_count(); ++id)
+    reader.decode_node(id, reader.read_page(reader.node(id).page), into);
+  const uint32_t* indices = into.mesh.indices.data();
+  const glm::vec3* positions = into.mesh.positions.data();
+  into.mesh.colors.assign(3, glm::vec4(1.0f));  // what a recycled node may hold and these nodes do not
+  into.vertex_data.assign(3, 7u), into.extra.assign(2, 1), into.cluster_triangles.assign(2, 5u);
+  into.first_vertex = 9;
+  size_t in_records = 0;
+  for (uint32_t id = 0; id < reader.node_count(); ++id) {
+    reader.decode_node(id, reader.read_page(reader.node(id).page), into);
+    const DecodedNode d = alone.load_node(id);
+    in_records += reader.node(id).cluster > 0;
+    EXPECT_EQ(into.mesh.indices, d.mesh.indices) << id;
+    EXPECT_EQ(into.mesh.positions, d.mesh.positions) << id;
+    EXPECT_EQ(into.mesh.normals, d.mesh.normals) << id;
+    EXPECT_EQ(into.mesh.uvs, d.mesh.uvs) << id;
+    EXPECT_EQ(into.mesh.colors, d.mesh.colors) << id;
+    EXPECT_EQ(into.mesh.material, d.mesh.material) << id;
+    EXPECT_EQ(into.vertex_data, d.vertex_data) << id;
+    EXPECT_EQ(into.extra, d.extra) << id;
+    EXPECT_EQ(into.cluster_triangles, d.cluster_triangles) << id;
+    EXPECT_EQ(into.first_vertex, d.first_vertex) << id;
+    EXPECT_EQ(into.index_end, d.index_end) << id;
+    EXPECT_EQ(into.mesh.indices.data(), indices) << id;
+    EXPECT_EQ(into.mesh.positions.data(), positions) << id;
+  }
+  EXPECT_GT(in_records, 4u);
+}
+
 }  // namespace
 }  // namespace lodstream::test

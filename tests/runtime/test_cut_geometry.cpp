@@ -157,6 +157,28 @@ TEST(CutGeometry, DropsIdleMeshesBeyondTheBudget) {
   EXPECT_EQ(geometry.cached_nodes(), distinct_nodes(coarse).size());
 }
 
+// Nodes decoded into the buffers of evicted ones (fine, coarse, fine again with no room for idle meshes) come
+// out as a fresh CutGeometry decodes them.
+TEST(CutGeometry, DecodesIntoEvictedNodesBuffersAlike) {
+  GeometryPackage p;
+  package::PackageReader reader = package::PackageReader::open(p.file);
+  ReaderNodes all(reader);
+  CutGeometry recycling(reader, {}, 0), fresh(reader, {}, 0);
+  const Cut fine = select_cut(reader.scene(), all, view_of({-1.0f, 0.5f, 1.0f}, {8.0f, 0.0f, 0.0f}), {0.5});
+  const Cut coarse =
+      select_cut(reader.scene(), all, view_of({8.0f, 2.0f, 60.0f}, {18.0f, 0.0f, 0.0f}), {2.0});
+  for (const Cut* cut : {&fine, &coarse, &fine, &coarse}) recycling.update(*cut, pages_from_reader(reader));
+  fresh.update(coarse, pages_from_reader(reader));
+  ASSERT_EQ(recycling.items().size(), fresh.items().size());
+  for (size_t i = 0; i < fresh.items().size(); ++i) {
+    const Mesh &a = *recycling.items()[i].mesh, &b = *fresh.items()[i].mesh;
+    EXPECT_EQ(a.indices, b.indices) << i;
+    EXPECT_EQ(a.positions, b.positions) << i;
+    EXPECT_EQ(a.normals, b.normals) << i;
+    EXPECT_EQ(a.material, b.material) << i;
+  }
+}
+
 // Pages from the client's cache, as transferred (stored) or unpacked; a drawn page that is not cached is an
 // error naming it.
 TEST(CutGeometry, ReadsPagesFromTheCache) {
