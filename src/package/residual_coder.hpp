@@ -68,9 +68,9 @@ std::vector<uint8_t> encode_paired_residuals(std::span<const uint64_t> values,
                                              std::span<const uint32_t> counts);
 
 // Reads a stream of encode_residuals (or, paired, of encode_paired_residuals) back, in the order written, as
-// byte planes. Every table, size, symbol
-// and bit read is checked: a corrupted or hostile stream throws lodstream::Error starting with `where`, never
-// reads outside its bytes or writes outside the planes asked for.
+// byte planes. Every table, size, symbol and bit read is checked: a corrupted or hostile stream throws
+// lodstream::Error starting with `where`, never reads outside its bytes or writes outside the planes asked
+// for.
 class ResidualDecoder {
  public:
   // Parses the table (a paired stream's set when `paired`). Cost: O(2^12) (the decode table, 20 KB; a paired
