@@ -260,6 +260,20 @@ std::vector<uint8_t> decoded_pair_planes(std::span<const uint8_t> stream, const 
   return out;
 }
 
+// The built-in tables are what residual_tables.hpp says: each adds up to 2^12 and codes every symbol.
+TEST(ResidualCoder, BuiltInTablesAddUpToTheScaleAndCodeEverySymbol) {
+  using namespace residual_tables;
+  for (uint32_t set = 0; set < kSets; ++set)
+    for (uint32_t c = 0; c < kContexts; ++c) {
+      uint32_t sum = 0;
+      for (uint32_t s = 0; s < kSymbols; ++s) {
+        EXPECT_GE(kFrequencies[set][c][s], 1u) << set << " " << c << " " << s;
+        sum += kFrequencies[set][c][s];
+      }
+      EXPECT_EQ(sum, 4096u) << set << " " << c;
+    }
+}
+
 TEST(ResidualCoder, PairedStreamsDecodeToThePlanesAndCodeRelatedPairsSmaller) {
   for (uint32_t set = 0; set < residual_tables::kSets; ++set) {
     const Pairs r = drawn_pairs(set, set);
