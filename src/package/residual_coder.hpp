@@ -35,17 +35,21 @@
 // built-in tables (residual_tables.hpp, learnt on horse and motorBike) that the encoder chooses per stream.
 // Measured first (offline, every page of the format-12 bakes): the stored tables are 0.29-0.48 % of the
 // packages (refined_elephant 1,176 B of 243,982: 711 in positions' streams, 465 in normals'; bunny 672 B,
-// horse 1,256, motorBike 4,936), so that dropping them alone saves little, and built-in tables without
-// contexts lose more than that (positions +2.2 %, normals +13.6 % on refined_elephant with one table; +0.3 /
-// +1.3 % choosing among 16): a page's scale varies. With contexts: the normals' pair gains 6-9 % (sizes in
-// residual_tables.hpp); for the positions, the previous value's class (a dependency between the four
-// states' chains) and the other components' gained at most 1 % over today's coder (16 sets), nothing was
-// built for them. Packages, format 12 -> 13 (`lodstream bake`): refined_elephant 243,982 -> 241,729 B
-// (-0.92 %), bunny 234,933 -> 232,855 (-0.88 %), elephant_1m 2,769,806 -> 2,745,756 (-0.87 %), elephant_5m
-// 10,550,301 -> 10,515,300 (-0.33 %); the training meshes horse -0.87 %, motorBike -0.32 %. Decode
-// (`bench decode --runs 1` under callgrind, whole process): refined_elephant 89.59 -> 90.26 M instructions
-// (+0.75 %: a paired component-1 value's context, a load and an add, and the set's 9 tables built on first
-// use), elephant_1m 1,072.6 -> 1,073.5 M (+0.08 %: fewer tables built per page).
+// horse 1,256, motorBike 4,936) but for elephant_1m's 1.06 % (29,233 B in 852 streams, 21,543 of them the
+// positions'), and built-in tables without contexts lose more than they save (positions +2.2 %, normals +13.6
+// % on refined_elephant with one table; +0.3 / +1.3 % choosing among 16): a page's scale varies. Offered
+// beside the stream's own table (the smaller kept per stream), 32 built-in order-0 tables would save 272 B on
+// refined_elephant's positions, 1,580 B on elephant_1m's (0.06 %): not built. With contexts: the normals'
+// pair gains 6-9 % (sizes in residual_tables.hpp); for the positions, the previous value's class (a
+// dependency between the four states' chains) and the other components' gained at most 1 % over today's coder
+// (16 sets), nothing was built for them. Packages, format 12 -> 13 (`lodstream bake`): refined_elephant
+// 243,982 -> 241,729 B (-0.92 %), bunny 234,933 -> 232,855 (-0.88 %), elephant_1m 2,769,806 -> 2,745,756
+// (-0.87 %), elephant_5m 10,550,301 -> 10,515,300 (-0.33 %); the training meshes horse -0.87 %, motorBike
+// -0.32 %. Decode (`bench decode --runs 1` under callgrind, whole process): refined_elephant 89.59 -> 90.26 M
+// instructions (+0.75 %: a paired component-1 value's context, a load and an add, and the set's 9 tables
+// built on first use), elephant_1m 1,072.6 -> 1,073.5 M (+0.08 %: fewer tables built per page). A set's 9
+// tables (180 KB) do not stay in L1 as one table (20 KB) does: the L1 read misses of planes() in
+// refined_elephant's decode, 28.6 k -> 71.3 k (cachegrind, its default caches).
 //
 // A stream (no bytes for no values): u8 D (1..6), u8 A (symbols in the table, 1..2^D + 40 - D), A varint
 // frequencies adding up to 2^12, varint size of the rANS bytes, the rANS bytes (the four final states
