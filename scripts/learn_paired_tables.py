@@ -9,8 +9,8 @@ component, u32 normal residuals per component); then for the positions and then 
 u32 stored size, f64 zstd estimate, u64 value count, the zigzagged values as u64, node by node, component
 by component). Usage: learn_paired_tables.py OUT.cpp horse.dump motorBike.dump
 
-Method: each page's normals give a histogram per context (residual_tables.hpp: context 8 for component 0,
-min(bit length of the low byte of the vertex's component 0, 7) for component 1) of residual_coder's symbols
+Method: each page's normals give a histogram per context (residual_tables.hpp: context 3 for component 0,
+min(bit length of the low byte of the vertex's component 0, 2) for component 1) of residual_coder's symbols
 with D = 6; the pages are clustered by k-means under the code length (start: pages sorted by mean symbol,
 split into kSets equal runs; each round assigns every page to the set coding it shortest and re-estimates
 each set's tables as normalize(64 * counts + 1) to 2^12, rans.cpp's rounding), 10 rounds.
@@ -21,7 +21,7 @@ import sys
 import numpy as np
 
 SCALE_BITS, SCALE = 12, 1 << 12
-D, SETS, CONTEXTS, FIRST = 6, 8, 9, 8
+D, SETS, CONTEXTS, FIRST = 6, 8, 4, 3
 SYMBOLS = (1 << D) + 40 - D
 
 
@@ -71,7 +71,7 @@ def page_histogram(nodes, values):
         v = values[at:at + 2 * count].reshape(2, count)
         at += 2 * count
         zs += [v[0], v[1]]
-        contexts += [np.full(count, FIRST), np.minimum(bit_length(v[0] & 255), 7)]
+        contexts += [np.full(count, FIRST), np.minimum(bit_length(v[0] & 255), FIRST - 1)]
     if not zs:
         return None
     z, c = np.concatenate(zs), np.concatenate(contexts)

@@ -171,7 +171,7 @@ const std::array<PairedSet, residual_tables::kSets>& paired_sets() {
 }
 
 // The decode tables of set `set`'s kContexts contexts, one after the other, built on first use (once per
-// set and process: 9 tables, ~40 k slots). Cost after the first: a call_once check.
+// set and process: 4 tables, 16 k slots). Cost after the first: a call_once check.
 const uint32_t* paired_tables(uint32_t set) {
   static std::once_flag once[residual_tables::kSets];
   static std::unique_ptr<uint32_t[]> tables[residual_tables::kSets];

@@ -43,13 +43,13 @@
 // pair gains 6-9 % (sizes in residual_tables.hpp); for the positions, the previous value's class (a
 // dependency between the four states' chains) and the other components' gained at most 1 % over today's coder
 // (16 sets), nothing was built for them. Packages, format 12 -> 13 (`lodstream bake`): refined_elephant
-// 243,982 -> 241,729 B (-0.92 %), bunny 234,933 -> 232,855 (-0.88 %), elephant_1m 2,769,806 -> 2,745,756
-// (-0.87 %), elephant_5m 10,550,301 -> 10,515,300 (-0.33 %); the training meshes horse -0.87 %, motorBike
-// -0.32 %. Decode (`bench decode --runs 1` under callgrind, whole process): refined_elephant 89.59 -> 90.26 M
-// instructions (+0.75 %: a paired component-1 value's context, a load and an add, and the set's 9 tables
-// built on first use), elephant_1m 1,072.6 -> 1,073.5 M (+0.08 %: fewer tables built per page). A set's 9
-// tables (180 KB) do not stay in L1 as one table (20 KB) does: the L1 read misses of planes() in
-// refined_elephant's decode, 28.6 k -> 71.3 k (cachegrind, its default caches).
+// 243,982 -> 241,759 B (-0.91 %), bunny 234,933 -> 232,898 (-0.87 %), elephant_1m 2,769,806 -> 2,746,287
+// (-0.85 %), elephant_5m 10,550,301 -> 10,515,447 (-0.33 %); the training meshes horse -0.81 %, motorBike
+// -0.28 %. Decode (`bench decode --runs 1` under callgrind, whole process): refined_elephant 89.59 -> 90.00 M
+// instructions (+0.46 %: a paired component-1 value's context, a load and an add, and the set's 4 tables
+// built on first use), elephant_1m 1,072.6 -> 1,074.1 M (+0.13 %). A set's 4 tables (80 KB) do not stay in
+// L1 as one table (20 KB) does: the L1 read misses of planes() in refined_elephant's decode, 28.6 k -> 62.7 k
+// (cachegrind, its default caches; 71.3 k with 9 contexts).
 //
 // A stream (no bytes for no values): u8 D (1..6), u8 A (symbols in the table, 1..2^D + 40 - D), A varint
 // frequencies adding up to 2^12, varint size of the rANS bytes, the rANS bytes (the four final states
