@@ -40,7 +40,7 @@
 // % on refined_elephant with one table; +0.3 / +1.3 % choosing among 16): a page's scale varies. Offered
 // beside the stream's own table (the smaller kept per stream), 32 built-in order-0 tables would save 272 B on
 // refined_elephant's positions, 1,580 B on elephant_1m's (0.06 %): not built. With contexts: the normals'
-// pair gains 6-9 % (sizes in residual_tables.hpp); for the positions, the previous value's class (a
+// pair gains 6-8 % (sizes in residual_tables.hpp); for the positions, the previous value's class (a
 // dependency between the four states' chains) and the other components' gained at most 1 % over today's coder
 // (16 sets), nothing was built for them. Packages, format 12 -> 13 (`lodstream bake`): refined_elephant
 // 243,982 -> 241,759 B (-0.91 %), bunny 234,933 -> 232,898 (-0.87 %), elephant_1m 2,769,806 -> 2,746,287
