@@ -245,16 +245,21 @@ std::vector<uint8_t> encode_paired_residuals(std::span<const uint64_t> values,
     at += 2 * size_t(n);
   }
   if (at != values.size()) throw Error("residual coder: paired counts short of the residuals");
-  // The set coding the values shortest (raw bits are the same under every set).
-  const std::array<PairedSet, kSets>& sets = paired_sets();
-  std::array<double, kSets> bits{};
+  // The set coding the values shortest (raw bits are the same under every set), from the symbols' counts
+  // per context (a count a value, where summing each set's code lengths value by value took 8 additions:
+  // refined_elephant's bake 2,084.3 -> 2,071.2 M instructions, callgrind; format 12's 2,059.4).
+  std::array<std::array<uint32_t, kMaxSymbols>, kContexts> histogram{};
   for (size_t i = 0; i < values.size(); ++i) {
     const uint32_t k = bit_length(values[i]);
     if (k > kMaxBits) throw Error("residual coder: a residual of more than 40 bits");
     symbols[i] = uint8_t(k);
-    const uint32_t s = symbol_of(values[i], k, kDirectBits);
-    for (uint32_t set = 0; set < kSets; ++set) bits[set] += sets[set].bits[context[i]][s];
+    ++histogram[context[i]][symbol_of(values[i], k, kDirectBits)];
   }
+  const std::array<PairedSet, kSets>& sets = paired_sets();
+  std::array<double, kSets> bits{};
+  for (uint32_t set = 0; set < kSets; ++set)
+    for (uint32_t c = 0; c < kContexts; ++c)
+      for (uint32_t s = 0; s < kMaxSymbols; ++s) bits[set] += histogram[c][s] * double(sets[set].bits[c][s]);
   const uint32_t set = uint32_t(std::min_element(bits.begin(), bits.end()) - bits.begin());
   ByteWriter w;
   w.u8(uint8_t(set));

@@ -72,7 +72,8 @@ std::vector<uint8_t> encode_residuals(std::span<const uint64_t> values);
 // The paired stream (residual_coder.hpp) of `values`: per count n of `counts` in turn, n values of component
 // 0 then the n of component 1 of the same vertices (a page's normal residuals, node by node), each below
 // 2^40; the set is the one whose code lengths add up smallest. Throws lodstream::Error when the counts do not
-// add up to the values. Cost: O(values.size() * kSets) for the choice, then a coding pass.
+// add up to the values. Cost: O(values.size()) and O(kSets * kContexts * kSymbols) for the choice, then a
+// coding pass.
 std::vector<uint8_t> encode_paired_residuals(std::span<const uint64_t> values,
                                              std::span<const uint32_t> counts);
 
