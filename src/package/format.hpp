@@ -40,7 +40,8 @@ inline constexpr std::array<uint8_t, 8> kMagic = {0x89, 'L', 'O', 'D', 'S', '\r'
 // children lists, repeated children lists as references, range tables as offset deltas and varints
 // (index.hpp); 13: a record's traversal symbols one rANS stream under fixed tables, decoded inside the
 // traversal by the gate's context (traversal_connectivity.hpp, traversal_tables.hpp); no connectivity form
-// byte in pages (page_parts.hpp).
+// byte in pages (page_parts.hpp); normal residuals may be one paired stream of built-in tables, component 1
+// in the context of component 0 (page_parts.hpp's paired form, residual_coder.hpp).
 inline constexpr uint32_t kFormatVersion = 13;
 inline constexpr size_t kHeaderSize = 64;
 

@@ -41,7 +41,7 @@ void put_varint(std::vector<uint8_t>& out, uint64_t v) {
 }
 
 // The residual parts' forms (page_parts.hpp).
-constexpr uint8_t kPlanesForm = 0, kCodedForm = 1, kSplitForm = 2;
+constexpr uint8_t kPlanesForm = 0, kCodedForm = 1, kSplitForm = 2, kPairedForm = 3;
 // The bits a residual the coded form must save over the zstd'd bytes (page_parts.hpp).
 constexpr double kMinSavedBits = 0.2;
 
@@ -65,6 +65,7 @@ std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<co
   const bool coded = residuals_coded(codec);
   std::vector<uint64_t> residuals[kParts];  // of kPositions and kNormals, coded
   std::vector<uint64_t> split[2];           // the positions' component 0, and components 1 and 2
+  std::vector<uint32_t> normal_counts;      // each node's normal residuals per component
   std::vector<int64_t> signed_residuals;
   // The nodes' layouts first, so that the residual arrays are allocated once at their size (grown value by
   // value, each doubling copied them: more than the values themselves).
@@ -106,6 +107,7 @@ std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<co
         const size_t at = all.size();
         all.resize(at + signed_residuals.size());
         for (size_t i = 0; i < signed_residuals.size(); ++i) all[at + i] = zigzag(signed_residuals[i]);
+        if (p == kNormals) normal_counts.push_back(uint32_t(s.count));
         if (p == kPositions) {
           split[0].insert(split[0].end(), all.begin() + at, all.begin() + at + s.count);
           split[1].insert(split[1].end(), all.begin() + at + s.count, all.end());
@@ -129,6 +131,12 @@ std::optional<std::array<std::vector<uint8_t>, kParts + 1>> regroup(std::span<co
         split_form.insert(split_form.end(), first.begin(), first.end());
         split_form.insert(split_form.end(), rest.begin(), rest.end());
         if (split_form.size() < form.size()) form = std::move(split_form);
+      } else {  // the paired form when smaller (page_parts.hpp)
+        const std::vector<uint8_t> paired = encode_paired_residuals(residuals[p], normal_counts);
+        if (1 + paired.size() < form.size()) {
+          form.assign(1, kPairedForm);
+          form.insert(form.end(), paired.begin(), paired.end());
+        }
       }
       // Coded only when it saves kMinSavedBits a residual (page_parts.hpp): not where zstd finds repeats,
       // nor where it saves too little to pay for its decode.
@@ -201,13 +209,16 @@ std::span<const uint8_t> decompress_page(std::span<const uint8_t> stored, uint32
 
   std::array<bool, kParts> coded{};     // the residual parts in a coded form
   bool split = false;                   // the positions in the split form: stream[kPositions] its component 0
+  bool paired = false;                  // the normals in the paired form
   std::span<const uint8_t> split_rest;  // and its other components
   if (residuals_coded(codec))
     for (size_t p : {kPositions, kNormals}) {
       if (stream[p].empty()) continue;
       const uint8_t form = stream[p][0];
-      if (form != kPlanesForm && form != kCodedForm && !(form == kSplitForm && p == kPositions))
+      if (form != kPlanesForm && form != kCodedForm && !(form == kSplitForm && p == kPositions) &&
+          !(form == kPairedForm && p == kNormals))
         r.fail("invalid residual part form");
+      paired = paired || form == kPairedForm;
       coded[p] = form != kPlanesForm, stream[p] = stream[p].subspan(1);
       if (form == kSplitForm) {
         ByteReader s(stream[p], where);
@@ -218,7 +229,7 @@ std::span<const uint8_t> decompress_page(std::span<const uint8_t> stored, uint32
     }
   ResidualDecoder positions(coded[kPositions] ? stream[kPositions] : std::span<const uint8_t>(), where),
       position_rest(split_rest, where),
-      normals(coded[kNormals] ? stream[kNormals] : std::span<const uint8_t>(), where);
+      normals(coded[kNormals] ? stream[kNormals] : std::span<const uint8_t>(), where, paired);
   std::array<size_t, kParts> used{};  // bytes of each stream consumed
   ByteReader headers(stream[0], where);
   size_t at = 0;

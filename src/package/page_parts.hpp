@@ -43,6 +43,10 @@
 // (-5.2 %), refined_elephant 325,520 -> 321,226 -> 318,287 (-2.2 %), motorBike 1,628,092 -> 1,596,611 ->
 // 1,580,314 (-2.9 %).
 //
+// Format 13: the normals' residual part may also take the paired form (3): one paired stream of
+// residual_coder.hpp (built-in tables, component 1 in the context of component 0); the writer keeps it when
+// smaller than the one stream. `lodstream bake`, format 12 -> 13: see residual_coder.hpp.
+//
 // The regrouped bytes (the zstd frame's content): seven varints, the sizes of the seven part streams; then
 // the streams. The header stream holds, per node in page order, varint node size then the node's header; the
 // other streams the node's part, in the same order (the residual streams: the node's residuals, component

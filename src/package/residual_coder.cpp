@@ -4,10 +4,12 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <mutex>
 
 #include "core/error.hpp"
 #include "package/bytes.hpp"
 #include "package/rans.hpp"
+#include "package/residual_tables.hpp"
 
 namespace lodstream::package {
 
@@ -20,6 +22,9 @@ constexpr uint32_t kMaxBits = 40, kMinDirect = 1, kMaxDirect = 6;
 // The size a larger D may cost for its speed (residual_coder.hpp).
 constexpr double kDirectTolerance = 0.005;
 constexpr uint32_t kMaxSymbols = (1u << kMaxDirect) + kMaxBits - kMaxDirect;  // 98: 7 bits
+static_assert(residual_tables::kSymbols == kMaxSymbols && residual_tables::kDirectBits == kMaxDirect);
+// A decode table's words: 2^12 slots (ResidualDecoder::slot_), then its 2^12 symbols as bytes.
+constexpr uint32_t kTableWords = kScale + kScale / 4;
 
 inline uint32_t bit_length(uint64_t z) {
   return z ? 64 - uint32_t(__builtin_clzll(z)) : 0;
@@ -76,6 +81,117 @@ double estimated_bits(const std::array<uint32_t, 1u << kMaxDirect>& low,
   return bits;
 }
 
+// A table's starts and frequencies, as the encoder takes them.
+struct Coding {
+  std::array<uint32_t, kMaxSymbols> start{}, f{};
+};
+Coding coding_of(std::span<const uint32_t> f) {
+  Coding c;
+  std::copy(f.begin(), f.end(), c.f.begin());
+  for (size_t s = 1; s < f.size(); ++s) c.start[s] = c.start[s - 1] + c.f[s - 1];
+  return c;
+}
+
+// Appends the varint size of the rANS bytes, the rANS bytes and the raw bits of `values`
+// (residual_coder.hpp), value i coded with the Coding table_of(i); `symbols` holds each value's bit length
+// and takes its symbol with D direct bits. Cost: O(values.size()), a division a value.
+template <typename TableOf>
+void write_codes(std::span<const uint64_t> values, std::vector<uint8_t>& symbols, uint32_t D,
+                 TableOf table_of, ByteWriter& w) {
+  std::vector<uint8_t> raw;
+  uint64_t raw_bits = 0;
+  uint32_t bit_count = 0;
+  for (size_t i = 0; i < values.size(); ++i) {
+    const uint64_t z = values[i];
+    const uint32_t k = symbols[i];
+    symbols[i] = uint8_t(symbol_of(z, k, D));
+    if (k > D) {
+      raw_bits |= (z & ((uint64_t(1) << (k - 1)) - 1)) << bit_count, bit_count += k - 1;
+      for (; bit_count >= 8; bit_count -= 8, raw_bits >>= 8) raw.push_back(uint8_t(raw_bits));
+    }
+  }
+  if (bit_count) raw.push_back(uint8_t(raw_bits));
+
+  // rANS, last value first (value i in state i mod kStates); the bytes come out last first and are
+  // reversed after.
+  std::vector<uint8_t> reversed;
+  reversed.reserve(2 * values.size());  // a step moves out at most 16 bits: never regrown
+  uint32_t state[kStates];
+  std::fill(state, state + kStates, kLow);
+  for (size_t i = values.size(); i-- > 0;) {
+    uint32_t& x = state[i % kStates];
+    const uint32_t s = symbols[i];
+    const Coding& c = table_of(i);
+    rans::encode(x, c.start[s], c.f[s], kScaleBits, reversed);
+  }
+  w.varint(4 * kStates + reversed.size());
+  for (uint32_t x : state)
+    for (int b = 0; b < 4; ++b) w.u8(uint8_t(x >> (8 * b)));
+  w.bytes.insert(w.bytes.end(), reversed.rbegin(), reversed.rend());
+  w.raw(raw);
+}
+
+// A decode table (kTableWords words: ResidualDecoder::slot_'s layout) of the frequencies frequency(s) of
+// symbols 0..A-1, which add up to kScale; returns false when they do not (the table then partly written).
+// Cost: O(2^12).
+template <typename Frequency>
+bool fill_table(uint32_t* table, uint32_t A, Frequency frequency) {
+  uint8_t* const symbols = reinterpret_cast<uint8_t*>(table + kScale);
+  uint32_t sum = 0;
+  for (uint32_t s = 0; s < A; ++s) {
+    const uint64_t f = frequency(s);
+    if (f > kScale - sum) return false;
+    rans::fill_slots(table + sum, uint32_t(f), uint32_t(f), 16);
+    std::memset(symbols + sum, int(s), f);
+    sum += uint32_t(f);
+  }
+  return sum == kScale;
+}
+
+// The built-in tables of residual_tables.hpp: per set, the encoder's Codings and code lengths (bits, raw
+// bits not counted) of every context, built on first use.
+struct PairedSet {
+  std::array<Coding, residual_tables::kContexts> coding;
+  std::array<std::array<float, kMaxSymbols>, residual_tables::kContexts> bits;
+};
+const std::array<PairedSet, residual_tables::kSets>& paired_sets() {
+  static const std::array<PairedSet, residual_tables::kSets> sets = [] {
+    std::array<PairedSet, residual_tables::kSets> out;
+    for (uint32_t k = 0; k < residual_tables::kSets; ++k)
+      for (uint32_t c = 0; c < residual_tables::kContexts; ++c) {
+        std::array<uint32_t, kMaxSymbols> f;
+        std::copy_n(residual_tables::kFrequencies[k][c], kMaxSymbols, f.begin());
+        out[k].coding[c] = coding_of(f);
+        for (uint32_t s = 0; s < kMaxSymbols; ++s)
+          out[k].bits[c][s] = float(kScaleBits - std::log2(double(f[s])));
+      }
+    return out;
+  }();
+  return sets;
+}
+
+// The decode tables of set `set`'s kContexts contexts, one after the other, built on first use (once per
+// set and process: 4 tables, 16 k slots). Cost after the first: a call_once check.
+const uint32_t* paired_tables(uint32_t set) {
+  static std::once_flag once[residual_tables::kSets];
+  static std::unique_ptr<uint32_t[]> tables[residual_tables::kSets];
+  std::call_once(once[set], [set] {
+    tables[set] = std::make_unique_for_overwrite<uint32_t[]>(residual_tables::kContexts * kTableWords);
+    for (uint32_t c = 0; c < residual_tables::kContexts; ++c)
+      fill_table(tables[set].get() + c * kTableWords, kMaxSymbols,
+                 [&](uint32_t s) { return residual_tables::kFrequencies[set][c][s]; });
+  });
+  return tables[set].get();
+}
+
+// Per low byte of a component-0 value: the word offset of its component-1 value's decode table in a set's
+// tables (residual_tables::context_of).
+constexpr std::array<uint32_t, 256> kContextOffset = [] {
+  std::array<uint32_t, 256> out{};
+  for (uint32_t b = 0; b < 256; ++b) out[b] = residual_tables::context_of(uint8_t(b)) * kTableWords;
+  return out;
+}();
+
 }  // namespace
 
 std::vector<uint8_t> encode_residuals(std::span<const uint64_t> values) {
@@ -105,65 +221,72 @@ std::vector<uint8_t> encode_residuals(std::span<const uint64_t> values) {
   const std::array<uint32_t, kMaxSymbols> counts = symbol_counts(low, lengths, D);
   uint32_t A = symbols_for(D);
   while (counts[A - 1] == 0) --A;
-  const std::array<uint32_t, kMaxSymbols> f = normalized(counts, values.size());
-  std::array<uint32_t, kMaxSymbols> start{};
-  for (uint32_t s = 1; s < A; ++s) start[s] = start[s - 1] + f[s - 1];
-
-  std::vector<uint8_t> raw;
-  uint64_t raw_bits = 0;
-  uint32_t bit_count = 0;
-  for (size_t i = 0; i < values.size(); ++i) {
-    const uint64_t z = values[i];
-    const uint32_t k = symbols[i];
-    symbols[i] = uint8_t(symbol_of(z, k, D));
-    if (k > D) {
-      raw_bits |= (z & ((uint64_t(1) << (k - 1)) - 1)) << bit_count, bit_count += k - 1;
-      for (; bit_count >= 8; bit_count -= 8, raw_bits >>= 8) raw.push_back(uint8_t(raw_bits));
-    }
-  }
-  if (bit_count) raw.push_back(uint8_t(raw_bits));
-
-  // rANS, last value first (value i in state i mod kStates); the bytes come out last first and are
-  // reversed after.
-  std::vector<uint8_t> reversed;
-  reversed.reserve(2 * values.size());  // a step moves out at most 16 bits: never regrown
-  uint32_t state[kStates];
-  std::fill(state, state + kStates, kLow);
-  for (size_t i = values.size(); i-- > 0;) {
-    uint32_t& x = state[i % kStates];
-    const uint32_t s = symbols[i];
-    rans::encode(x, start[s], f[s], kScaleBits, reversed);
-  }
+  const Coding c = coding_of(normalized(counts, values.size()));
   ByteWriter w;
   w.u8(uint8_t(D));
   w.u8(uint8_t(A));
-  for (uint32_t s = 0; s < A; ++s) w.varint(f[s]);
-  w.varint(4 * kStates + reversed.size());
-  for (uint32_t x : state)
-    for (int b = 0; b < 4; ++b) w.u8(uint8_t(x >> (8 * b)));
-  w.bytes.insert(w.bytes.end(), reversed.rbegin(), reversed.rend());
-  w.raw(raw);
+  for (uint32_t s = 0; s < A; ++s) w.varint(c.f[s]);
+  write_codes(
+      values, symbols, D, [&c](size_t) -> const Coding& { return c; }, w);
   return std::move(w.bytes);
 }
 
-ResidualDecoder::ResidualDecoder(std::span<const uint8_t> stream, const std::string& where) : where_(where) {
+std::vector<uint8_t> encode_paired_residuals(std::span<const uint64_t> values,
+                                             std::span<const uint32_t> counts) {
+  if (values.empty()) return {};
+  using namespace residual_tables;
+  // Each value's context (residual_tables.hpp) and bit length.
+  std::vector<uint8_t> context(values.size()), symbols(values.size());
+  size_t at = 0;
+  for (uint32_t n : counts) {
+    if (2 * uint64_t(n) > values.size() - at) throw Error("residual coder: paired counts past the residuals");
+    std::fill_n(context.begin() + at, n, uint8_t(kFirstContext));
+    for (size_t i = 0; i < n; ++i) context[at + n + i] = uint8_t(context_of(uint8_t(values[at + i])));
+    at += 2 * size_t(n);
+  }
+  if (at != values.size()) throw Error("residual coder: paired counts short of the residuals");
+  // The set coding the values shortest (raw bits are the same under every set), from the symbols' counts
+  // per context (a count a value, where summing each set's code lengths value by value took 8 additions:
+  // refined_elephant's bake 2,084.3 -> 2,071.2 M instructions, callgrind; format 12's 2,059.4).
+  std::array<std::array<uint32_t, kMaxSymbols>, kContexts> histogram{};
+  for (size_t i = 0; i < values.size(); ++i) {
+    const uint32_t k = bit_length(values[i]);
+    if (k > kMaxBits) throw Error("residual coder: a residual of more than 40 bits");
+    symbols[i] = uint8_t(k);
+    ++histogram[context[i]][symbol_of(values[i], k, kDirectBits)];
+  }
+  const std::array<PairedSet, kSets>& sets = paired_sets();
+  std::array<double, kSets> bits{};
+  for (uint32_t set = 0; set < kSets; ++set)
+    for (uint32_t c = 0; c < kContexts; ++c)
+      for (uint32_t s = 0; s < kMaxSymbols; ++s) bits[set] += histogram[c][s] * double(sets[set].bits[c][s]);
+  const uint32_t set = uint32_t(std::min_element(bits.begin(), bits.end()) - bits.begin());
+  ByteWriter w;
+  w.u8(uint8_t(set));
+  write_codes(
+      values, symbols, kDirectBits, [&](size_t i) -> const Coding& { return sets[set].coding[context[i]]; },
+      w);
+  return std::move(w.bytes);
+}
+
+ResidualDecoder::ResidualDecoder(std::span<const uint8_t> stream, const std::string& where, bool paired)
+    : where_(where), paired_(paired) {
   if (stream.empty()) return;  // no values
   ByteReader r(stream, where);
-  const uint32_t D = r.u8(), A = r.u8();
-  if (D < kMinDirect || D > kMaxDirect) r.fail("residual direct bits out of range");
-  direct_bits_ = D;
-  if (A == 0 || A > symbols_for(D)) r.fail("residual table of an invalid size");
-  slot_ = std::make_unique_for_overwrite<uint32_t[]>(kScale + kScale / 4);  // the slots, then the symbols
-  uint8_t* const symbols = reinterpret_cast<uint8_t*>(slot_.get() + kScale);
-  uint32_t sum = 0;
-  for (uint32_t s = 0; s < A; ++s) {
-    const uint64_t f = r.varint();
-    if (f > kScale - sum) r.fail("residual frequencies add up past the scale");
-    rans::fill_slots(slot_.get() + sum, uint32_t(f), uint32_t(f), 16);
-    std::memset(symbols + sum, int(s), f);
-    sum += uint32_t(f);
+  if (paired) {
+    const uint32_t set = r.u8();
+    if (set >= residual_tables::kSets) r.fail("residual table set out of range");
+    direct_bits_ = residual_tables::kDirectBits, slots_ = paired_tables(set);
+  } else {
+    const uint32_t D = r.u8(), A = r.u8();
+    if (D < kMinDirect || D > kMaxDirect) r.fail("residual direct bits out of range");
+    direct_bits_ = D;
+    if (A == 0 || A > symbols_for(D)) r.fail("residual table of an invalid size");
+    own_slots_ = std::make_unique_for_overwrite<uint32_t[]>(kTableWords);
+    if (!fill_table(own_slots_.get(), A, [&r](uint32_t) { return r.varint(); }))
+      r.fail("residual frequencies do not add up to the scale");
+    slots_ = own_slots_.get();
   }
-  if (sum != kScale) r.fail("residual frequencies do not add up to the scale");
   const uint64_t size = r.varint();
   if (size < 4 * kStates || size > r.remaining()) r.fail("residual rANS stream past the stream's end");
   const std::span<const uint8_t> rest = r.bytes(r.remaining(), "residual rANS stream");
@@ -185,13 +308,30 @@ void ResidualDecoder::fail(const char* what) const {
 void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, uint8_t* planes,
                              uint32_t first, uint32_t taken) {
   if (count == 0) return;
-  if (!slot_) fail("residuals past the residual stream's end");
+  if (!slots_) fail("residuals past the residual stream's end");
+  if (paired_ && (components != 2 || first != 0 || taken != 2)) fail("paired residuals of other components");
   const size_t values = taken * count, stride = components * count;  // stride: from one plane to the next
   planes += first * count;
   // The higher planes are zero but for values of raw bits, which write their higher bytes themselves.
   for (uint32_t b = 1; b < width; ++b) std::memset(planes + b * stride, 0, values);
+  const uint64_t largest = width >= 8 ? ~uint64_t(0) : (uint64_t(1) << (8 * width)) - 1;
+  if (!paired_) {
+    decode(planes, values, stride, largest, [slots = slots_](const uint8_t*) { return slots; });
+    return;
+  }
+  // Component 0 with the first context's table, then component 1 with the table of its vertex's component-0
+  // low byte, count bytes back (residual_tables.hpp).
+  const uint32_t* const tables = slots_;
+  decode(planes, count, stride, largest,
+         [first = tables + residual_tables::kFirstContext * kTableWords](const uint8_t*) { return first; });
+  decode(planes + count, count, stride, largest,
+         [tables, count](const uint8_t* out) { return tables + kContextOffset[out[-ptrdiff_t(count)]]; });
+}
+
+template <typename TableOf>
+void ResidualDecoder::decode(uint8_t* planes, size_t values, size_t stride, uint64_t largest,
+                             TableOf table_of) {
   // The decoder's state in locals (registers) for the loop, written back after it; x0 decodes next.
-  const uint32_t* slots = slot_.get();  // then the symbols, at byte 4 * kScale
   const uint8_t* bytes = bytes_.data();
   size_t at = rans_at_;
   uint64_t raw_at = raw_bit_at_;
@@ -199,12 +339,12 @@ void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, 
   const size_t rans_end = rans_end_;
   const uint32_t D = direct_bits_, direct = 1u << D;
   uint32_t x0 = state_[0], x1 = state_[1], x2 = state_[2], x3 = state_[3];
-  const uint64_t largest = width >= 8 ? ~uint64_t(0) : (uint64_t(1) << (8 * width)) - 1;
   // One step (rANS, Duda 2013, eq. 9: D(x) = (s, f_s floor(x / 2^12) + x mod 2^12 - start_s), s the
-  // symbol of slot x mod 2^12), then x read back up to kLow from the next 2 rANS bytes; a value's raw
-  // bits, rare (residual_coder.hpp), take a branch too.
+  // symbol of slot x mod 2^12 of the value's table), then x read back up to kLow from the next 2 rANS bytes;
+  // a value's raw bits, rare (residual_coder.hpp), take a branch too.
   const auto step = [&](uint32_t & x, uint8_t * out) __attribute__((always_inline)) {
-    const size_t slot = x & (kScale - 1);  // 64-bit: the symbol's address is slots + slot + 4 * kScale
+    const uint32_t* slots = table_of(out);  // then the symbols, at byte 4 * kScale
+    const size_t slot = x & (kScale - 1);   // 64-bit: the symbol's address is slots + slot + 4 * kScale
     const uint32_t s = reinterpret_cast<const uint8_t*>(slots)[4 * kScale + slot];
     x = rans::step(x, slots, slot, kScaleBits);
     uint16_t next;
@@ -245,7 +385,7 @@ void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, 
 }
 
 void ResidualDecoder::finish() const {
-  if (!slot_) return;
+  if (!slots_) return;
   bool states_back = true;
   for (uint32_t x : state_) states_back = states_back && x == kLow;
   // Raw bits: up to the last byte, and none set beyond the last one read.

@@ -29,9 +29,32 @@
 // --json`, with page_parts.hpp's 0.2-bit rule): elephant_5m 18,485,383 -> 17,511,877 B (-5.3 %),
 // elephant_1m -4.7 %, refined_elephant -2.9 %, motorBike -2.9 %, bunny -2.6 %, horse -2.3 %, city -2.7 %.
 //
+// Format 13 (helper "restables", 2026-12-03): a page's normal residuals may also be one paired stream
+// (encode_paired_residuals), with no stored tables: component 1 of a vertex is coded with the table of its
+// context, the bit length of the low byte of the same vertex's component 0 (decoded before it), from a set of
+// built-in tables (residual_tables.hpp, learnt on horse and motorBike) that the encoder chooses per stream.
+// Measured first (offline, every page of the format-12 bakes): the stored tables are 0.29-0.48 % of the
+// packages (refined_elephant 1,176 B of 243,982: 711 in positions' streams, 465 in normals'; bunny 672 B,
+// horse 1,256, motorBike 4,936) but for elephant_1m's 1.06 % (29,233 B in 852 streams, 21,543 of them the
+// positions'), and built-in tables without contexts lose more than they save (positions +2.2 %, normals +13.6
+// % on refined_elephant with one table; +0.3 / +1.3 % choosing among 16): a page's scale varies. Offered
+// beside the stream's own table (the smaller kept per stream), 32 built-in order-0 tables would save 272 B on
+// refined_elephant's positions, 1,580 B on elephant_1m's (0.06 %): not built. With contexts: the normals'
+// pair gains 6-8 % (sizes in residual_tables.hpp); for the positions, the previous value's class (a
+// dependency between the four states' chains) and the other components' gained at most 1 % over today's coder
+// (16 sets), nothing was built for them. Packages, format 12 -> 13 (`lodstream bake`): refined_elephant
+// 243,982 -> 241,759 B (-0.91 %), bunny 234,933 -> 232,898 (-0.87 %), elephant_1m 2,769,806 -> 2,746,287
+// (-0.85 %), elephant_5m 10,550,301 -> 10,515,447 (-0.33 %); the training meshes horse -0.81 %, motorBike
+// -0.28 %. Decode (`bench decode --runs 1` under callgrind, whole process): refined_elephant 89.59 -> 90.00 M
+// instructions (+0.46 %: a paired component-1 value's context, a load and an add, and the set's 4 tables
+// built on first use), elephant_1m 1,072.6 -> 1,074.1 M (+0.13 %). A set's 4 tables (80 KB) do not stay in
+// L1 as one table (20 KB) does: the L1 read misses of planes() in refined_elephant's decode, 28.6 k -> 62.7 k
+// (cachegrind, its default caches; 71.3 k with 9 contexts).
+//
 // A stream (no bytes for no values): u8 D (1..6), u8 A (symbols in the table, 1..2^D + 40 - D), A varint
 // frequencies adding up to 2^12, varint size of the rANS bytes, the rANS bytes (the four final states
-// first, u32 LE each; then u16 LE reads), then the raw bits (LSB first, in value order).
+// first, u32 LE each; then u16 LE reads), then the raw bits (LSB first, in value order). A paired stream: u8
+// set (below residual_tables::kSets; D is kDirectBits), then the same from the varint size on.
 #pragma once
 
 #include <cstdint>
@@ -46,18 +69,28 @@ namespace lodstream::package {
 // over a histogram for D.
 std::vector<uint8_t> encode_residuals(std::span<const uint64_t> values);
 
-// Reads a stream of encode_residuals back, in the order written, as byte planes. Every table, size, symbol
-// and bit read is checked: a corrupted or hostile stream throws lodstream::Error starting with `where`, never
-// reads outside its bytes or writes outside the planes asked for.
+// The paired stream (residual_coder.hpp) of `values`: per count n of `counts` in turn, n values of component
+// 0 then the n of component 1 of the same vertices (a page's normal residuals, node by node), each below
+// 2^40; the set is the one whose code lengths add up smallest. Throws lodstream::Error when the counts do not
+// add up to the values. Cost: O(values.size()) and O(kSets * kContexts * kSymbols) for the choice, then a
+// coding pass.
+std::vector<uint8_t> encode_paired_residuals(std::span<const uint64_t> values,
+                                             std::span<const uint32_t> counts);
+
+// Reads a stream of encode_residuals (or, paired, of encode_paired_residuals) back, in the order written, as
+// byte planes. Every table, size, symbol and bit read is checked: a corrupted or hostile stream throws
+// lodstream::Error starting with `where`, never reads outside its bytes or writes outside the planes asked
+// for.
 class ResidualDecoder {
  public:
-  // Parses the table. Cost: O(2^12) (the decode table, 16 KB) and a copy of the stream.
-  ResidualDecoder(std::span<const uint8_t> stream, const std::string& where);
+  // Parses the table (a paired stream's set when `paired`). Cost: O(2^12) (the decode table, 20 KB; a paired
+  // stream's built-in tables once per set and process) and a copy of the stream.
+  ResidualDecoder(std::span<const uint8_t> stream, const std::string& where, bool paired = false);
   // The next count * taken values, components first .. first + taken - 1 of `components` one after the
   // other, as `width` byte planes (put_planes' layout: byte b of component a of value i at
   // planes[(b * components + a) * count + i]; the other components' planes are left as they are); a value
-  // needing more than `width` bytes throws. Cost: O(count * taken * width); about 25 instructions a direct
-  // value.
+  // needing more than `width` bytes throws; a paired stream's only components are 0 and 1 of 2, taken
+  // together. Cost: O(count * taken * width); about 25 instructions a direct value.
   void planes(size_t count, uint32_t components, uint32_t width, uint8_t* planes, uint32_t first,
               uint32_t taken);
   void planes(size_t count, uint32_t components, uint32_t width, uint8_t* planes) {
@@ -68,15 +101,22 @@ class ResidualDecoder {
 
  private:
   [[noreturn]] void fail(const char* what) const;
+  // Decodes the next `values` values into planes[0 .. values) (their higher bytes `stride` apart), value at
+  // `out` with the decode table table_of(out); `largest` is the largest value the planes hold.
+  template <typename TableOf>
+  void decode(uint8_t* planes, size_t values, size_t stride, uint64_t largest, TableOf table_of);
 
   std::string where_;
-  // Per slot of 2^12 (null for no stream): bits 0-15 its symbol's frequency, 16-31 the slot minus the
-  // symbol's start; and apart, its symbol (a step takes each with one instruction: 3 fewer a value than with
-  // the symbol in the same word). Allocated without zero-filling: the constructor writes every slot or throws
-  // (zero-filling 2^12 slots for every page part took ~0.9 % of elephant_1m's decode instructions). The
-  // symbols (2^12 bytes) follow the slots in the same allocation, so that the decode loop reaches both from
-  // one register (two took one register too many: the loop reloaded them from the stack, two loads a value).
-  std::unique_ptr<uint32_t[]> slot_;
+  bool paired_ = false;
+  // The decode table (null for no stream), or a paired stream's set's kContexts tables one after the other:
+  // per slot of 2^12, bits 0-15 its symbol's frequency, 16-31 the slot minus the symbol's start; and apart,
+  // its symbol (a step takes each with one instruction: 3 fewer a value than with the symbol in the same
+  // word). The symbols (2^12 bytes) follow the slots, so that the decode loop reaches both from one register
+  // (two took one register too many: the loop reloaded them from the stack, two loads a value).
+  const uint32_t* slots_ = nullptr;
+  // The table of a stream with its own, allocated without zero-filling: the constructor writes every slot or
+  // throws (zero-filling 2^12 slots for every page part took ~0.9 % of elephant_1m's decode instructions).
+  std::unique_ptr<uint32_t[]> own_slots_;
   uint32_t direct_bits_ = 0;  // D
   // The rANS bytes then the raw bits, followed by 8 zero bytes, so that reads a few bytes past the rANS
   // bytes' end stay in the buffer (the decoder checks after each block of 4 values that they were not used)

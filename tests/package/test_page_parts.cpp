@@ -6,11 +6,13 @@
 #include <random>
 
 #include "core/error.hpp"
+#include "package/byte_planes.hpp"
 #include "package/bytes.hpp"
 #include "package/format.hpp"
 #include "package/meshopt_codec.hpp"
 #include "package/page_parts.hpp"
 #include "package/predictive_codec.hpp"
+#include "package/residual_coder.hpp"
 #include "package/traversal_codec.hpp"
 #include "package_fixture.hpp"
 #include "support/expect_error.hpp"
@@ -92,6 +94,25 @@ TEST_P(PageParts, RoundTripByPartAndNoLargerThanWhole) {
   }
 }
 
+// Regrouped bytes `plain` with part p (1 positions, 2 normals) replaced by the form byte
+// `form` and `bytes`, and where that part's form byte lies.
+std::pair<std::vector<uint8_t>, size_t> with_part(std::span<const uint8_t> plain, size_t p, uint8_t form,
+                                                  std::span<const uint8_t> bytes) {
+  ByteReader r(plain, "test");
+  uint64_t size[7];
+  for (uint64_t& s : size) s = r.varint();
+  const size_t at = form_at(plain, p);
+  size[p] = 1 + bytes.size();
+  ByteWriter w;
+  for (uint64_t s : size) w.varint(s);
+  const size_t out_at = w.bytes.size() + (at - r.position());
+  w.raw(plain.subspan(r.position(), at - r.position()));
+  w.u8(form);
+  w.raw(bytes);
+  w.raw(plain.subspan(form_at(plain, p + 1)));
+  return {std::move(w.bytes), out_at};
+}
+
 TEST(PageParts, NoisyResidualsAreStoredCodedAndSmaller) {
   for (uint32_t id : {PredictiveCodec::kId, TraversalCodec::kId}) {  // the byte-plane codecs
     const NodeCodec& codec = node_codec(id);
@@ -102,6 +123,60 @@ TEST(PageParts, NoisyResidualsAreStoredCodedAndSmaller) {
     // spread so evenly here that the coded form saves under kMinSavedBits on them: either form.
     EXPECT_GE(residual_forms(content(stored)).first, 1u) << "codec " << id;  // coded, one stream or split
     EXPECT_LT(stored.size(), zstd_compress(page.bytes, 9, 6).size());
+  }
+}
+
+// The regrouped bytes of the noisy sphere's page by codec 3 with its normals' part in the paired form
+// (residual_coder.hpp; the writer keeps it on scans, not on the sphere, whose normals zstd stores in fewer
+// bytes), and where that part's form byte lies.
+std::pair<std::vector<uint8_t>, size_t> paired_normals(const Page& page) {
+  const NodeCodec& codec = node_codec(TraversalCodec::kId);
+  const std::vector<uint8_t> plain = content(compress_page(page.bytes, page.node_sizes, codec, 9, 6));
+  const size_t at = form_at(plain, 2);
+  EXPECT_EQ(plain[at], 0u);
+  // The nodes' normal planes, one after the other in the part, as residuals (node by node, component 0
+  // then component 1).
+  std::vector<uint64_t> values;
+  std::vector<uint32_t> counts;
+  size_t node_at = 0, planes_at = at + 1;
+  for (uint32_t node_size : page.node_sizes) {
+    const NodeSizeBreakdown b = codec.breakdown(std::span(page.bytes).subspan(node_at, node_size), "test");
+    const size_t count = b.normal_low / 2;
+    std::vector<int64_t> residuals(2 * count);
+    if (count)
+      read_planes(plain.data() + planes_at, count, 2, uint32_t(b.normals / b.normal_low), residuals.data());
+    for (int64_t v : residuals) values.push_back(zigzag(v));
+    counts.push_back(uint32_t(count)), node_at += node_size, planes_at += b.normals;
+  }
+  EXPECT_EQ(planes_at, form_at(plain, 3));
+  return with_part(plain, 2, 3, encode_paired_residuals(values, counts));
+}
+
+// The normals' part in the paired form decodes back; a set out of range is an error, and so is the paired
+// form in the positions' part.
+TEST(PageParts, NormalsInThePairedFormDecodeBack) {
+  const NodeCodec& codec = node_codec(TraversalCodec::kId);
+  const Page page = sphere_page(codec, 0.01f);
+  const uint32_t raw_size = uint32_t(page.bytes.size());
+  const auto [good, at] = paired_normals(page);
+  auto unpack = [&](const std::vector<uint8_t>& regrouped) {
+    return decompress_page(zstd_compress(regrouped, 1), raw_size, codec, "page 7");
+  };
+  EXPECT_EQ(unpack(good), page.bytes);
+  std::vector<uint8_t> bad = good;
+  bad[at + 1] = 8;  // the set: residual_tables::kSets
+  expect_error_naming("page 7", "set out of range", [&] { unpack(bad); });
+  bad = good;
+  bad[form_at(good, 1)] = 3;
+  expect_error_naming("page 7", "positions in the paired form", [&] { unpack(bad); });
+  std::mt19937 rng(11);
+  for (int i = 0; i < 400; ++i) {
+    bad = good;
+    for (int k = 0; k < 1 + i % 3; ++k) bad[at + 1 + rng() % (form_at(good, 3) - at - 1)] = uint8_t(rng());
+    try {
+      EXPECT_EQ(unpack(bad).size(), raw_size);
+    } catch (const Error&) {
+    }
   }
 }
 

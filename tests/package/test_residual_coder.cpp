@@ -1,14 +1,18 @@
 // The residual coder (package/residual_coder.hpp): streams decode back to the planes put_planes writes,
-// mostly-zero residuals cost well under a bit each, and corrupted or hostile streams are errors, never reads
-// or writes out of bounds.
+// mostly-zero residuals cost well under a bit each, paired streams (built-in tables, component 1 in the
+// context of component 0) decode back and code pairs of related scale smaller than one table of their own,
+// and corrupted or hostile streams are errors, never reads or writes out of bounds.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 #include <set>
 
 #include "core/error.hpp"
 #include "package/byte_planes.hpp"
 #include "package/residual_coder.hpp"
+#include "package/residual_tables.hpp"
 #include "support/expect_error.hpp"
 
 namespace lodstream::test {
@@ -191,6 +195,129 @@ TEST(ResidualCoder, CorruptedStreamsAreErrorsNeverOutOfBounds) {
     for (int k = 0; k < 1 + i % 3; ++k) bad[rng() % bad.size()] = uint8_t(rng());
     try {
       EXPECT_EQ(decoded_planes(bad, r).size(), planes.size());  // wrong values, right size: possible
+    } catch (const Error&) {
+    }
+  }
+}
+
+// Pairs as a page's normal residuals hold them (node by node, component 0 then component 1), drawn from the
+// built-in set `set` (residual_tables.hpp): component 0 from its first context's table, component 1 from the
+// table of its vertex's component 0's context, a value of a raw-bits symbol uniform among its bit length's;
+// nodes of 1- and 2-byte planes (values that do not fit are drawn again).
+struct Pairs {
+  std::vector<uint32_t> counts, widths;
+  std::vector<uint64_t> values;
+};
+Pairs drawn_pairs(uint32_t seed, uint32_t set) {
+  using namespace residual_tables;
+  std::mt19937_64 rng(seed);
+  auto draw = [&](uint32_t context, uint32_t width) {
+    const uint16_t* f = kFrequencies[set][context];
+    for (;;) {
+      uint32_t slot = uint32_t(rng() % 4096), s = 0;
+      while (slot >= f[s]) slot -= f[s++];
+      if (s < (1u << kDirectBits)) return uint64_t(s);
+      const uint32_t k = s - (1u << kDirectBits) + kDirectBits + 1;  // the bit length
+      if (k > 8 * width) continue;
+      return uint64_t(1) << (k - 1) | (rng() & ((uint64_t(1) << (k - 1)) - 1));
+    }
+  };
+  Pairs r;
+  for (uint32_t node = 0; node < 10; ++node) {
+    const uint32_t count = 1 + uint32_t(rng() % 400), width = 1 + node % 2;
+    r.counts.push_back(count), r.widths.push_back(width);
+    const size_t at = r.values.size();
+    for (uint32_t i = 0; i < count; ++i) r.values.push_back(draw(kFirstContext, width));
+    for (uint32_t i = 0; i < count; ++i)
+      r.values.push_back(draw(context_of(uint8_t(r.values[at + i])), width));
+  }
+  return r;
+}
+
+std::vector<uint8_t> expected_pair_planes(const Pairs& r) {
+  std::vector<uint8_t> out;
+  size_t at = 0;
+  for (size_t node = 0; node < r.counts.size(); ++node) {
+    const size_t n = r.counts[node];
+    std::vector<uint64_t> records(2 * n);
+    for (size_t i = 0; i < n; ++i)
+      records[2 * i] = r.values[at + i], records[2 * i + 1] = r.values[at + n + i];
+    put_planes(out, records, 2, r.widths[node]);
+    at += 2 * n;
+  }
+  return out;
+}
+
+std::vector<uint8_t> decoded_pair_planes(std::span<const uint8_t> stream, const Pairs& r) {
+  ResidualDecoder decoder(stream, "stream 5", true);
+  std::vector<uint8_t> out;
+  for (size_t node = 0; node < r.counts.size(); ++node) {
+    const size_t at = out.size();
+    out.resize(at + 2 * r.counts[node] * r.widths[node], 0xa5);  // every byte written over
+    decoder.planes(r.counts[node], 2, r.widths[node], out.data() + at);
+  }
+  decoder.finish();
+  return out;
+}
+
+// The built-in tables are what residual_tables.hpp says: each adds up to 2^12 and codes every symbol.
+TEST(ResidualCoder, BuiltInTablesAddUpToTheScaleAndCodeEverySymbol) {
+  using namespace residual_tables;
+  for (uint32_t set = 0; set < kSets; ++set)
+    for (uint32_t c = 0; c < kContexts; ++c) {
+      uint32_t sum = 0;
+      for (uint32_t s = 0; s < kSymbols; ++s) {
+        EXPECT_GE(kFrequencies[set][c][s], 1u) << set << " " << c << " " << s;
+        sum += kFrequencies[set][c][s];
+      }
+      EXPECT_EQ(sum, 4096u) << set << " " << c;
+    }
+}
+
+TEST(ResidualCoder, PairedStreamsDecodeToThePlanesAndCodeRelatedPairsSmaller) {
+  for (uint32_t set = 0; set < residual_tables::kSets; ++set) {
+    const Pairs r = drawn_pairs(set, set);
+    const std::vector<uint8_t> paired = encode_paired_residuals(r.values, r.counts);
+    EXPECT_EQ(paired[0], set);  // the set the values follow codes them shortest
+    EXPECT_EQ(decoded_pair_planes(paired, r), expected_pair_planes(r)) << "set " << set;
+    // Component 1's table follows component 0 (its context), which one table of the stream's own cannot.
+    EXPECT_LT(double(paired.size()), 0.97 * double(encode_residuals(r.values).size())) << "set " << set;
+  }
+  EXPECT_TRUE(encode_paired_residuals({}, {}).empty());
+  const std::vector<uint64_t> three = {1, 2, 3};
+  EXPECT_THROW(encode_paired_residuals(three, std::vector<uint32_t>{1}), Error);  // counts short of values
+  EXPECT_THROW(encode_paired_residuals(three, std::vector<uint32_t>{2}), Error);  // counts past them
+}
+
+TEST(ResidualCoder, CorruptedPairedStreamsAreErrorsNeverOutOfBounds) {
+  const Pairs r = drawn_pairs(7, 3);
+  const std::vector<uint8_t> good = encode_paired_residuals(r.values, r.counts);
+  auto expect_error = [&](const std::vector<uint8_t>& stream, const char* what) {
+    expect_error_naming("stream 5", what, [&] { decoded_pair_planes(stream, r); });
+  };
+  for (size_t n = 0; n < good.size(); n += 1 + n / 64)
+    expect_error(std::vector<uint8_t>(good.begin(), good.begin() + n), "a prefix");
+  std::vector<uint8_t> bad = good;
+  bad.push_back(0);
+  expect_error(bad, "a byte too many");
+  for (uint32_t set : {residual_tables::kSets, 255u}) {
+    bad = good;
+    bad[0] = uint8_t(set);
+    expect_error(bad, "table set");
+  }
+  // A paired stream is read as pairs only: other components are an error.
+  std::vector<uint8_t> out(3 * r.widths[0] * r.counts[0]);
+  ResidualDecoder decoder(good, "stream 5", true);
+  EXPECT_THROW(decoder.planes(r.counts[0], 3, r.widths[0], out.data()), Error);
+  EXPECT_THROW(decoder.planes(r.counts[0], 2, r.widths[0], out.data(), 1, 1), Error);
+
+  const size_t size = expected_pair_planes(r).size();
+  std::mt19937 rng(5);
+  for (int i = 0; i < 2000; ++i) {
+    bad = good;
+    for (int k = 0; k < 1 + i % 3; ++k) bad[rng() % bad.size()] = uint8_t(rng());
+    try {
+      EXPECT_EQ(decoded_pair_planes(bad, r).size(), size);  // wrong values, right size: possible
     } catch (const Error&) {
     }
   }
