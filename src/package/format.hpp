@@ -38,8 +38,9 @@ inline constexpr std::array<uint8_t, 8> kMagic = {0x89, 'L', 'O', 'D', 'S', '\r'
 // kind's rank in the gate's context of decoded triangles (traversal_connectivity.hpp, ranked symbols); index
 // records without vertex counts, a node's own sphere coded against its parents', parents implied by the run's
 // children lists, repeated children lists as references, range tables as offset deltas and varints
-// (index.hpp).
-inline constexpr uint32_t kFormatVersion = 12;
+// (index.hpp); 13: spheres that do not fit their parents' on their grid rounded on the cell's corners or
+// the next grid (pair_rounding.hpp).
+inline constexpr uint32_t kFormatVersion = 13;
 inline constexpr size_t kHeaderSize = 64;
 
 // Hard limits a reader enforces before allocating: no valid writer output exceeds them.
