@@ -86,7 +86,7 @@ std::vector<NodeRecord> nested(int levels) {
 
 TEST(PairRounding, APairOfErrorZeroIsRoundedOnTheCoarserGrid) {
   // Two finest nodes (error 0) under one parents' pair, and that parents' own node: the finest nodes' own
-  // spheres on the grid of 2^(ilogb r - kZeroErrorSphereGridBits), the parents' on 2^(ilogb r -
+  // spheres on the grid of 2^(ilogb r - 2) (kZeroErrorSphereGridBits), the parents' on 2^(ilogb r -
   // kSphereGridBits); each contains its exact sphere and lies inside its parents'.
   std::vector<NodeRecord> nodes(3);
   const Sphere parents{{0.1234567f, -0.7654321f, 0.3141593f}, 0.9876543f};
@@ -109,7 +109,7 @@ TEST(PairRounding, APairOfErrorZeroIsRoundedOnTheCoarserGrid) {
   };
   for (int i = 1; i <= 2; ++i) {
     const NodeRecord& n = nodes[size_t(i)];
-    EXPECT_TRUE(on_grid(n.sphere, std::ilogb(exact[i - 1].radius) - kZeroErrorSphereGridBits)) << i;
+    EXPECT_TRUE(on_grid(n.sphere, std::ilogb(exact[i - 1].radius) - 2)) << i;  // a quarter of 2^ilogb r
     EXPECT_TRUE(sphere_contains(n.sphere, exact[i - 1], 0.0)) << i;
     EXPECT_TRUE(sphere_contains(n.parent_sphere, n.sphere, 0.0)) << i;
   }
