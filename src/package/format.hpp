@@ -39,7 +39,8 @@ inline constexpr std::array<uint8_t, 8> kMagic = {0x89, 'L', 'O', 'D', 'S', '\r'
 // records without vertex counts, a node's own sphere coded against its parents', parents implied by the run's
 // children lists, repeated children lists as references, range tables as offset deltas and varints
 // (index.hpp); 13: spheres that do not fit their parents' on their grid rounded on the cell's corners or
-// the next grid (pair_rounding.hpp).
+// the next grid (pair_rounding.hpp), a representation's grid origin not stored when it is its bounds'
+// minimum (index.cpp, kGridOriginAtBoundsMin).
 inline constexpr uint32_t kFormatVersion = 13;
 inline constexpr size_t kHeaderSize = 64;
 
