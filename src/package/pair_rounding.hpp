@@ -7,9 +7,9 @@
 //   - a rounded sphere contains the exact one (decoded vertices, HLOD objects' bounds stay inside);
 //   - a node's sphere stays inside its parents' sphere: a pair's rounded sphere is kept only when it lies
 //     inside the final sphere of every pair that is its parents' pair somewhere (when it does not: its
-//     centre on the other corners of its grid cell, without the step of margin, then each grid twice as
-//     fine, down to 2^9 times finer); else the exact sphere is kept, which the parents' final sphere
-//     contains (it contains their exact one, which contained it);
+//     centre on the corners of its grid cell, then the same without the step of margin, then each grid
+//     twice as fine, down to 2^-15 of the radius); else the exact sphere is kept, which the parents' final
+//     sphere contains (it contains their exact one, which contained it);
 //   - a node's parents' pair stays bit-for-bit its parents' own pair (rounding is per distinct pair).
 // Pairs of roots (a node without parents, and the +infinity parents' pair of a root) keep their exact
 // spheres: other representations' proxies (HLOD) are built to contain them.
