@@ -6,9 +6,10 @@
 //   - errors stay monotonic (rounding up to 16 bits is a non-decreasing function of the error);
 //   - a rounded sphere contains the exact one (decoded vertices, HLOD objects' bounds stay inside);
 //   - a node's sphere stays inside its parents' sphere: a pair's rounded sphere is kept only when it lies
-//     inside the final sphere of every pair that is its parents' pair somewhere (tried on grids 8, 64 and
-//     512 times finer when it does not); else the exact sphere is kept, which the parents' final sphere
-//     contains (it contains their exact one, which contained it);
+//     inside the final sphere of every pair that is its parents' pair somewhere (when it does not: its
+//     centre on the corners of its grid cell, then the same without the step of margin, then each grid
+//     twice as fine, down to 2^-15 of the radius); else the exact sphere is kept, which the parents' final
+//     sphere contains (it contains their exact one, which contained it);
 //   - a node's parents' pair stays bit-for-bit its parents' own pair (rounding is per distinct pair).
 // Pairs of roots (a node without parents, and the +infinity parents' pair of a root) keep their exact
 // spheres: other representations' proxies (HLOD) are built to contain them.
@@ -32,13 +33,15 @@ namespace lodstream::package {
 inline constexpr int kSphereGridBits = 6;
 // The grid of a pair of error 0 (a finest node's own: drawn whenever its parents are not, so its sphere
 // serves frustum culling and screen-area weights, never a screen error); finer grids follow as for any pair.
-// Why 3 (sizeindex, measured on format 12: bake, render --pixel-error 1 from bench/compare-binaries'
-// cameras): at 6 (as any pair) / 4 / 3 / 2 refined_elephant's index pages are 7,583 / 6,869 / 6,769 / 6,765 B
-// (at 2 most spheres no longer fit their parents' and fall back to finer grids); at 3 the city's index
-// 524,929 -> 433,663 B; refined_elephant's near / mid / far cuts (67,076 / 33,522 / 18,138 triangles) and the
-// city's city_0 / 12 / 24 cuts (91,686 / 189,764 / 212,549) and PSNR unchanged. Growth of a finest sphere: at
-// most about 3 x 2^-3.
-inline constexpr int kZeroErrorSphereGridBits = 3;
+// Why 2 (idxsize, format 13, with the cell's corners and every grid tried as pair_rounding.cpp's decide
+// does; sizeindex on format 12 had found 3 / 2 equal, 6,769 / 6,765 B, when most spheres at 2 fell back
+// to a grid 2^3 times finer): at 3 / 2 / 1 refined_elephant's index pages are 5,743 / 5,509 / 5,501 B,
+// elephant_1m's 122,602 / 119,141 / 117,046 B, the city's at 3 / 2 382,141 / 372,308 B; at 2 the 1 px
+// renders of refined_elephant, bunny, horse, motorBike, elephant_1m and the city (three cameras each) are
+// the same images as at 3, and bench stream's times to benefit 0.95 (elephant_1m, motorBike, city) the
+// same. A finest sphere's radius at 2 is 1.11x its radius at 3 on average (elephant_1m, city; at most
+// 1.40x); its growth over the exact sphere at most about 3 x 2^-2.
+inline constexpr int kZeroErrorSphereGridBits = 2;
 
 // e rounded up to a float whose low 8 mantissa bits are zero (16 significant bits): relative change below
 // 2^-15. 0, +infinity and values that would round to infinity are returned unchanged.

@@ -4,6 +4,8 @@
 // original content; never a crash (this test also runs under AddressSanitizer, see the package report).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -290,6 +292,32 @@ TEST_P(Corruption, ARangeStoredAfterTheLastTakesElevenBytes) {
   const Range& last = r.pages.back();
   r.pages.push_back(Range{last.offset + last.size, 100, 120, 0x0123456789abcdefull});
   EXPECT_EQ(serialize_root(r).size() - before, 11u);
+}
+
+TEST_P(Corruption, ARepresentationWhoseGridStartsAtItsBoundsMinimumStoresNoOrigin) {
+  // The kind byte's bit 7 stands for the grid origin's 12 bytes; either form parses back bit for bit.
+  RootIndex r = root;
+  Representation& rep = r.scene.representations[0];
+  rep.grid.origin = rep.bounds.min;
+  const std::vector<uint8_t> implied = serialize_root(r);
+  EXPECT_EQ(parse_root(implied, "implied").scene.representations[0].grid.origin, rep.bounds.min);
+  rep.grid.origin = rep.bounds.min - glm::vec3(0.25f, 0.0f, -0.5f);
+  const std::vector<uint8_t> stored = serialize_root(r);
+  EXPECT_EQ(stored.size() - implied.size(), 12u);
+  EXPECT_EQ(parse_root(stored, "stored").scene.representations[0].grid.origin, rep.grid.origin);
+}
+
+TEST_P(Corruption, UnknownRepresentationKindBitsAreErrors) {
+  RootIndex r = root;
+  r.scene.representations[0].name = "kind probe";
+  std::vector<uint8_t> raw = serialize_root(r);
+  const std::string name = "kind probe";
+  const auto at = std::search(raw.begin(), raw.end(), name.begin(), name.end());
+  ASSERT_NE(at, raw.end());
+  *(at - 2) |= 0x40;  // the kind byte, before the name's length
+  std::string message;
+  EXPECT_EQ(outcome(with_raw_root(raw), &message), Outcome::error);
+  EXPECT_NE(message.find("representation kind"), std::string::npos) << message;
 }
 
 TEST_P(Corruption, HandWrittenRangesOutsideTheFileAreErrors) {

@@ -86,7 +86,7 @@ std::vector<NodeRecord> nested(int levels) {
 
 TEST(PairRounding, APairOfErrorZeroIsRoundedOnTheCoarserGrid) {
   // Two finest nodes (error 0) under one parents' pair, and that parents' own node: the finest nodes' own
-  // spheres on the grid of 2^(ilogb r - kZeroErrorSphereGridBits), the parents' on 2^(ilogb r -
+  // spheres on the grid of 2^(ilogb r - 2) (kZeroErrorSphereGridBits), the parents' on 2^(ilogb r -
   // kSphereGridBits); each contains its exact sphere and lies inside its parents'.
   std::vector<NodeRecord> nodes(3);
   const Sphere parents{{0.1234567f, -0.7654321f, 0.3141593f}, 0.9876543f};
@@ -109,12 +109,46 @@ TEST(PairRounding, APairOfErrorZeroIsRoundedOnTheCoarserGrid) {
   };
   for (int i = 1; i <= 2; ++i) {
     const NodeRecord& n = nodes[size_t(i)];
-    EXPECT_TRUE(on_grid(n.sphere, std::ilogb(exact[i - 1].radius) - kZeroErrorSphereGridBits)) << i;
+    EXPECT_TRUE(on_grid(n.sphere, std::ilogb(exact[i - 1].radius) - 2)) << i;  // a quarter of 2^ilogb r
     EXPECT_TRUE(sphere_contains(n.sphere, exact[i - 1], 0.0)) << i;
     EXPECT_TRUE(sphere_contains(n.parent_sphere, n.sphere, 0.0)) << i;
   }
   EXPECT_TRUE(on_grid(nodes[0].sphere, std::ilogb(parents.radius) - kSphereGridBits));
   EXPECT_FALSE(on_grid(nodes[0].sphere, std::ilogb(parents.radius) - kZeroErrorSphereGridBits));
+}
+
+TEST(PairRounding, ASphereThatDoesNotFitOnItsGridTriesTheCellsCornersThenTheNextGrid) {
+  // A node whose sphere is `slack` inside its parents' rounded sphere: the nearest grid point with a step of
+  // margin (round_sphere_out) leaves the parents' sphere on its coarsest grid, so the rounding takes a corner
+  // of the grid cell or no margin there (slack 0.0065), else the next grid (slack 0.0015), not the grid 2^3
+  // times finer that the rounding went to before (a few bits more a coordinate).
+  const Sphere parents{{0.1234567f, -0.7654321f, 0.3141593f}, 0.9876543f};
+  const Sphere rounded_parents = round_sphere_out(parents);
+  const glm::vec3 direction = glm::normalize(glm::vec3(0.6f, -0.3f, 0.74f));
+  const float radius = 0.4321987f;
+  for (const auto [slack, grid_bits] :
+       {std::pair{0.0065f, kSphereGridBits}, std::pair{0.0015f, kSphereGridBits + 1}}) {
+    SCOPED_TRACE("slack " + std::to_string(slack));
+    const Sphere exact{rounded_parents.center + direction * (rounded_parents.radius - radius - slack),
+                       radius};
+    ASSERT_FALSE(sphere_contains(rounded_parents, round_sphere_out(exact), 0.0));
+    std::vector<NodeRecord> nodes(2);
+    nodes[0].error = 0.01f, nodes[0].sphere = parents, nodes[0].children = {1};
+    nodes[0].parents = {7}, nodes[0].parent_error = 0.5f, nodes[0].parent_sphere = {{0.0f, 0.0f, 0.0f}, 4.0f};
+    nodes[1].error = 0.001f, nodes[1].sphere = exact, nodes[1].parents = {0};
+    nodes[1].parent_error = nodes[0].error, nodes[1].parent_sphere = parents;
+    round_pairs(nodes);
+    const Sphere& s = nodes[1].sphere;
+    const int exponent = std::ilogb(radius) - grid_bits;
+    for (int a = 0; a < 3; ++a)
+      EXPECT_EQ(std::ldexp(double(s.center[a]), -exponent),
+                std::floor(std::ldexp(double(s.center[a]), -exponent)))
+          << a;
+    EXPECT_EQ(std::ldexp(double(s.radius), -exponent), std::floor(std::ldexp(double(s.radius), -exponent)));
+    EXPECT_TRUE(sphere_contains(s, exact, 0.0));
+    EXPECT_EQ(nodes[0].sphere.radius, rounded_parents.radius);
+    EXPECT_TRUE(sphere_contains(nodes[1].parent_sphere, s, 0.0));
+  }
 }
 
 TEST(PairRounding, TightlyNestedPairsKeepEveryInvariant) {
