@@ -41,8 +41,8 @@ inline constexpr std::array<uint8_t, 8> kMagic = {0x89, 'L', 'O', 'D', 'S', '\r'
 // (index.hpp); 13: a record's traversal symbols one rANS stream under fixed tables, decoded inside the
 // traversal by the gate's context (traversal_connectivity.hpp, traversal_tables.hpp); no connectivity form
 // byte in pages (page_parts.hpp); normal residuals may be one paired stream of built-in tables, component 1
-// in the context of component 0 (page_parts.hpp's paired form, residual_coder.hpp); spheres that do not fit their
-// parents' on their grid rounded on the cell's corners or the next grid (pair_rounding.hpp), a
+// in the context of component 0 (page_parts.hpp's paired form, residual_coder.hpp); spheres that do not fit
+// their parents' on their grid rounded on the cell's corners or the next grid (pair_rounding.hpp), a
 // representation's grid origin not stored when it is its bounds' minimum (index.cpp, kGridOriginAtBoundsMin).
 inline constexpr uint32_t kFormatVersion = 13;
 inline constexpr size_t kHeaderSize = 64;

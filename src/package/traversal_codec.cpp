@@ -51,8 +51,8 @@ std::vector<uint8_t> TraversalCodec::encode(const NodeGeometry& g, const Positio
   const uint32_t T = uint32_t(n.indices.size() / 3);
   std::vector<uint32_t> indices(n.indices.size()), predictors(3 * (size_t(V) + 1));
   Parallelograms extra;
-  decode_traversal(code.symbols, code.references, T, V, indices.data(),
-                   predictors.data(), "node codec", g.cluster_triangles, &extra);
+  decode_traversal(code.symbols, code.references, T, V, indices.data(), predictors.data(), "node codec",
+                   g.cluster_triangles, &extra);
   return write_predictive_node(
       NodeHeader::of(kFormat, flags, g, n),
       predictive_residuals(g, n, code.predictors, predictors, &extra, n.indices, locked_stream, grid),
@@ -85,8 +85,8 @@ void TraversalCodec::decode_into(std::span<const uint8_t> bytes, const PositionG
   predictors.resize(3 * (size_t(V) + 1));
   thread_local Parallelograms extra;
   Parallelograms* const multi = p.flags & kMultiParallelogram ? &extra : nullptr;
-  decode_traversal(p.connectivity, p.tail, p.triangles, V, out.mesh.indices.data(),
-                   predictors.data(), where, p.cluster_triangles, multi);
+  decode_traversal(p.connectivity, p.tail, p.triangles, V, out.mesh.indices.data(), predictors.data(), where,
+                   p.cluster_triangles, multi);
   decode_predicted_vertices(p, predictors, multi, grid, out, where);
   out.cluster_triangles = p.cluster_triangles;
 }

@@ -40,15 +40,16 @@
 // Ranked symbols (format 12; format 13 codes the kind itself under the same gate context, below): bits 0-2
 // of a symbol byte held not the kind but its rank in the gate's context, the kinds ordered by their
 // frequency after gates a -> b where a lies in min(t_a, 7) and b in min(t_b, 7) decoded triangles (t
-// counted as the triangles arrive, by encoder and decoder alike; a fixed table of 64 orders). A vertex that already holds most of a fan's triangles is
-// about to close it (the valence insight of Touma & Gotsman 1998 and Alliez & Desbrun 2001, "Valence-driven
-// connectivity encoding for 3D meshes"): at level 0 of refined_elephant a gate (2, 5) turns right 98 % of
-// the time, a gate (4, 3) takes a new vertex 97 %, a gate (5, 1) turns left 86 %, a gate (6, 6) is a
-// border 100 %. The page's symbol coder (symbol_coder.hpp) then codes ranks, mostly 0, under the previous
-// rank. Measured offline first (order-0 entropy of the classes, aggregated per level, table costs not
-// counted; the table learnt on horse and motorBike): under the previous class, then the previous rank,
-// then (t_a, t_b) alone, bits a symbol: refined_elephant level 0 1.558 / 0.871 / 0.742, levels >= 1 2.253
-// / 2.104 / 1.890; bunny 1.865 / 1.308 / 1.220 and 2.226 / 2.183 / 1.983. Packages, format 11 -> 12
+// counted as the triangles arrive, by encoder and decoder alike; a fixed table of 64 orders). A vertex that
+// already holds most of a fan's triangles is about to close it (the valence insight of Touma & Gotsman 1998
+// and Alliez & Desbrun 2001, "Valence-driven connectivity encoding for 3D meshes"): at level 0 of
+// refined_elephant a gate (2, 5) turns right 98 % of the time, a gate (4, 3) takes a new vertex 97 %, a gate
+// (5, 1) turns left 86 %, a gate (6, 6) is a border 100 %. The page's symbol coder (format 12; gone in 13)
+// then codes ranks, mostly 0, under the previous rank. Measured offline first (order-0 entropy of the
+// classes, aggregated per level, table costs not counted; the table learnt on horse and motorBike): under the
+// previous class, then the previous rank, then (t_a, t_b) alone, bits a symbol: refined_elephant level
+// 0 1.558 / 0.871 / 0.742, levels >= 1 2.253 / 2.104 / 1.890; bunny 1.865 / 1.308 / 1.220 and 2.226 / 2.183
+// / 1.983. Packages, format 11 -> 12
 // (`lodstream bake --json`; decoded nodes and 1 px renders identical): refined_elephant 256,618 -> 247,049 B
 // (-3.7 %; level-0 connectivity 0.25 -> 0.16 B a stored triangle, levels 1-2 0.38 / 0.43 -> 0.35 / 0.42),
 // elephant_1m 2,898,959 -> 2,808,434 (-3.1 %), elephant_5m 11,027,977 -> 10,705,624 (-2.9 %), motorBike
