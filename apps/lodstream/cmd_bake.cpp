@@ -76,7 +76,7 @@ using namespace package;
 // Meshes of at most this many triangles become progressive meshes (hierarchy/progressive_steps.hpp), larger
 // ones cluster DAGs. Why 2048: as a DAG such a mesh is 16 clusters, 3-4 levels and about 2 x 2048 stored
 // triangles (1.67 x since the group ratio is 0.4; the figures below were measured at 0.5), ~20 KB encoded:
-// less than one 48 KB page, so the DAG's per-cluster selection buys nothing (a page is what travels), while a
+// less than one 40 KB page, so the DAG's per-cluster selection buys nothing (a page is what travels), while a
 // progressive mesh stores each triangle once and streams it in about 3 steps (base, then doubling). Measured
 // (bench stream gen:fly, 10 Mbit/s 80 ms, push time to benefit 0.95): motorBike 2.10 s all-DAG, 2.03 s at
 // 2048, 2.20 s at 8192; city 2.20 s all-DAG, 2.30 s at 2048, 2.37 s at 8192 (sse-pull 4.37 -> 3.97 s at
