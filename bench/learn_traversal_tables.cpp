@@ -9,6 +9,7 @@
 // per package: its gates at level 0 and above, and the bits a gate of their streams under the tables built in
 // (the encoder's choice of set: their cost before and after a new learning). Cost: a decode and an encode of
 // every record.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -98,7 +99,10 @@ int main(int argc, char** argv) {
     std::printf("%s%s", i > 1 ? ", " : "", std::filesystem::path(argv[i]).filename().c_str());
   std::printf(
       "): do not edit.\n#include \"package/traversal_tables.hpp\"\n\nnamespace lodstream::package {\n\n");
-  std::printf("alignas(64) const uint16_t kTraversalClassStarts[2 * kTraversalContexts][16] = {\n");
+  // Each context's row, then printed once per distinct row (contexts never seen in training share their
+  // prior's row) with each context's row number.
+  std::vector<std::array<uint16_t, 16>> rows;
+  std::vector<uint32_t> row_of(2 * kTraversalContexts);
   for (uint32_t c = 0; c < 2 * kTraversalContexts; ++c) {
     // The same gate context (set, t_a, t_b) over every previous class.
     std::vector<double> prior(kTraversalClasses);
@@ -106,11 +110,27 @@ int main(int argc, char** argv) {
       for (uint32_t s = 0; s < kTraversalClasses; ++s)
         prior[s] += counts[c - c % kTraversalContexts + previous * 64 + c % 64][s];
     const std::vector<uint32_t> f = frequencies(counts[c], prior, kPrior);
-    std::printf("    {0");
-    for (uint32_t s = 0, at = 0; s < kTraversalClasses; ++s) std::printf(", %u", at += f[s]);
-    std::printf(", 4096, 4096, 4096},\n");
+    std::array<uint16_t, 16> row;
+    row.fill(uint16_t(1u << kTraversalScaleBits));
+    row[0] = 0;
+    for (uint32_t s = 0, at = 0; s < kTraversalClasses; ++s) row[s + 1] = uint16_t(at += f[s]);
+    const auto same = std::find(rows.begin(), rows.end(), row);
+    row_of[c] = uint32_t(same - rows.begin());
+    if (same == rows.end()) rows.push_back(row);
   }
-  std::printf("};\n\nconst uint16_t kClusterRankFrequencies[kClusterRanks] = {");
+  std::printf("const uint16_t kTraversalDistinctRows[kTraversalDistinctRowCount][16] = {\n");
+  for (const std::array<uint16_t, 16>& row : rows) {
+    std::printf("    {");
+    for (uint32_t k = 0; k < 16; ++k) std::printf("%s%u", k ? ", " : "", row[k]);
+    std::printf("},\n");
+  }
+  std::printf("};\n\nconst uint16_t kTraversalRowOfContext[2 * kTraversalContexts] = {");
+  for (uint32_t c = 0; c < 2 * kTraversalContexts; ++c)
+    std::printf("%s%u", c % 16 ? ", " : c ? ",\n    " : "\n    ", row_of[c]);
+  std::printf("};\n\n");
+  std::fprintf(stderr, "%zu distinct rows: set kTraversalDistinctRowCount in traversal_tables.hpp\n",
+               rows.size());
+  std::printf("const uint16_t kClusterRankFrequencies[kClusterRanks] = {");
   const std::vector<uint32_t> f = frequencies(ranks, std::vector<double>(kClusterRanks, 1), 0);
   for (uint32_t r = 0; r < kClusterRanks; ++r) std::printf("%s%u", r ? ", " : "", f[r]);
   std::printf("};\n\n}  // namespace lodstream::package\n");

@@ -126,7 +126,7 @@ void put_varint(std::vector<uint8_t>& out, uint32_t v) {
 constexpr uint32_t kKinds = 6, kScale = 1u << kTraversalScaleBits;
 
 // By a vertex's triangle count t (a byte): 16 x 8 min(t, 7) and 16 x min(t, 7), the offsets of a gate's
-// row of kTraversalClassStarts from its level's and previous class's first row, for the gate's first and
+// row of class_starts() from its level's and previous class's first row, for the gate's first and
 // second vertex (two loads where a min took four instructions with its constant: refined_elephant's
 // decode_traversal 19.90 -> 19.27 M instructions, format 12).
 struct GateOffsets {
@@ -177,6 +177,22 @@ uint32_t to_front(RecentClusterCodes& recent, uint32_t r) {
   return code;
 }
 
+// Every context's row of class starts (traversal_tables.hpp), at kTraversalContexts set + context: the
+// distinct rows expanded once (48 KB), so that a gate's row is one address computation from its context,
+// with no look-up of its row number on the decoder's path.
+struct ClassStarts {
+  alignas(64) uint16_t row[2 * kTraversalContexts][16];
+};
+const uint16_t (*class_starts())[16] {
+  static const ClassStarts rows = [] {
+    ClassStarts t;
+    for (uint32_t c = 0; c < 2 * kTraversalContexts; ++c)
+      std::memcpy(t.row[c], kTraversalDistinctRows[kTraversalRowOfContext[c]], sizeof t.row[c]);
+    return t;
+  }();
+  return rows.row;
+}
+
 // The cluster ranks' decode table (rans.hpp's fill_slots entries, shift 16) and each slot's rank, and each
 // rank's start, from kClusterRankFrequencies (built once: 20 KB).
 struct RankTable {
@@ -199,7 +215,7 @@ const RankTable& rank_table() {
 }
 
 // One rANS step (Duda 2013, eq. 9: D(x) = (s, f_s floor(x / 2^12) + x mod 2^12 - start_s)) under the class
-// row `starts` (kTraversalClassStarts): s is the class whose range holds the slot x mod 2^12, found by
+// row `starts` (class_starts()): s is the class whose range holds the slot x mod 2^12, found by
 // comparing the slot with all 16 starts at once (the lanes whose start lies above it: the first is s + 1,
 // lanes 12-15 always); then x is read back up to kLow from the next 2 bytes at `at`. Cost: about 14
 // instructions, two loads of the row, no branch.
@@ -263,7 +279,7 @@ uint32_t traversal_context(uint32_t previous, uint32_t triangles_at_a, uint32_t 
 std::vector<uint8_t> encode_traversal_steps(std::span<const TraversalStep> steps, uint32_t set) {
   if (steps.empty()) return {};
   const RankTable& ranks = rank_table();
-  const uint16_t(*const rows)[16] = kTraversalClassStarts + kTraversalContexts * set;
+  const uint16_t(*const rows)[16] = class_starts() + kTraversalContexts * set;
   // The coding steps in the decoder's order (start and frequency): the set, then each gate's class and a
   // tagged class's rank; then rANS last step first, step i on state i mod 2.
   std::vector<std::array<uint32_t, 2>> coded = {{kScale / 2 * set, kScale / 2}};
@@ -472,7 +488,8 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
   RecentClusterCodes recent = kFirstClusterCodes;
   // The rows of the stream's table set (its first step, at 1/2 each: the slot's top bit), and the offset of
   // the previous class's (times 16 u16 a row).
-  const uint16_t* set_rows = kTraversalClassStarts[0];
+  const uint16_t(*const all_rows)[16] = class_starts();
+  const uint16_t* set_rows = all_rows[0];
   if (read <= end) {
     const uint32_t slot = x & (kScale - 1), set = slot >> (kTraversalScaleBits - 1);
     x = kScale / 2 * (x >> kTraversalScaleBits) + slot - kScale / 2 * set;
@@ -480,7 +497,7 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     std::memcpy(&next, bytes + read, 2);
     rans::renormalize(x, read, next);
     std::swap(x, y);
-    set_rows = kTraversalClassStarts[kTraversalContexts * set];
+    set_rows = all_rows[kTraversalContexts * set];
   }
   uint32_t previous = 0;
   // Clusters of a record: each triangle goes straight to the next free place in its cluster's range of

@@ -10,10 +10,10 @@
 // of refined_elephant's level 1 and 2 records too). A tagged class is followed by the move-to-front rank of
 // its cluster code (symbol_coder's scheme of format 8) under one order-0 table.
 //
-// Learnt by bench/learn_traversal_tables.cpp (which prints traversal_tables.cpp) on the bakes of horse and
-// motorBike only, never on the meshes the package is measured on (refined_elephant, bunny, elephant_*):
-// each context's class counts plus 4 pseudo-counts spread as the context (set, t_a, t_b) without the
-// previous class, plus half a count a class, normalized to 2^12 with at least 1 for every class (every
+// Learnt by bench/learn_traversal_tables.cpp (which prints traversal_tables.cpp; then clang-format) on the
+// bakes of horse and motorBike only, never on the meshes the package is measured on (refined_elephant, bunny,
+// elephant_*): each context's class counts plus 4 pseudo-counts spread as the context (set, t_a, t_b) without
+// the previous class, plus half a count a class, normalized to 2^12 with at least 1 for every class (every
 // class stays codable in every context). The tables are part of the format: learning them again changes the
 // bytes a bake writes (and the tool reads packages baked with the tables built in; the traversal, and so what
 // it learns, does not depend on them: learnt again from its own bakes, the tables come back the same).
@@ -36,11 +36,14 @@ inline constexpr uint32_t kTraversalScaleBits = 12;
 inline constexpr uint32_t kTraversalClasses = 12, kTraversalContexts = 12 * 64;
 inline constexpr uint32_t kClusterRanks = 31;
 
+// A row: the classes' cumulative frequencies, starts[0] = 0, starts[12..15] = 2^12 (the decoder compares all
+// 16 at once); class s has frequency starts[s + 1] - starts[s] >= 1. Each distinct row once (contexts never
+// seen in training share their prior's row: 878 rows for 1,536 contexts).
+inline constexpr uint32_t kTraversalDistinctRowCount = 878;
+extern const uint16_t kTraversalDistinctRows[kTraversalDistinctRowCount][16];
 // Per table set (0: learnt on level 0, 1: above) and context (previous class 64 + 8 min(t_a, 7) +
-// min(t_b, 7)), row kTraversalContexts set + context: the classes' cumulative frequencies, starts[0] = 0,
-// starts[12..15] = 2^12 (the decoder compares all 16 at once); class s has frequency starts[s + 1] -
-// starts[s] >= 1.
-extern const uint16_t kTraversalClassStarts[2 * kTraversalContexts][16];
+// min(t_b, 7)), at kTraversalContexts set + context: the number of its row in kTraversalDistinctRows.
+extern const uint16_t kTraversalRowOfContext[2 * kTraversalContexts];
 // The cluster codes' move-to-front ranks' frequencies (add up to 2^12, each >= 1).
 extern const uint16_t kClusterRankFrequencies[kClusterRanks];
 
