@@ -39,8 +39,8 @@ struct WriterOptions {
   // and its simulated streams (`bench stream --path gen:fly --link bandwidth=10mbit,rtt=80ms`, seconds to
   // benefit 0.95, sse-pull / push / oracle) 1.133 / 0.700 / 0.633 -> 1.300 / 0.767 / 0.700; at 40 KB 1,306
   // pages and 1.133 / 0.667 / 0.600, elephant_1m 1.000 / 0.800 / 0.733 -> 0.967 / 0.767 / 0.700, motorBike
-  // unchanged (0.967 / 0.933 / 0.867). Bytes against 48 KB: elephant_1m +0.5 %, city +0.07 %, refined_elephant
-  // -0.4 %.
+  // unchanged (0.967 / 0.933 / 0.867). Bytes against 48 KB: elephant_1m +0.5 %, city +0.07 %,
+  // refined_elephant -0.4 %.
   size_t page_bytes = 40 * 1024;
   // zstd level of data and index pages: measured on refined_elephant, level 9 is 4x faster to write than 15
   // (8 vs 2 M triangles per second per core); with codec 3 its data pages are 2.6 % larger than at 15

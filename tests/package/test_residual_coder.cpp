@@ -8,6 +8,7 @@
 #include <cmath>
 #include <random>
 #include <set>
+#include <string>
 
 #include "core/error.hpp"
 #include "package/byte_planes.hpp"
@@ -45,31 +46,46 @@ Residuals random_residuals(uint32_t seed, double zero_share) {
   return r;
 }
 
-// The planes of every node, as put_planes writes them, one after the other.
-std::vector<uint8_t> expected_planes(const Residuals& r) {
+// The planes of every node of `components` components (its values component-major), as put_planes writes
+// them, one after the other.
+template <class Count>
+std::vector<uint8_t> planes_of(const std::vector<Count>& counts, const std::vector<uint32_t>& widths,
+                               const std::vector<uint64_t>& values, uint32_t components) {
   std::vector<uint8_t> out;
   size_t at = 0;
-  for (size_t node = 0; node < r.counts.size(); ++node) {
-    const size_t n = r.counts[node];
-    std::vector<uint64_t> records(3 * n);  // put_planes takes records of 3 components
-    for (uint32_t a = 0; a < 3; ++a)
-      for (size_t i = 0; i < n; ++i) records[3 * i + a] = r.values[at + a * n + i];
-    put_planes(out, records, 3, r.widths[node]);
-    at += 3 * n;
+  for (size_t node = 0; node < counts.size(); ++node) {
+    const size_t n = counts[node];
+    std::vector<uint64_t> records(components * n);
+    for (uint32_t a = 0; a < components; ++a)
+      for (size_t i = 0; i < n; ++i) records[components * i + a] = values[at + a * n + i];
+    put_planes(out, records, components, widths[node]);
+    at += components * n;
   }
   return out;
 }
 
-std::vector<uint8_t> decoded_planes(std::span<const uint8_t> stream, const Residuals& r) {
-  ResidualDecoder decoder(stream, "stream 3");
+// What a ResidualDecoder of `stream` (named `where`; paired: encode_paired_residuals') gives for every node,
+// into planes filled with 0xa5 first (every byte must be written over).
+template <class Count>
+std::vector<uint8_t> decoded_planes_of(std::span<const uint8_t> stream, const std::string& where, bool paired,
+                                       const std::vector<Count>& counts, const std::vector<uint32_t>& widths,
+                                       uint32_t components) {
+  ResidualDecoder decoder(stream, where, paired);
   std::vector<uint8_t> out;
-  for (size_t node = 0; node < r.counts.size(); ++node) {
+  for (size_t node = 0; node < counts.size(); ++node) {
     const size_t at = out.size();
-    out.resize(at + 3 * r.counts[node] * r.widths[node]);
-    decoder.planes(r.counts[node], 3, r.widths[node], out.data() + at);
+    out.resize(at + components * counts[node] * widths[node], 0xa5);
+    decoder.planes(counts[node], components, widths[node], out.data() + at);
   }
   decoder.finish();
   return out;
+}
+
+std::vector<uint8_t> expected_planes(const Residuals& r) {
+  return planes_of(r.counts, r.widths, r.values, 3);
+}
+std::vector<uint8_t> decoded_planes(std::span<const uint8_t> stream, const Residuals& r) {
+  return decoded_planes_of(stream, "stream 3", false, r.counts, r.widths, 3);
 }
 
 TEST(ResidualCoder, DecodesToThePlanesOfTheResiduals) {
@@ -235,29 +251,10 @@ Pairs drawn_pairs(uint32_t seed, uint32_t set) {
 }
 
 std::vector<uint8_t> expected_pair_planes(const Pairs& r) {
-  std::vector<uint8_t> out;
-  size_t at = 0;
-  for (size_t node = 0; node < r.counts.size(); ++node) {
-    const size_t n = r.counts[node];
-    std::vector<uint64_t> records(2 * n);
-    for (size_t i = 0; i < n; ++i)
-      records[2 * i] = r.values[at + i], records[2 * i + 1] = r.values[at + n + i];
-    put_planes(out, records, 2, r.widths[node]);
-    at += 2 * n;
-  }
-  return out;
+  return planes_of(r.counts, r.widths, r.values, 2);
 }
-
 std::vector<uint8_t> decoded_pair_planes(std::span<const uint8_t> stream, const Pairs& r) {
-  ResidualDecoder decoder(stream, "stream 5", true);
-  std::vector<uint8_t> out;
-  for (size_t node = 0; node < r.counts.size(); ++node) {
-    const size_t at = out.size();
-    out.resize(at + 2 * r.counts[node] * r.widths[node], 0xa5);  // every byte written over
-    decoder.planes(r.counts[node], 2, r.widths[node], out.data() + at);
-  }
-  decoder.finish();
-  return out;
+  return decoded_planes_of(stream, "stream 5", true, r.counts, r.widths, 2);
 }
 
 // The built-in tables are what residual_tables.hpp says: each adds up to 2^12 and codes every symbol.
