@@ -1,5 +1,6 @@
 #include "package/records.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstring>
 #include <ranges>
@@ -19,28 +20,55 @@ void gather(const std::vector<T>& from, std::span<const uint32_t> order, std::ve
   to.assign(values.begin(), values.end());
 }
 
-// gather of positions and normals in one pass over `order`, straight into m's arrays (their capacity kept
-// across calls: a caller that extracts into one DecodedNode allocates once): ~9 instructions a vertex for
-// both, where two gathers took ~16 (elephant_1m's bench decode: extract_cluster 157.4 -> 149.8 M).
-// With `wide` (every entry of `order` below in's last vertex), a vertex a 16-byte load and store each:
-// lanes 0-2 are its x y z, lane 3 the next vertex's x, stored into the next place (the arrays' spare entry
-// for the last, dropped after), which the next vertex overwrites: 15 -> 11 instructions a vertex (`bench
-// decode --runs 1` under callgrind, decode_node: refined_elephant 46.29 -> 46.02 M, elephant_1m 695.8 ->
-// 691.9 M). Cost: O(order.size()).
-void gather_positions_normals(const Mesh& in, std::span<const uint32_t> order, bool wide, Mesh& m) {
-  // resize zero-fills only beyond the size the arrays had.
-  m.positions.resize(order.size() + 1), m.normals.resize(order.size() + 1);
+// Resizes `v` to n entries without value-initialising new ones: they are copied from `junk` (at least
+// n - v.size() entries, which the caller overwrites next), one memmove where resize stored each glm::vec3
+// alone (~5 instructions an entry, and a caller that extracts clusters of varying sizes into one DecodedNode
+// grows its arrays at about every other call: elephant_1m's `bench decode --runs 1` under callgrind spent
+// 14.0 M instructions there). Cost: O(the growth).
+template <class T>
+void resize_for_overwrite(std::vector<T>& v, size_t n, const T* junk) {
+  if (v.size() >= n)
+    v.resize(n);  // shrinking writes nothing
+  else
+    v.insert(v.end(), junk, junk + (n - v.size()));
+}
+
+// m.positions[k] = in.positions[order[k]] and likewise the normals, in one pass over `order` that also
+// resets map[order[k]] to UINT32_MAX (extract_cluster's table, left as it found it, where a loop of its own
+// took ~2.6 instructions a vertex more); m's arrays sized first (their capacity kept across calls: a caller
+// that extracts into one DecodedNode allocates once), the only step that may throw, after which the map is
+// reset too. Two gathers took ~16 instructions a vertex (elephant_1m's bench decode: extract_cluster 157.4 ->
+// 149.8 M). With `wide` (every entry of `order` below in's last vertex), a vertex a 16-byte load and store
+// each: lanes 0-2 are its x y z, lane 3 the next vertex's x, stored into the next place (the arrays' spare
+// entry for the last, dropped after), which the next vertex overwrites: ~11 instructions a vertex with the
+// reset (`bench decode --runs 1` under callgrind, elephant_1m: 17.6 M for 1.59 M vertices). Cost:
+// O(order.size()).
+void gather_positions_normals(const Mesh& in, std::span<const uint32_t> order, bool wide, uint32_t* map,
+                              Mesh& m) {
+  const size_t n = order.size() + (wide ? 1 : 0);  // wide: n <= in's vertices, as `order` leaves one out
+  try {
+    resize_for_overwrite(m.positions, n, in.positions.data());
+    resize_for_overwrite(m.normals, n, in.normals.data());
+  } catch (...) {
+    for (uint32_t v : order) map[v] = UINT32_MAX;
+    throw;
+  }
   const glm::vec3 *p = in.positions.data(), *q = in.normals.data();
   glm::vec3 *to_p = m.positions.data(), *to_q = m.normals.data();
   if (wide) {
     for (size_t k = 0; k < order.size(); ++k) {
-      std::memcpy(to_p + k, p + order[k], 16);
-      std::memcpy(to_q + k, q + order[k], 16);
+      const uint32_t v = order[k];
+      std::memcpy(to_p + k, p + v, 16);
+      std::memcpy(to_q + k, q + v, 16);
+      map[v] = UINT32_MAX;
     }
+    m.positions.pop_back(), m.normals.pop_back();
   } else {
-    for (size_t k = 0; k < order.size(); ++k) to_p[k] = p[order[k]], to_q[k] = q[order[k]];
+    for (size_t k = 0; k < order.size(); ++k) {
+      const uint32_t v = order[k];
+      to_p[k] = p[v], to_q[k] = q[v], map[v] = UINT32_MAX;
+    }
   }
-  m.positions.pop_back(), m.normals.pop_back();
 }
 
 }  // namespace
@@ -133,12 +161,16 @@ void extract_cluster(const DecodedNode& record, uint32_t cluster, const std::str
   if (used.size() < in.positions.size()) used.resize(in.positions.size());
   Mesh& m = out.mesh;
   m.material = in.material;
-  // What the cluster does not hold cleared (capacity kept); the rest overwritten below.
-  m.normals.clear(), m.uvs.clear(), m.colors.clear();
+  // What the cluster does not hold cleared (capacity kept); the rest overwritten below (positions and normals
+  // resized without clearing: only their growth is written twice).
+  if (!in.has_normals()) m.normals.clear();
+  m.uvs.clear(), m.colors.clear();
   out.first_vertex = 0, out.vertex_data.clear(), out.extra.clear(), out.cluster_triangles.clear();
-  // Copied, then renumbered in place: no value-initialisation of a buffer that is overwritten anyway.
-  m.indices.assign(in.indices.begin() + std::ptrdiff_t(3 * first),
-                   in.indices.begin() + std::ptrdiff_t(3 * (first + count)));  // < V: the codec checked them
+  // Sized without value-initialisation (only its growth copied first), then each index renumbered from the
+  // record's (< V: the codec checked them) into it: no copy of the indices before the renumbering (`bench
+  // decode --runs 1` under callgrind: elephant_1m's memcpy from extract_cluster 3.28 M instructions).
+  const uint32_t* const from = in.indices.data() + 3 * first;
+  resize_for_overwrite(m.indices, 3 * count, from);
   uint32_t* const map = compact.data();
   uint32_t* const first_use = used.data();
   size_t n = 0;
@@ -146,25 +178,29 @@ void extract_cluster(const DecodedNode& record, uint32_t cluster, const std::str
   // written every time and kept only when v is new. A triangle a step, the count in 64 bits (no zero
   // extension before it indexes): ~15 -> ~12.5 instructions a corner; the loop by pointer, one counter a
   // triangle fewer (`bench decode --runs 1` under callgrind, decode_node: refined_elephant 44.32 -> 44.18 M,
-  // elephant_1m 668.4 -> 666.0 M).
-  auto renumber = [&](uint32_t& v) {
-    const size_t seen = map[v];
-    const size_t fresh = seen >> 31;  // 1 for UINT32_MAX (not used yet): cluster vertices are below 2^31
+  // elephant_1m 668.4 -> 666.0 M). A used vertex's number is below n and an unused one's UINT32_MAX above,
+  // so the number is min(seen, n) and n grows by (seen > n): GCC 12 then takes a compare, cmov and adc, and
+  // with first_use written before the look-up no register copy, 11 -> 10 instructions a corner.
+  auto renumber = [&](uint32_t v) {
     first_use[n] = v;
-    const uint32_t c = uint32_t(fresh ? n : seen);
-    map[v] = c, n += fresh;
-    v = c;
+    uint32_t* const slot = map + v;
+    const size_t seen = *slot;
+    const size_t c = std::min(seen, n);
+    n += seen > n;
+    *slot = uint32_t(c);
+    return uint32_t(c);
   };
-  for (uint32_t *t = m.indices.data(), *const end = t + 3 * count; t != end; t += 3)
-    renumber(t[0]), renumber(t[1]), renumber(t[2]);
+  const uint32_t* f = from;
+  for (uint32_t *t = m.indices.data(), *const end = t + 3 * count; t != end; t += 3, f += 3)
+    t[0] = renumber(f[0]), t[1] = renumber(f[1]), t[2] = renumber(f[2]);
   // Whether the cluster leaves the record's last vertex out: its others are followed by 4 bytes of their
   // arrays (gather_positions_normals' wide form).
   const bool wide = !in.positions.empty() && map[in.positions.size() - 1] == UINT32_MAX;
-  for (size_t k = 0; k < n; ++k) map[first_use[k]] = UINT32_MAX;  // before anything may throw
   const std::span<const uint32_t> order(first_use, n);
   if (in.has_normals()) {
-    gather_positions_normals(in, order, wide, m);
+    gather_positions_normals(in, order, wide, map, m);  // resets the map
   } else {
+    for (size_t k = 0; k < n; ++k) map[first_use[k]] = UINT32_MAX;  // before anything may throw
     gather(in.positions, order, m.positions);
   }
   if (in.has_uvs()) gather(in.uvs, order, m.uvs);

@@ -114,6 +114,38 @@ TEST(Records, EachClusterComesBackExactlyAndSharedVerticesAreIdentical) {
   EXPECT_GT(shared, 20u);  // the chunks' borders
 }
 
+// Extracting into one DecodedNode (its arrays sized without clearing: they shrink, or grow by copies that
+// the extraction overwrites) gives each cluster as extracting it alone does, in any order, whatever the node
+// held before.
+TEST(Records, ExtractingIntoOneNodeMatchesExtractingAlone) {
+  const Record r = sphere_record(0);
+  const DecodedNode record = TraversalCodec().decode(r.bytes, r.grid, "record");
+  const uint32_t C = record_clusters(record);
+  ASSERT_GE(C, 4u);
+  DecodedNode into;
+  into.mesh.positions.assign(3 * record.mesh.vertex_count(), glm::vec3(7.0f));
+  into.mesh.normals.assign(5, glm::vec3(-1.0f));
+  into.mesh.indices.assign(9 * record.mesh.indices.size(), 5u);
+  std::vector<uint32_t> order;  // 0, C-1, 1, C-2, ...: sizes up and down
+  for (uint32_t lo = 0, hi = C - 1; lo <= hi; ++lo, --hi) {
+    order.push_back(lo);
+    if (hi != lo) order.push_back(hi);
+  }
+  for (int pass = 0; pass < 2; ++pass) {
+    for (uint32_t c : order) {
+      extract_cluster(record, c, "record", into);
+      const DecodedNode alone = extract_cluster(record, c, "record");
+      EXPECT_EQ(into.mesh.indices, alone.mesh.indices) << c;
+      EXPECT_EQ(into.mesh.positions, alone.mesh.positions) << c;
+      EXPECT_EQ(into.mesh.normals, alone.mesh.normals) << c;
+      EXPECT_EQ(into.mesh.uvs, alone.mesh.uvs) << c;
+      EXPECT_EQ(into.index_end, alone.index_end) << c;
+      EXPECT_EQ(into.mesh.vertex_count(), r.clusters[c].vertex_count()) << c;
+    }
+    std::reverse(order.begin(), order.end());
+  }
+}
+
 TEST(Records, FreeVerticesKeepTheShiftsBoundAndLockedOnesStayExact) {
   const uint32_t shift = 3;
   const Record r = sphere_record(shift);
