@@ -90,7 +90,7 @@ struct BakeArgs {
   std::vector<std::string> models;
   std::string output;
   bool json = false, hlod = true;
-  uint32_t normal_bits = 9, coarse_normal_bits = 8;
+  uint32_t normal_bits = 9, coarse_normal_bits = 7;
   int max_grid_bits = 20;
   uint32_t codec = default_node_codec().id();
   uint32_t pm_max_triangles = kDefaultPmMaxTriangles;
@@ -174,22 +174,38 @@ Sphere stored_sphere(const Sphere& s, float error, const PositionGrid& grid) {
 // 0.2 dB near and 3.3 dB far: quantized positions tilt face normals by more than 8-bit octahedral rounding
 // does.) These figures are of format 5's global octahedral code; format 6 codes a normal in the frame of its
 // prediction at the same RMS angular error for the same bits (predicted_normals.hpp).
-// A cluster whose position shift is at least kFewerNormalBitsShift (error >= 64 finest steps: 2^-8 of the
-// diagonal on a 14-bit grid) stores one normal bit less: its triangles stand for many
-// finer ones and are drawn small. Measured (format 7, same renders; PSNR near / mid / far, motorBike front /
-// side / above) against 8 bits at every coarse level, one bit less from shift 1 / 2 / 3 / everywhere:
-// elephant_1m 3,939,809 -> 3,920,917 / 3,929,606 (-0.26 %) / 3,933,993 / 3,779,090 B, PSNR 48.599 / 61.097
-// / 61.434 -> far 61.384 / 61.430 / 61.434 / 48.480, 60.897, 61.362 (near and mid unchanged but for the
-// last); refined_elephant 335,287 -> 333,317 / 333,606 (-0.50 %) B, PSNR at most +0.014 dB; motorBike
-// 1,662,656 -> 1,644,160 / 1,647,075 (-0.94 %) B, PSNR 47.786 / 46.000 / 48.067 -> 47.780 / 45.995 / 48.057
-// (shift 1), 47.785 / 45.994 / 48.064 (shift 2); the same triangles in every view. Shift 1 costs
-// elephant_1m's far view 0.05 dB; 2 costs at most 0.006 dB.
-constexpr uint32_t kFewerNormalBitsShift = 2;
+// A cluster whose position shift is at least 2 (error >= 64 finest steps) stored one normal bit less
+// (format 7, same renders; PSNR near / mid / far, motorBike front / side / above), against 8 bits at every
+// coarse level, one bit less from shift 1 / 2 / 3 / everywhere: elephant_1m 3,939,809 -> 3,920,917 /
+// 3,929,606 (-0.26 %) / 3,933,993 / 3,779,090 B, PSNR 48.599 / 61.097 / 61.434 -> far 61.384 / 61.430 /
+// 61.434 / 48.480, 60.897, 61.362 (near and mid unchanged but for the last); refined_elephant 335,287 ->
+// 333,317 / 333,606 (-0.50 %) B, PSNR at most +0.014 dB; motorBike 1,662,656 -> 1,644,160 / 1,647,075
+// (-0.94 %) B, PSNR 47.786 / 46.000 / 48.067 -> 47.780 / 45.995 / 48.057 (shift 1), 47.785 / 45.994 / 48.064
+// (shift 2); the same triangles in every view.
+// Format 14 (helper sizepos, issue 4's package goal): --coarse-normal-bits 7 by default, and one bit less
+// (6) from error >= kFewerNormalBitsSteps = 16 finest steps (2^-10 of the diagonal on a 14-bit grid: the
+// page groups of level 2 and up; level 1's are 5-9 steps at their finest cluster, which sets the page
+// group's bits). Errors, spheres and so the triangles drawn are unchanged; the cost is 0.0-0.3 dB of PSNR.
+// Measured (bake, render at 1 px against the full model, the usual cameras; PSNR near / mid / far,
+// motorBike above / front / side) against format 13's 8 bits and one less from 64 steps, then 7 bits and
+// one less from 64 steps / from 16: refined_elephant 234,946 -> 226,444 / 225,434 B (-4.05 %), PSNR 47.600 /
+// 50.943 / 56.511 -> 47.577 / 50.791 / 56.372 / 47.577 / 50.798 / 56.337; elephant_1m 2,642,733 ->
+// 2,542,582 / 2,535,327 (-4.06 %), PSNR 47.610 / 54.903 / 59.838 -> 47.402 / 54.681 / 59.699 / 47.402 /
+// 54.671 / 59.635; then (bench/compare-binaries) bunny 225,833 -> 214,701 B (-4.9 %), PSNR 54.908 / 50.290 /
+// 53.605 -> 54.908 / 50.290 / 53.328; horse 291,669 -> 280,746 (-3.7 %), 57.892 / 59.377 / 69.820 -> 57.612
+// / 59.087 / 69.528; motorBike 1,333,793 -> 1,305,234 (-2.1 %), 47.853 / 47.670 / 45.619 -> 47.801 / 47.588
+// / 45.546. Keeping 8 bits at level 1 (one less from 16 steps, two from 64) saved only 1.5 % / 0.7 %: level
+// 1 holds most coarse normals. The other lever, the positions'
+// shift (position_shift's divisor 16 -> 8 / 4 / 2, normals as format 13), saved 0.03 / 0.75 / 2.0 % on
+// refined_elephant (a page group's shift is its finest cluster's), and clients drew more triangles at a lower
+// PSNR: divisor 4 near / mid / far 69,692 / 35,012 / 18,138 triangles (+3.9 / +4.4 / 0 %), 47.718 / 50.614 /
+// 56.000 dB; divisor 2 (with its coupled normal rule) 75,618 / 37,640 / 18,614, 47.888 / 51.158 / 55.899.
+constexpr double kFewerNormalBitsSteps = 16.0;
 
 uint32_t cluster_normal_bits(float error, const PositionGrid& grid, const BakeArgs& args) {
   if (!(error > 0.0f)) return args.normal_bits;
   const uint32_t coarse = std::min(args.normal_bits, args.coarse_normal_bits);
-  return position_shift(error, grid) >= kFewerNormalBitsShift && coarse > 4 ? coarse - 1 : coarse;
+  return double(error) >= kFewerNormalBitsSteps * double(grid.step) && coarse > 4 ? coarse - 1 : coarse;
 }
 
 // How a DAG cluster is stored: (position shift, normal bits).
@@ -859,8 +875,8 @@ const bool registered = register_command(
            "octahedral normal bits per component at level 0 and in progressive meshes (4..16, default 9)");
        sub.add_option(
            "--coarse-normal-bits", args->coarse_normal_bits,
-           "at most this many normal bits in clusters coarser than level 0, one less from position shift 2 "
-           "(4..16, default 8)");
+           "at most this many normal bits in clusters coarser than level 0, one less from an error of 16 "
+           "finest grid steps (4..16, default 7)");
        sub.add_option("--codec", args->codec,
                       "node codec: 3 = edge-front connectivity, predicted positions and normals (default; "
                       "23-31 % smaller than 1, decodes at about 0.9x its speed), 1 = meshoptimizer's codecs, "

@@ -26,7 +26,7 @@ namespace lodstream::package {
 // (index - first_vertex below V, as predicted_normals counts them) is not closed (above), else 0. Returns the
 // number of open vertices. Cost: O(T + V), one pass over the corners.
 // The most normal bits at which the encoder derives closed vertices' normals: 9, level 0's (and progressive
-// meshes') by default, and the coarse levels' 8 and 7 (bake --coarse-normal-bits), where the codes already
+// meshes') by default, and the coarse levels' 7 and 6 (bake --coarse-normal-bits), where the codes already
 // round toward the prediction (predicted_normals.cpp's dead zone); more bits, a precision asked for
 // explicitly, keep their codes, as they keep nearest rounding. Measured (bake, render at 1 px against the
 // full model, the usual three cameras), level 0 only: refined_elephant 291,609 -> 288,725 B (-1.0 %), PSNR

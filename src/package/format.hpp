@@ -43,8 +43,10 @@ inline constexpr std::array<uint8_t, 8> kMagic = {0x89, 'L', 'O', 'D', 'S', '\r'
 // byte in pages (page_parts.hpp); normal residuals may be one paired stream of built-in tables, component 1
 // in the context of component 0 (page_parts.hpp's paired form, residual_coder.hpp); spheres that do not fit
 // their parents' on their grid rounded on the cell's corners or the next grid (pair_rounding.hpp), a
-// representation's grid origin not stored when it is its bounds' minimum (index.cpp, kGridOriginAtBoundsMin).
-inline constexpr uint32_t kFormatVersion = 13;
+// representation's grid origin not stored when it is its bounds' minimum (index.cpp, kGridOriginAtBoundsMin);
+// 14: coarse clusters' normals at 7 bits, 6 from an error of 16 finest steps (bake's precision, cmd_bake.cpp;
+// the encoder's choice, decoders unchanged).
+inline constexpr uint32_t kFormatVersion = 14;
 inline constexpr size_t kHeaderSize = 64;
 
 // Hard limits a reader enforces before allocating: no valid writer output exceeds them.

@@ -290,10 +290,12 @@ TEST(DerivedNormals, ClosedVerticesWithinOneStepDecodeToThePrediction) {
   expect_closed_vertices_derived(kDerivedNormalBits);
 }
 
-// The coarse levels' normal bits (bake's --coarse-normal-bits 8, one less from shift 2) derive too.
+// The coarse levels' normal bits (bake's --coarse-normal-bits 7, one less from 16 finest steps; 8 asked for)
+// derive too.
 TEST(DerivedNormals, CoarseNormalBitsDeriveToo) {
   expect_closed_vertices_derived(8);
   expect_closed_vertices_derived(7);
+  expect_closed_vertices_derived(6);
 }
 
 }  // namespace
