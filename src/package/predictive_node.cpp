@@ -72,7 +72,7 @@ inline void add_normal(const uint64_t* x, const uint64_t* y, const uint64_t* z, 
   n[2] += e[0][0] * e[1][1] - e[0][1] * e[1][0];
 }
 struct PlaneGate {
-  double n[3];
+  double along, first, second;  // n[d], n[d + 1], n[d + 2]
   uint32_t d;
   PlaneGate(const uint64_t* c, const uint32_t* o, const uint32_t* more) {
     uint64_t s[3] = {0, 0, 0};
@@ -80,60 +80,77 @@ struct PlaneGate {
     if (more) add_normal(c + 3 * size_t(more[0]), c + 3 * size_t(more[1]), c + 3 * size_t(more[2]), s);
     set(s);
   }
+  // n's components in the order (d, d + 1, d + 2) taken by selects, not by an index into an array (which
+  // put n on the stack: a store and reload on the decoder's chain from one vertex to the next).
   void set(const uint64_t (&s)[3]) {
-    n[0] = double(int64_t(s[0])), n[1] = double(int64_t(s[1])), n[2] = double(int64_t(s[2]));
-    const double a0 = std::fabs(n[0]), a1 = std::fabs(n[1]), a2 = std::fabs(n[2]);
+    const double n0 = double(int64_t(s[0])), n1 = double(int64_t(s[1])), n2 = double(int64_t(s[2]));
+    const double a0 = std::fabs(n0), a1 = std::fabs(n1), a2 = std::fabs(n2);
     d = a0 >= a1 ? (a0 >= a2 ? 0 : 2) : (a1 >= a2 ? 1 : 2);
+    along = d == 0 ? n0 : d == 1 ? n1 : n2;
+    first = d == 0 ? n1 : d == 1 ? n2 : n0;
+    second = d == 0 ? n2 : d == 1 ? n0 : n1;
   }
   int64_t offset(int64_t ra, int64_t rb) const {
-    if (n[d] == 0.0) return 0;
-    const uint32_t a = d == 2 ? 0 : d + 1, b = d == 0 ? 2 : d - 1;
-    const double t = -(n[a] * double(ra) + n[b] * double(rb)) / n[d] + 0.5;
+    if (along == 0.0) return 0;
+    const double t = -(first * double(ra) + second * double(rb)) / along + 0.5;
     const int64_t i = int64_t(t);  // toward zero; floor below (no libm call)
     return i - (t < double(i));
   }
 };
 
 // c[v] = P + residual[v] per axis for v < V (predictive_node.hpp), wrapping, the residuals as read_planes
-// leaves them (one array per component), with the plane prediction when `plane`. One pass; returns whether a
-// result lies outside [-kMaxCoarse, kMaxCoarse).
+// leaves them (one array per component), with the plane prediction when `plane`. One pass, nothing but the
+// prediction in it: the range check is a pass of its own (out_of_range), where OR-ing each result into an
+// accumulator took 7 instructions a vertex and a register the loop spilled for, and the plane's lifted
+// components return to their axes by selects, where an array indexed by d went through the stack, on the
+// chain from one vertex to the next (refined_elephant's `bench decode`: decode_predicted_vertices 8.22 ->
+// 7.85 M instructions under callgrind; rdtsc around the loop, each node's fastest of 15 runs summed: 0.88 ->
+// 0.57 M ticks for the 47,649 vertices of nodes without the plane prediction, 1.39 -> 1.27 M for the 31,811
+// with it, ~40 ticks a vertex there: the division's chain, predictive_node.hpp).
 // With `extra` (multi), P is the multi-parallelogram (averaged_parallelogram) where a second one was found.
 // Forced inline (and its dispatch below), into decode_predicted_vertices' AVX2 build (as read_planes).
 template <uint32_t j, bool plane, bool multi>
-[[gnu::always_inline]] inline bool predict_positions(const int64_t* residual, uint32_t V, const uint32_t* o,
+[[gnu::always_inline]] inline void predict_positions(const int64_t* residual, uint32_t V, const uint32_t* o,
                                                      const Parallelograms* extra, uint64_t* c) {
-  const int64_t *r0 = residual, *r1 = r0 + V, *r2 = r1 + V;
-  uint64_t shifted = 0;  // OR of c + kMaxCoarse: in range while below 2 kMaxCoarse
-  for (uint32_t v = 0; v < V; ++v, o += 3) {
-    uint64_t* to = c + 3 * size_t(v);
-    const uint32_t* more = multi && extra->found[v] ? extra->corners.data() + 3 * size_t(v) : nullptr;
+  const uint64_t* r = reinterpret_cast<const uint64_t*>(residual);
+  const uint8_t* const found = multi ? extra->found.data() : nullptr;
+  const uint32_t* const corners = multi ? extra->corners.data() : nullptr;
+  uint64_t* to = c;
+  for (uint32_t v = 0; v < V; ++v, o += 3, to += 3, ++r) {
+    const uint32_t* more = multi && found[v] ? corners + 3 * size_t(v) : nullptr;
     uint64_t p[3];
     averaged_parallelogram<j>(c, o, more, p);
+    uint64_t q0 = r[0], q1 = r[V], q2 = r[2 * size_t(V)];
     if constexpr (plane) {
+      // The lifted components (r[d] - offset, r[d + 1], r[d + 2]) back to axes: axis k takes component
+      // (k - d) mod 3, by selects.
       const PlaneGate gate(c, o, more);
-      const uint32_t d = gate.d, a = d == 2 ? 0 : d + 1, b = d == 0 ? 2 : d - 1;
-      uint64_t r[3];
-      r[a] = uint64_t(r1[v]), r[b] = uint64_t(r2[v]),
-      r[d] = uint64_t(r0[v]) + uint64_t(gate.offset(r1[v], r2[v]));
-      to[0] = p[0] + r[0], to[1] = p[1] + r[1], to[2] = p[2] + r[2];
-    } else {
-      to[0] = p[0] + uint64_t(r0[v]), to[1] = p[1] + uint64_t(r1[v]), to[2] = p[2] + uint64_t(r2[v]);
+      const uint64_t lifted = q0 + uint64_t(gate.offset(int64_t(q1), int64_t(q2))), d = gate.d;
+      const uint64_t x = d == 0 ? lifted : d == 1 ? q2 : q1, y = d == 0 ? q1 : d == 1 ? lifted : q2;
+      q2 = d == 0 ? q2 : d == 1 ? q1 : lifted, q0 = x, q1 = y;
     }
-    shifted |=
-        (to[0] + uint64_t(kMaxCoarse)) | (to[1] + uint64_t(kMaxCoarse)) | (to[2] + uint64_t(kMaxCoarse));
+    to[0] = p[0] + q0, to[1] = p[1] + q1, to[2] = p[2] + q2;
   }
-  return shifted >= 2 * uint64_t(kMaxCoarse);
 }
 
 template <uint32_t j>
-[[gnu::always_inline]] inline bool predict_positions(bool plane, const int64_t* residual, uint32_t V,
+[[gnu::always_inline]] inline void predict_positions(bool plane, const int64_t* residual, uint32_t V,
                                                      const uint32_t* o, const Parallelograms* extra,
                                                      uint64_t* c) {
   if (extra)
-    return plane ? predict_positions<j, true, true>(residual, V, o, extra, c)
-                 : predict_positions<j, false, true>(residual, V, o, extra, c);
-  return plane ? predict_positions<j, true, false>(residual, V, o, extra, c)
-               : predict_positions<j, false, false>(residual, V, o, extra, c);
+    plane ? predict_positions<j, true, true>(residual, V, o, extra, c)
+          : predict_positions<j, false, true>(residual, V, o, extra, c);
+  else
+    plane ? predict_positions<j, true, false>(residual, V, o, extra, c)
+          : predict_positions<j, false, false>(residual, V, o, extra, c);
+}
+
+// Whether any of c[0 .. n) lies outside [-kMaxCoarse, kMaxCoarse): their shifted values OR-ed, one pass that
+// vectorizes (4 values an instruction in the AVX2 build). Cost: O(n).
+[[gnu::always_inline]] inline bool out_of_range(const uint64_t* c, size_t n) {
+  uint64_t shifted = 0;  // in range while below 2 kMaxCoarse
+  for (size_t i = 0; i < n; ++i) shifted |= c[i] + uint64_t(kMaxCoarse);
+  return shifted >= 2 * uint64_t(kMaxCoarse);
 }
 
 // Bits of a zigzagged residual (0 for 0): the encoder's estimate of what a damping costs.
@@ -326,7 +343,7 @@ __attribute__((target_clones("avx2", "default"))) void decode_predicted_vertices
   const LockedStream locked = LockedStream::parse(p.locked_stream, V, p.shift, where);
   // c[v] = P + residual (the damped parallelogram), with entry V holding cmin, the residuals read from their
   // planes first (one vectorized pass). The arithmetic wraps (unsigned), so hostile residuals cannot
-  // overflow; the results are range-checked in the same pass.
+  // overflow; the results are range-checked after it (out_of_range).
   thread_local std::vector<int64_t> c;
   c.resize(3 * (size_t(V) + 1));
   uint64_t* cu = reinterpret_cast<uint64_t*>(c.data());
@@ -335,11 +352,13 @@ __attribute__((target_clones("avx2", "default"))) void decode_predicted_vertices
   residual.resize(3 * size_t(V));
   read_planes(p.position_planes.data(), V, 3, p.position_bytes, residual.data());
   const bool plane = p.flags & kPlanePrediction;
-  const bool out_of_range =
-      p.damping == 4   ? predict_positions<4>(plane, residual.data(), V, predictors.data(), extra, cu)
-      : p.damping == 3 ? predict_positions<3>(plane, residual.data(), V, predictors.data(), extra, cu)
-                       : predict_positions<2>(plane, residual.data(), V, predictors.data(), extra, cu);
-  if (out_of_range) throw Error(where + ": predicted position out of the grid's range");
+  if (p.damping == 4)
+    predict_positions<4>(plane, residual.data(), V, predictors.data(), extra, cu);
+  else if (p.damping == 3)
+    predict_positions<3>(plane, residual.data(), V, predictors.data(), extra, cu);
+  else
+    predict_positions<2>(plane, residual.data(), V, predictors.data(), extra, cu);
+  if (out_of_range(cu, 3 * size_t(V))) throw Error(where + ": predicted position out of the grid's range");
   // Decoded straight into m.positions with one spare entry for predicted_normals, dropped after it: a
   // record's mesh is reused (PackageReader's last record), so the resize zero-fills only what it grows by,
   // where decoding into scratch copied every position (refined_elephant's bench decode: 0.9 M of memcpy).

@@ -6,6 +6,7 @@
 #include <random>
 
 #include "core/error.hpp"
+#include "package/byte_planes.hpp"
 #include "package/bytes.hpp"
 #include "package/node_header.hpp"
 #include "package/predictive_codec.hpp"
@@ -60,19 +61,59 @@ TEST_P(DampedParallelogram, EveryDampingDecodesToTheQuantizedPositions) {
   EXPECT_TRUE(damped);  // the jittered grids predict better damped
 }
 
-TEST(DampedParallelogram, AnInvalidDampingIsAnError) {
+// The traversal codec's node of an irregular grid, and the position grid it is quantized to.
+struct TraversalNode {
+  PositionGrid pg;
+  std::vector<uint8_t> bytes;
+};
+TraversalNode traversal_node() {
   const Mesh m = jittered_grid(8, 3);
-  const PositionGrid pg = PositionGrid::for_bounds(m.bounds(), 14);
   NodeGeometry g;
   g.mesh = &m;
+  TraversalNode n{PositionGrid::for_bounds(m.bounds(), 14), {}};
+  n.bytes = node_codec(TraversalCodec::kId).encode(g, n.pg);
+  return n;
+}
+
+TEST(DampedParallelogram, AnInvalidDampingIsAnError) {
   const NodeCodec& codec = node_codec(TraversalCodec::kId);
-  std::vector<uint8_t> node = codec.encode(g, pg);
+  auto [pg, node] = traversal_node();
   ByteReader r(node, "node");
   NodeHeader::read(r, 2, 15 | kPlanePrediction | kMultiParallelogram, node.size());
   const size_t at = r.position();  // the widths byte follows the common header
   ASSERT_EQ(node[at] >> 6, 4 - damping_of(node, 2));
   node[at] |= 3 << 6;  // j = 1
   EXPECT_THROW(codec.decode(node, pg, "node"), Error);
+}
+
+// A node rewritten with 5-byte position residuals, all 0 but the last vertex's first component, `last`.
+std::vector<uint8_t> with_last_residual(std::span<const uint8_t> node, int64_t last) {
+  const PredictiveNode p =
+      PredictiveNode::parse(node, 2, 15 | kPlanePrediction | kMultiParallelogram, "node");
+  PredictiveResiduals r;
+  r.position_bytes = 5, r.normal_bytes = p.normal_bytes, r.damping = p.damping,
+  r.smooth_normals = p.smooth_normals;
+  r.plane = p.flags & kPlanePrediction, r.multi = p.flags & kMultiParallelogram;
+  r.positions.assign(3 * size_t(p.vertices), 0),
+      r.normals.assign(p.normal_bytes ? 2 * size_t(p.vertices) : 0, 0);
+  r.positions[3 * size_t(p.vertices - 1)] = zigzag(last);
+  return write_predictive_node(p, r, p.attribute_stream, p.locked_stream, p.connectivity, p.tail);
+}
+
+// The decoder range-checks the predicted coordinates (its pass after the prediction, predictive_node.cpp):
+// one beyond +-2^32 on the last vertex, the one no other vertex's prediction reads, is an error.
+TEST(DampedParallelogram, APositionOffTheGridsRangeIsAnError) {
+  const NodeCodec& codec = node_codec(TraversalCodec::kId);
+  const auto [pg, node] = traversal_node();
+  EXPECT_NO_THROW(codec.decode(with_last_residual(node, 1000), pg, "node"));
+  for (int64_t last : {int64_t(1) << 33, -(int64_t(1) << 33)}) {
+    try {
+      codec.decode(with_last_residual(node, last), pg, "node");
+      ADD_FAILURE() << last << " decoded";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("out of the grid's range"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace
