@@ -155,8 +155,8 @@ constexpr RecentClusterCodes kFirstClusterCodes = {1,  2,  3,  4,  5,  6,  7,  8
 // instructions for r < 16 (most ranks: the codes of bytes 0..r of one or two little-endian words move up a
 // byte, without a loop), about 20 above (four words). Measured (format 12's page symbol pass, `bench decode
 // --runs 1` under callgrind, read_page): a byte loop for every rank from 8 took elephant_1m 257.20 M
-// instructions, refined_elephant 15.50 M (~180 a rank above 16, 14,172 of them in elephant_1m), these 255.92 /
-// 15.37. No call (a memmove above 16 was one), so that the decoder's loop holds none.
+// instructions, refined_elephant 15.50 M (~180 a rank above 16, 14,172 of them in elephant_1m), these 255.92
+// / 15.37. No call (a memmove above 16 was one), so that the decoder's loop holds none.
 inline __attribute__((always_inline)) uint32_t to_front(RecentClusterCodes& recent, uint32_t r) {
   const uint8_t code = recent[r];
   if (r < 8) [[likely]] {
@@ -272,8 +272,8 @@ inline __attribute__((always_inline)) uint32_t decode_class(uint32_t& x, const u
       : [x] "+r"(x), [at] "+r"(at), [above] "=&r"(above), [slot] "=&r"(slot), [t] "=&r"(t), [u] "=&r"(u),
         [v] "=&x"(v), [low] "=&x"(low), [high] "=&x"(high)
       : [row] "r"(starts), "m"(*reinterpret_cast<const uint16_t(*)[16]>(starts)),
-        "m"(*reinterpret_cast<const uint8_t(*)[2]>(at)), [mask] "i"(kScale - 1), [bits] "i"(kTraversalScaleBits),
-        [low_state] "i"(rans::kLow)
+        "m"(*reinterpret_cast<const uint8_t(*)[2]>(at)), [mask] "i"(kScale - 1),
+        [bits] "i"(kTraversalScaleBits), [low_state] "i"(rans::kLow)
       : "cc");
   return uint32_t(above) - 1;
 #else
@@ -515,9 +515,12 @@ namespace {
 // decode_traversal, with the further parallelograms when `multi` (a template constant: none of their work
 // without them).
 template <bool multi>
-inline __attribute__((always_inline)) void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> references, uint32_t T,
-                    uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where,
-                    std::span<const uint32_t> cluster_triangles, Parallelograms* extra) {
+inline __attribute__((always_inline)) void decode_symbols(std::span<const uint8_t> symbols,
+                                                          std::span<const uint8_t> references, uint32_t T,
+                                                          uint32_t V, uint32_t* indices, uint32_t* predictors,
+                                                          const std::string& where,
+                                                          std::span<const uint32_t> cluster_triangles,
+                                                          Parallelograms* extra) {
   ByteReader refs(references, where);
   thread_local std::vector<Front::Edge> edges;
   Front front(edges, T);
@@ -631,11 +634,12 @@ inline __attribute__((always_inline)) void decode_symbols(std::span<const uint8_
     // The gates from here until a piece start in an inner loop (GCC 12 allocated fewer stack slots to the
     // gate's state than with one loop: elephant_1m's decode_traversal 353.5 -> 344.7 M instructions).
     for (; e != front.size(); e = front.gate(e + 1)) {
-      if (in > end) [[unlikely]] corrupted(where, "symbols end early");
+      if (in > end) [[unlikely]]
+        corrupted(where, "symbols end early");
       const Front::Edge& g = front.edge(e);
       const uint32_t a = g.a, b = g.b;
-      const uint32_t symbol_class =
-          decode_class(x, set_rows + previous + kGateOffsets.first[count[a]] + kGateOffsets.second[count[b]], in);
+      const uint32_t symbol_class = decode_class(
+          x, set_rows + previous + kGateOffsets.first[count[a]] + kGateOffsets.second[count[b]], in);
       std::swap(x, y);
       previous = 16 * 64 * symbol_class;
       uint32_t kind = symbol_class;
@@ -648,13 +652,13 @@ inline __attribute__((always_inline)) void decode_symbols(std::span<const uint8_
         if (k >= C) corrupted(where, "cluster out of range");
       }
       uint32_t c;
-      // kVertex, about half the symbols, tested before the jump table of the others. Branch-free forms of this
-      // dispatch were slower (refined_elephant's `bench decode`, main 2b2a9a3, callgrind --branch-sim on
+      // kVertex, about half the symbols, tested before the jump table of the others. Branch-free forms of
+      // this dispatch were slower (refined_elephant's `bench decode`, main 2b2a9a3, callgrind --branch-sim on
       // decode_node, wall as paired new / old ratios of `--runs 50`): kVertex and kRight on one path by
-      // conditional moves, 47.8 -> 58.7 M instructions, simulated mispredictions 255 -> 205 K, wall 0.92; every
-      // kind by conditional moves and tables, 82.0 M, 149 K, wall 0.73. Conditional moves for the cluster code
-      // and the gate scan's first step: 48.9 M, 186 K, wall 0.99-1.01 (noise +-1.5 %): the CPU predicts most of
-      // what the simulation counts as mispredicted.
+      // conditional moves, 47.8 -> 58.7 M instructions, simulated mispredictions 255 -> 205 K, wall 0.92;
+      // every kind by conditional moves and tables, 82.0 M, 149 K, wall 0.73. Conditional moves for the
+      // cluster code and the gate scan's first step: 48.9 M, 186 K, wall 0.99-1.01 (noise +-1.5 %): the CPU
+      // predicts most of what the simulation counts as mispredicted.
       if (kind == kVertex) {
         if (next == V) corrupted(where, "more vertices than the node holds");
         c = next++;
