@@ -631,24 +631,28 @@ inline __attribute__((always_inline)) void decode_symbols(std::span<const uint8_
       --left;
       continue;
     }
-    // The gates from here until a piece start in an inner loop (GCC 12 allocated fewer stack slots to the
-    // gate's state than with one loop: elephant_1m's decode_traversal 353.5 -> 344.7 M instructions).
-    for (; e != front.size(); e = front.gate(e + 1)) {
+    // The gates from here until a piece start, two a loop step: the first one's class on x, the second one's
+    // on y (each step on the state the step before did not take), so that the states need no swap but after
+    // a tagged class's rank. gate(s, t) decodes the gate e, its class on s, and goes on to the next one;
+    // false when there is none before a piece start, or no triangle is left. (In an inner loop, out of the
+    // piece starts' one, GCC 12 gave the gate's state fewer stack slots; with the swap in every gate, the
+    // states went to the stack: elephant_1m's decode_traversal 353.5 (one loop) -> 344.7 (two) -> 337.8 M
+    // instructions (two gates a step), `bench decode --runs 1` under callgrind.)
+    auto gate = [&](uint32_t & s, uint32_t & t) __attribute__((always_inline)) {
       if (in > end) [[unlikely]]
         corrupted(where, "symbols end early");
       const Front::Edge& g = front.edge(e);
       const uint32_t a = g.a, b = g.b;
       const uint32_t symbol_class = decode_class(
-          x, set_rows + previous + kGateOffsets.first[count[a]] + kGateOffsets.second[count[b]], in);
-      std::swap(x, y);
+          s, set_rows + previous + kGateOffsets.first[count[a]] + kGateOffsets.second[count[b]], in);
       previous = 16 * 64 * symbol_class;
       uint32_t kind = symbol_class;
       // Untagged: the gate's cluster (below C, checked when its triangle was decoded), else the code's - 1.
       uint32_t k = g.cluster;
       if (symbol_class >= kKinds) [[unlikely]] {
         kind -= kKinds;
-        k = to_front(recent, decode_rank(x, ranks, in)) - 1;
-        std::swap(x, y);
+        k = to_front(recent, decode_rank(t, ranks, in)) - 1;
+        std::swap(s, t);  // the next gate's class on this gate's state
         if (k >= C) corrupted(where, "cluster out of range");
       }
       uint32_t c;
@@ -695,12 +699,22 @@ inline __attribute__((always_inline)) void decode_symbols(std::span<const uint8_
             break;
           }
           default:  // kBoundary, the kind left: the gate stays in its loop, processed
-            continue;
+            e = front.gate(e + 1);
+            return e != front.size();
         }
         if constexpr (multi) join(a, b, g.o, c);  // the gate
       }
       emit(b, a, c, k);
-      if (--left == 0) break;
+      if (--left == 0) return false;
+      e = front.gate(e + 1);
+      return e != front.size();
+    };
+    for (;;) {
+      if (!gate(x, y)) {
+        std::swap(x, y);  // the next gate's class on y
+        break;
+      }
+      if (!gate(y, x)) break;
     }
   }
   if (!symbols.empty()) {
