@@ -656,13 +656,13 @@ inline __attribute__((always_inline)) void decode_symbols(std::span<const uint8_
         if (k >= C) corrupted(where, "cluster out of range");
       }
       uint32_t c;
-      // kVertex, about half the symbols, tested before the jump table of the others. Branch-free forms of
-      // this dispatch were slower (refined_elephant's `bench decode`, main 2b2a9a3, callgrind --branch-sim on
-      // decode_node, wall as paired new / old ratios of `--runs 50`): kVertex and kRight on one path by
-      // conditional moves, 47.8 -> 58.7 M instructions, simulated mispredictions 255 -> 205 K, wall 0.92;
-      // every kind by conditional moves and tables, 82.0 M, 149 K, wall 0.73. Conditional moves for the
-      // cluster code and the gate scan's first step: 48.9 M, 186 K, wall 0.99-1.01 (noise +-1.5 %): the CPU
-      // predicts most of what the simulation counts as mispredicted.
+      // kVertex, about half the symbols, tested first. Branch-free forms of this dispatch were slower
+      // (refined_elephant's `bench decode`, main 2b2a9a3, callgrind --branch-sim on decode_node, wall as
+      // paired new / old ratios of `--runs 50`): kVertex and kRight on one path by conditional moves, 47.8
+      // -> 58.7 M instructions, simulated mispredictions 255 -> 205 K, wall 0.92; every kind by conditional
+      // moves and tables, 82.0 M, 149 K, wall 0.73. Conditional moves for the cluster code and the gate
+      // scan's first step: 48.9 M, 186 K, wall 0.99-1.01 (noise +-1.5 %): the CPU predicts most of what the
+      // simulation counts as mispredicted.
       if (kind == kVertex) {
         if (next == V) corrupted(where, "more vertices than the node holds");
         c = next++;
@@ -671,38 +671,34 @@ inline __attribute__((always_inline)) void decode_symbols(std::span<const uint8_
         front.attach(e, c, k);
         uint32_t* const predictor = predictors + 3 * size_t(c);
         predictor[0] = a, predictor[1] = b, predictor[2] = o;
-      } else {
-        switch (kind) {
-          case kLeft:
-            c = front.left(e);
-            if (c == kNone) corrupted(where, "left turn in a loop of 2");
-            if constexpr (multi) join(c, a, front.edge(g.prev).o, b);  // P = c -> a
-            front.close_left(e, k);
-            break;
-          case kRight:
-            c = front.right(e);
-            if (c == kNone) corrupted(where, "right turn in a loop of 2");
-            if constexpr (multi) join(b, c, front.edge(g.next).o, a);  // N = b -> c
-            front.close_right(e, k);
-            break;
-          case kEnd:
-            if (!front.closes(e)) corrupted(where, "end of a loop that is not 3 edges");
-            c = front.left(e);
-            if constexpr (multi) join(c, a, front.edge(g.prev).o, b), join(b, c, front.edge(g.next).o, a);
-            front.close_loop(e);
-            break;
-          case kSplit: {
-            const uint64_t r = refs.varint();
-            if (r >= next) corrupted(where, "reference to a vertex not decoded yet");
-            c = next - 1 - uint32_t(r);
-            front.attach(e, c, k);
-            break;
-          }
-          default:  // kBoundary, the kind left: the gate stays in its loop, processed
-            e = front.gate(e + 1);
-            return e != front.size();
-        }
-        if constexpr (multi) join(a, b, g.o, c);  // the gate
+      } else if (kind == kRight) {
+        // The others by frequency, a chain of tests (a switch took GCC 12's search by value, 4 tests for a
+        // kRight: elephant_1m's decode_traversal 337.8 -> 334.3 M instructions).
+        c = front.right(e);
+        if (c == kNone) corrupted(where, "right turn in a loop of 2");
+        if constexpr (multi) join(b, c, front.edge(g.next).o, a);  // N = b -> c
+        front.close_right(e, k);
+      } else if (kind == kBoundary) {  // the gate stays in its loop, processed
+        e = front.gate(e + 1);
+        return e != front.size();
+      } else if (kind == kLeft) {
+        c = front.left(e);
+        if (c == kNone) corrupted(where, "left turn in a loop of 2");
+        if constexpr (multi) join(c, a, front.edge(g.prev).o, b);  // P = c -> a
+        front.close_left(e, k);
+      } else if (kind == kEnd) {
+        if (!front.closes(e)) corrupted(where, "end of a loop that is not 3 edges");
+        c = front.left(e);
+        if constexpr (multi) join(c, a, front.edge(g.prev).o, b), join(b, c, front.edge(g.next).o, a);
+        front.close_loop(e);
+      } else {  // kSplit, the kind left
+        const uint64_t r = refs.varint();
+        if (r >= next) corrupted(where, "reference to a vertex not decoded yet");
+        c = next - 1 - uint32_t(r);
+        front.attach(e, c, k);
+      }
+      if constexpr (multi) {
+        if (kind != kVertex) join(a, b, g.o, c);  // the gate (a kVertex's is its predictor)
       }
       emit(b, a, c, k);
       if (--left == 0) return false;
