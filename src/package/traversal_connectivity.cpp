@@ -253,7 +253,7 @@ inline __attribute__((always_inline)) uint32_t decode_class(uint32_t& x, const u
       "pcmpgtw %[v], %[high]\n\t"
       "packsswb %[high], %[low]\n\t"
       "pmovmskb %[low], %k[above]\n\t"
-      "bsfl %k[above], %k[above]\n\t"
+      "tzcntl %k[above], %k[above]\n\t"  // (bsf where there is no BMI1: the same for the nonzero mask)
       // x = (start_{s+1} - start_s) (x >> 12) + slot - start_s
       "movzwl -2(%[row],%[above],2), %k[u]\n\t"
       "movzwl (%[row],%[above],2), %k[t]\n\t"
