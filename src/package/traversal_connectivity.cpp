@@ -525,8 +525,8 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
   Front front(edges, T);
   uint32_t next = 0;  // the next new vertex
   // The symbols' rANS stream (encode_traversal_steps), copied with 8 bytes of padding: a gate reads at most 4
-  // bytes and starts only at or before the stream's end. An empty stream holds no gate (at past its end).
-  // Two states, each step on the one the step before did not take (x, then the two swap names): a gate's
+  // bytes and starts only at or before the stream's end. An empty stream holds no gate (`in` past its end).
+  // Two states, each step on the one the step before did not take (x, then y: the loop below): a gate's
   // state is not the previous gate's, whose decode only picks its context's row, so that the steps of
   // consecutive gates overlap in the CPU.
   thread_local std::vector<uint8_t> stream;
