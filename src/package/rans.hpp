@@ -79,11 +79,13 @@ inline void copy_padded(std::span<const uint8_t> from, std::vector<uint8_t>& to)
 
 // The decoder's renormalization: x < kLow: x = x << 16 | next and at += 2, else neither; with conditional
 // moves, not a branch (a read comes about every 16 bits of code, every few steps: a branch mispredicts on
-// most, and GCC 12 compiles every C form of the selection, hints included, to a branch).
-inline __attribute__((always_inline)) void renormalize(uint32_t& x, size_t& at, uint16_t next) {
+// most, and GCC 12 compiles every C form of the selection, hints included, to a branch). `at`: a position
+// (size_t) or a pointer to bytes.
+template <typename Position>
+inline __attribute__((always_inline)) void renormalize(uint32_t& x, Position& at, uint16_t next) {
   const uint32_t read = x << 16 | next;
 #if defined(__x86_64__)
-  const size_t after = at + 2;
+  const Position after = at + 2;
   asm("cmpl %[low], %[x]\n\tcmovbl %[read], %[x]\n\tcmovbq %[after], %[at]"
       : [x] "+r"(x), [at] "+r"(at)
       : [read] "r"(read), [after] "r"(after), [low] "i"(kLow)

@@ -75,11 +75,15 @@ class Front {
     push(v2, v0, v1, at + 1, at, k);
   }
   // kVertex and kSplit: the gate a -> b becomes a -> c, c -> b.
+  // The two new edges stored through one address (elephant_1m's decode_traversal 358.0 -> 353.7 M
+  // instructions, `bench decode --runs 1` under callgrind: ~3 a kVertex).
   void attach(uint32_t e, uint32_t c, uint32_t k) {
     const uint32_t a = edges_[e].a, b = edges_[e].b, prev = edges_[e].prev, next = edges_[e].next;
     const uint32_t x = size_, y = x + 1;
-    push(a, c, b, prev, y, k);
-    push(c, b, a, x, next, k);
+    Edge* const to = edges_ + x;
+    to[0] = {a, c, b, prev, y, k};
+    to[1] = {c, b, a, x, next, k};
+    size_ += 2;
     edges_[prev].next = x;  // a loop has 2 edges or more: prev and next are not the gate
     edges_[next].prev = y;
   }
@@ -140,20 +144,21 @@ constexpr GateOffsets kGateOffsets = [] {
   return t;
 }();
 
-// The cluster codes 1..31, most recently coded first: a code is stored as its rank here (0..30), then moves
-// to the front; every record starts from kFirstClusterCodes.
-using RecentClusterCodes = std::array<uint8_t, 31>;
+// The cluster codes 1..31, most recently coded first (and a byte of padding, 0): a code is stored as its
+// rank here (0..30), then moves to the front; every record starts from kFirstClusterCodes.
+using RecentClusterCodes = std::array<uint8_t, 32>;
 constexpr RecentClusterCodes kFirstClusterCodes = {1,  2,  3,  4,  5,  6,  7,  8,  9,  10, 11,
                                                    12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22,
-                                                   23, 24, 25, 26, 27, 28, 29, 30, 31};
+                                                   23, 24, 25, 26, 27, 28, 29, 30, 31, 0};
 
 // Move-to-front (Bentley, Sleator, Tarjan & Wei 1986, "A locally adaptive data compression scheme", CACM
-// 29(4)) over the recent cluster codes: the code of rank r, which then moves to the front. Cost: a few
+// 29(4)) over the recent cluster codes: the code of rank r < 31, which then moves to the front. Cost: a few
 // instructions for r < 16 (most ranks: the codes of bytes 0..r of one or two little-endian words move up a
-// byte, without a loop), a memmove above. Measured (format 12's page symbol pass, `bench decode --runs 1`
-// under callgrind, read_page): a byte loop for every rank from 8 took elephant_1m 257.20 M instructions,
-// refined_elephant 15.50 M (~180 a rank above 16, 14,172 of them in elephant_1m), these 255.92 / 15.37.
-uint32_t to_front(RecentClusterCodes& recent, uint32_t r) {
+// byte, without a loop), about 20 above (four words). Measured (format 12's page symbol pass, `bench decode
+// --runs 1` under callgrind, read_page): a byte loop for every rank from 8 took elephant_1m 257.20 M
+// instructions, refined_elephant 15.50 M (~180 a rank above 16, 14,172 of them in elephant_1m), these 255.92
+// / 15.37. No call (a memmove above 16 was one), so that the decoder's loop holds none.
+inline __attribute__((always_inline)) uint32_t to_front(RecentClusterCodes& recent, uint32_t r) {
   const uint8_t code = recent[r];
   if (r < 8) [[likely]] {
     uint64_t word;
@@ -172,8 +177,16 @@ uint32_t to_front(RecentClusterCodes& recent, uint32_t r) {
     std::memcpy(recent.data(), word, 16);
     return code;
   }
-  std::memmove(recent.data() + 1, recent.data(), r);
-  recent[0] = code;
+  uint64_t word[4];
+  std::memcpy(word, recent.data(), 32);
+  // Bytes 16..r: of word 2 (all of it from r = 23) and of word 3 (from r = 24; byte 31 is the padding).
+  const uint64_t moved2 = r >= 23 ? ~uint64_t(0) : ~uint64_t(0) >> (56 - 8 * (r - 16));
+  const uint64_t moved3 = r >= 24 ? ~uint64_t(0) >> (56 - 8 * (r - 24)) : 0;
+  word[3] = (word[3] & ~moved3) | (((word[3] << 8) | (word[2] >> 56)) & moved3);
+  word[2] = (word[2] & ~moved2) | (((word[2] << 8) | (word[1] >> 56)) & moved2);
+  word[1] = (word[1] << 8) | (word[0] >> 56);
+  word[0] = (word[0] << 8) | code;
+  std::memcpy(recent.data(), word, 32);
   return code;
 }
 
@@ -217,36 +230,74 @@ const RankTable& rank_table() {
 // One rANS step (Duda 2013, eq. 9: D(x) = (s, f_s floor(x / 2^12) + x mod 2^12 - start_s)) under the class
 // row `starts` (class_starts()): s is the class whose range holds the slot x mod 2^12, found by
 // comparing the slot with all 16 starts at once (the lanes whose start lies above it: the first is s + 1,
-// lanes 12-15 always); then x is read back up to kLow from the next 2 bytes at `at`. Cost: about 14
-// instructions, two loads of the row, no branch.
+// lanes 12-15 always); then x is read back up to kLow from the next 2 bytes at `at` (rans::renormalize).
+// Cost: 28 instructions on x86-64, two loads of the row, no branch. There one asm block: GCC 12 took ~37
+// for the same steps from intrinsics (copies of x and `at` around renormalize's asm, the class index
+// sign-extended and moved): `bench decode --runs 1` under callgrind, decode_traversal, refined_elephant
+// 27.95 -> 25.40 M instructions, elephant_1m 370.9 -> 367.0 M.
 inline __attribute__((always_inline)) uint32_t decode_class(uint32_t& x, const uint16_t* starts,
-                                                            const uint8_t* bytes, size_t& at) {
-  const uint32_t slot = x & (kScale - 1);
-#if defined(__SSE2__)
-  const __m128i s = _mm_set1_epi16(int16_t(slot));  // below 2^15: the signed compare is the unsigned one
-  const __m128i low = _mm_loadu_si128(reinterpret_cast<const __m128i*>(starts));
-  const __m128i high = _mm_loadu_si128(reinterpret_cast<const __m128i*>(starts + 8));
-  const uint32_t above =
-      uint32_t(_mm_movemask_epi8(_mm_packs_epi16(_mm_cmpgt_epi16(low, s), _mm_cmpgt_epi16(high, s))));
-  const uint32_t c = uint32_t(__builtin_ctz(above)) - 1;
+                                                            const uint8_t*& at) {
+  // (AddressSanitizer sees no access in an asm block: its builds take the C++ form, whose reads it checks.)
+#if defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
+  uint64_t above, slot, t, u;  // above: s + 1; t, u: scratch
+  __m128i v, low, high;
+  asm("movl %k[x], %k[slot]\n\t"
+      "andl %[mask], %k[slot]\n\t"
+      // The slot in every lane (below 2^15: the signed compare is the unsigned one); the lanes above it.
+      "movd %k[slot], %[v]\n\t"
+      "punpcklwd %[v], %[v]\n\t"
+      "pshufd $0, %[v], %[v]\n\t"
+      "movdqu (%[row]), %[low]\n\t"
+      "movdqu 16(%[row]), %[high]\n\t"
+      "pcmpgtw %[v], %[low]\n\t"
+      "pcmpgtw %[v], %[high]\n\t"
+      "packsswb %[high], %[low]\n\t"
+      "pmovmskb %[low], %k[above]\n\t"
+      "tzcntl %k[above], %k[above]\n\t"  // (bsf where there is no BMI1: the same for the nonzero mask)
+      // x = (start_{s+1} - start_s) (x >> 12) + slot - start_s
+      "movzwl -2(%[row],%[above],2), %k[u]\n\t"
+      "movzwl (%[row],%[above],2), %k[t]\n\t"
+      "subl %k[u], %k[t]\n\t"
+      "subl %k[u], %k[slot]\n\t"
+      "shrl %[bits], %k[x]\n\t"
+      "imull %k[t], %k[x]\n\t"
+      "addl %k[slot], %k[x]\n\t"
+      // x < kLow: x = x << 16 | the next u16 and at += 2
+      "movzwl (%[at]), %k[t]\n\t"
+      "movl %k[x], %k[u]\n\t"
+      "shll $16, %k[u]\n\t"
+      "orl %k[t], %k[u]\n\t"
+      "leaq 2(%[at]), %[t]\n\t"
+      "cmpl %[low_state], %k[x]\n\t"
+      "cmovbl %k[u], %k[x]\n\t"
+      "cmovbq %[t], %[at]"
+      : [x] "+r"(x), [at] "+r"(at), [above] "=&r"(above), [slot] "=&r"(slot), [t] "=&r"(t), [u] "=&r"(u),
+        [v] "=&x"(v), [low] "=&x"(low), [high] "=&x"(high)
+      : [row] "r"(starts), "m"(*reinterpret_cast<const uint16_t(*)[16]>(starts)),
+        "m"(*reinterpret_cast<const uint8_t(*)[2]>(at)), [mask] "i"(kScale - 1),
+        [bits] "i"(kTraversalScaleBits), [low_state] "i"(rans::kLow)
+      : "cc");
+  return uint32_t(above) - 1;
 #else
+  const uint32_t slot = x & (kScale - 1);
   uint32_t c = 0;
   while (starts[c + 1] <= slot) ++c;
-#endif
   const uint32_t start = starts[c];
   x = (starts[c + 1] - start) * (x >> kTraversalScaleBits) + slot - start;
   uint16_t next;
-  std::memcpy(&next, bytes + at, 2);
+  std::memcpy(&next, at, 2);
   rans::renormalize(x, at, next);
   return c;
+#endif
 }
 
 // The cluster rank's step likewise, under rank_table().
-inline uint32_t decode_rank(uint32_t& x, const RankTable& table, const uint8_t* bytes, size_t& at) {
+inline __attribute__((always_inline)) uint32_t decode_rank(uint32_t& x, const RankTable& table,
+                                                           const uint8_t*& at) {
   const size_t slot = x & (kScale - 1);
   x = rans::step(x, table.slot, slot, kTraversalScaleBits);
   uint16_t next;
-  std::memcpy(&next, bytes + at, 2);
+  std::memcpy(&next, at, 2);
   rans::renormalize(x, at, next);
   return table.rank[slot];
 }
@@ -394,7 +445,7 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
       uint8_t symbol_class = kind, rank = 0;
       if (k != g.cluster) {
         symbol_class += kKinds;
-        rank = uint8_t(std::find(recent.begin(), recent.end(), k + 1) - recent.begin());
+        rank = uint8_t(std::find(recent.begin(), recent.begin() + 31, k + 1) - recent.begin());
         to_front(recent, rank);
       }
       code.steps.push_back({uint16_t(context), symbol_class, rank});
@@ -457,6 +508,12 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
 
 namespace {
 
+// The decoder's error for a corrupted traversal: out of line, cold and noreturn, so that the decode loop
+// holds none of the message's set-up.
+[[noreturn, gnu::noinline, gnu::cold]] void corrupted(const std::string& where, const char* what) {
+  throw Error(where + ": corrupted connectivity (" + what + ")");
+}
+
 // decode_traversal, with the further parallelograms when `multi` (a template constant: none of their work
 // without them).
 template <bool multi>
@@ -464,38 +521,40 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
                     uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where,
                     std::span<const uint32_t> cluster_triangles, Parallelograms* extra) {
   ByteReader refs(references, where);
-  auto fail = [&](const char* what) { throw Error(where + ": corrupted connectivity (" + what + ")"); };
   thread_local std::vector<Front::Edge> edges;
   Front front(edges, T);
   uint32_t next = 0;  // the next new vertex
   // The symbols' rANS stream (encode_traversal_steps), copied with 8 bytes of padding: a gate reads at most 4
-  // bytes and starts only at or before the stream's end. An empty stream holds no gate (at past its end).
-  // Two states, each step on the one the step before did not take (x, then the two swap names): a gate's
+  // bytes, and a loop step of two gates starts only at or before the stream's end (one test a step, not one
+  // a gate: `bench decode --runs 1` under callgrind, the traversal's decode 337.3 -> 332.9 M instructions on
+  // elephant_1m, 24.31 -> 24.04 M on refined_elephant; a stream that ends early is refused at the step after,
+  // or for what its padding decodes to). An empty stream holds no gate (`in` past its end).
+  // Two states, each step on the one the step before did not take (x, then y: the loop below): a gate's
   // state is not the previous gate's, whose decode only picks its context's row, so that the steps of
   // consecutive gates overlap in the CPU.
   thread_local std::vector<uint8_t> stream;
+  static constexpr uint8_t kNoStream[1] = {};
   uint32_t x = 0, y = 0;
-  size_t read = 1, end = 0;  // the next rANS read, and the stream's end
+  const uint8_t *in = kNoStream + 1, *end = kNoStream;  // the next rANS read, and the stream's end
   if (!symbols.empty()) {
-    if (symbols.size() < 8) fail("symbol stream shorter than its states");
+    if (symbols.size() < 8) corrupted(where, "symbol stream shorter than its states");
     rans::copy_padded(symbols, stream);
     std::memcpy(&x, stream.data(), 4), std::memcpy(&y, stream.data() + 4, 4);
-    if (x < rans::kLow || y < rans::kLow) fail("invalid symbol state");
-    read = 8, end = symbols.size();
+    if (x < rans::kLow || y < rans::kLow) corrupted(where, "invalid symbol state");
+    in = stream.data() + 8, end = stream.data() + symbols.size();
   }
-  const uint8_t* const bytes = stream.data();
   const RankTable& ranks = rank_table();
   RecentClusterCodes recent = kFirstClusterCodes;
   // The rows of the stream's table set (its first step, at 1/2 each: the slot's top bit), and the offset of
   // the previous class's (times 16 u16 a row).
   const uint16_t(*const all_rows)[16] = class_starts();
   const uint16_t* set_rows = all_rows[0];
-  if (read <= end) {
+  if (in <= end) {
     const uint32_t slot = x & (kScale - 1), set = slot >> (kTraversalScaleBits - 1);
     x = kScale / 2 * (x >> kTraversalScaleBits) + slot - kScale / 2 * set;
-    uint16_t next;
-    std::memcpy(&next, bytes + read, 2);
-    rans::renormalize(x, read, next);
+    uint16_t bits;
+    std::memcpy(&bits, in, 2);
+    rans::renormalize(x, in, bits);
     std::swap(x, y);
     set_rows = all_rows[kTraversalContexts * set];
   }
@@ -505,11 +564,11 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
   // of each cluster stay in traversal order, as the encoder's counting sort leaves them; C = 1 otherwise
   // (every symbol's cluster code must then be 0).
   const uint32_t C = cluster_triangles.size() > 1 ? uint32_t(cluster_triangles.size()) : 1;
-  if (C > kMaxRecordClusters) fail("more clusters than a record may hold");
+  if (C > kMaxRecordClusters) corrupted(where, "more clusters than a record may hold");
   std::array<uint32_t*, kMaxRecordClusters> at, range_end;  // per cluster: next place, end of its range
   size_t placed = 0;                                        // triangles of the clusters before k
   for (uint32_t k = 0; k < C; ++k) placed += C > 1 ? cluster_triangles[k] : T;
-  if (placed != T) fail("triangles per cluster differ from the header's");
+  if (placed != T) corrupted(where, "triangles per cluster differ from the header's");
   placed = 0;
   for (uint32_t k = 0; k < C; ++k) {
     at[k] = indices + 3 * placed;
@@ -524,7 +583,7 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
   auto emit = [&](uint32_t v0, uint32_t v1, uint32_t v2, uint32_t k) {
     ++count[v0], ++count[v1], ++count[v2];
     uint32_t*& out = at[k];
-    if (out == range_end[k]) fail("triangles per cluster differ from the header's");
+    if (out == range_end[k]) corrupted(where, "triangles per cluster differ from the header's");
     out[0] = v0, out[1] = v1, out[2] = v2;
     out += 3;
   };
@@ -553,19 +612,19 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
       uint32_t k = 0;
       if (C > 1) {
         const uint64_t read = refs.varint();
-        if (read >= C) fail("cluster out of range");
+        if (read >= C) corrupted(where, "cluster out of range");
         k = uint32_t(read);
       }
       uint32_t corner[3];
       for (int k = 0; k < 3; ++k) {
         const uint64_t r = refs.varint();
         if (r == 0) {
-          if (next == V) fail("more vertices than the node holds");
+          if (next == V) corrupted(where, "more vertices than the node holds");
           const uint32_t from = k > 0 ? corner[k - 1] : next > 0 ? next - 1 : V;
           predictors[3 * next] = predictors[3 * next + 1] = predictors[3 * next + 2] = from;
           corner[k] = next++;
         } else {
-          if (r > next) fail("reference to a vertex not decoded yet");
+          if (r > next) corrupted(where, "reference to a vertex not decoded yet");
           corner[k] = next - uint32_t(r);
         }
       }
@@ -574,81 +633,95 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
       --left;
       continue;
     }
-    if (read > end) fail("symbols end early");
-    const Front::Edge& g = front.edge(e);
-    const uint32_t a = g.a, b = g.b;
-    const uint32_t symbol_class = decode_class(
-        x, set_rows + previous + kGateOffsets.first[count[a]] + kGateOffsets.second[count[b]], bytes, read);
-    std::swap(x, y);
-    previous = 16 * 64 * symbol_class;
-    uint32_t kind = symbol_class;
-    // Untagged: the gate's cluster (below C, checked when its triangle was decoded), else the code's - 1.
-    uint32_t k = g.cluster;
-    if (symbol_class >= kKinds) [[unlikely]] {
-      kind -= kKinds;
-      k = to_front(recent, decode_rank(x, ranks, bytes, read)) - 1;
-      std::swap(x, y);
-      if (k >= C) fail("cluster out of range");
-    }
-    uint32_t c;
-    // kVertex, about half the symbols, tested before the jump table of the others. Branch-free forms of this
-    // dispatch were slower (refined_elephant's `bench decode`, main 2b2a9a3, callgrind --branch-sim on
-    // decode_node, wall as paired new / old ratios of `--runs 50`): kVertex and kRight on one path by
-    // conditional moves, 47.8 -> 58.7 M instructions, simulated mispredictions 255 -> 205 K, wall 0.92; every
-    // kind by conditional moves and tables, 82.0 M, 149 K, wall 0.73. Conditional moves for the cluster code
-    // and the gate scan's first step: 48.9 M, 186 K, wall 0.99-1.01 (noise +-1.5 %): the CPU predicts most of
-    // what the simulation counts as mispredicted.
-    if (kind == kVertex) {
-      if (next == V) fail("more vertices than the node holds");
-      c = next++;
-      // The front first: it reads the gate's fields that a, b were loaded from, and no store lies between.
-      const uint32_t o = g.o;
-      front.attach(e, c, k);
-      uint32_t* const predictor = predictors + 3 * size_t(c);
-      predictor[0] = a, predictor[1] = b, predictor[2] = o;
-    } else {
-      switch (kind) {
-        case kLeft:
-          c = front.left(e);
-          if (c == kNone) fail("left turn in a loop of 2");
-          if constexpr (multi) join(c, a, front.edge(g.prev).o, b);  // P = c -> a
-          front.close_left(e, k);
-          break;
-        case kRight:
-          c = front.right(e);
-          if (c == kNone) fail("right turn in a loop of 2");
-          if constexpr (multi) join(b, c, front.edge(g.next).o, a);  // N = b -> c
-          front.close_right(e, k);
-          break;
-        case kEnd:
-          if (!front.closes(e)) fail("end of a loop that is not 3 edges");
-          c = front.left(e);
-          if constexpr (multi) join(c, a, front.edge(g.prev).o, b), join(b, c, front.edge(g.next).o, a);
-          front.close_loop(e);
-          break;
-        case kSplit: {
-          const uint64_t r = refs.varint();
-          if (r >= next) fail("reference to a vertex not decoded yet");
-          c = next - 1 - uint32_t(r);
-          front.attach(e, c, k);
-          break;
-        }
-        default:  // kBoundary, the kind left
-          ++e;    // the gate stays in its loop, processed: the next one lies past it
-          continue;
+    // The gates from here until a piece start, two a loop step: the first one's class on x, the second one's
+    // on y (each step on the state the step before did not take), so that the states need no swap but after
+    // a tagged class's rank. gate(s, t) decodes the gate e, its class on s, and goes on to the next one;
+    // false when there is none before a piece start, or no triangle is left. (In an inner loop, out of the
+    // piece starts' one, GCC 12 gave the gate's state fewer stack slots; with the swap in every gate, the
+    // states went to the stack: elephant_1m's decode_traversal 353.5 (one loop) -> 344.7 (two) -> 337.8 M
+    // instructions (two gates a step), `bench decode --runs 1` under callgrind.)
+    auto gate = [&](uint32_t & s, uint32_t & t) __attribute__((always_inline)) {
+      const Front::Edge& g = front.edge(e);
+      const uint32_t a = g.a, b = g.b;
+      const uint32_t symbol_class = decode_class(
+          s, set_rows + previous + kGateOffsets.first[count[a]] + kGateOffsets.second[count[b]], in);
+      previous = 16 * 64 * symbol_class;
+      uint32_t kind = symbol_class;
+      // Untagged: the gate's cluster (below C, checked when its triangle was decoded), else the code's - 1.
+      uint32_t k = g.cluster;
+      if (symbol_class >= kKinds) [[unlikely]] {
+        kind -= kKinds;
+        k = to_front(recent, decode_rank(t, ranks, in)) - 1;
+        std::swap(s, t);  // the next gate's class on this gate's state
+        if (k >= C) corrupted(where, "cluster out of range");
       }
-      if constexpr (multi) join(a, b, g.o, c);  // the gate
+      uint32_t c;
+      // kVertex, about half the symbols, tested first. Branch-free forms of this dispatch were slower
+      // (refined_elephant's `bench decode`, main 2b2a9a3, callgrind --branch-sim on decode_node, wall as
+      // paired new / old ratios of `--runs 50`): kVertex and kRight on one path by conditional moves, 47.8
+      // -> 58.7 M instructions, simulated mispredictions 255 -> 205 K, wall 0.92; every kind by conditional
+      // moves and tables, 82.0 M, 149 K, wall 0.73. Conditional moves for the cluster code and the gate
+      // scan's first step: 48.9 M, 186 K, wall 0.99-1.01 (noise +-1.5 %): the CPU predicts most of what the
+      // simulation counts as mispredicted.
+      if (kind == kVertex) {
+        if (next == V) corrupted(where, "more vertices than the node holds");
+        c = next++;
+        // The front first: it reads the gate's fields that a, b were loaded from, and no store lies between.
+        const uint32_t o = g.o;
+        front.attach(e, c, k);
+        uint32_t* const predictor = predictors + 3 * size_t(c);
+        predictor[0] = a, predictor[1] = b, predictor[2] = o;
+      } else if (kind == kRight) {
+        // The others by frequency, a chain of tests (a switch took GCC 12's search by value, 4 tests for a
+        // kRight: elephant_1m's decode_traversal 337.8 -> 334.3 M instructions).
+        c = front.right(e);
+        if (c == kNone) corrupted(where, "right turn in a loop of 2");
+        if constexpr (multi) join(b, c, front.edge(g.next).o, a);  // N = b -> c
+        front.close_right(e, k);
+      } else if (kind == kBoundary) {  // the gate stays in its loop, processed
+        e = front.gate(e + 1);
+        return e != front.size();
+      } else if (kind == kLeft) {
+        c = front.left(e);
+        if (c == kNone) corrupted(where, "left turn in a loop of 2");
+        if constexpr (multi) join(c, a, front.edge(g.prev).o, b);  // P = c -> a
+        front.close_left(e, k);
+      } else if (kind == kEnd) {
+        if (!front.closes(e)) corrupted(where, "end of a loop that is not 3 edges");
+        c = front.left(e);
+        if constexpr (multi) join(c, a, front.edge(g.prev).o, b), join(b, c, front.edge(g.next).o, a);
+        front.close_loop(e);
+      } else {  // kSplit, the kind left
+        const uint64_t r = refs.varint();
+        if (r >= next) corrupted(where, "reference to a vertex not decoded yet");
+        c = next - 1 - uint32_t(r);
+        front.attach(e, c, k);
+      }
+      if constexpr (multi) {
+        if (kind != kVertex) join(a, b, g.o, c);  // the gate (a kVertex's is its predictor)
+      }
+      emit(b, a, c, k);
+      if (--left == 0) return false;
+      e = front.gate(e + 1);
+      return e != front.size();
+    };
+    for (;;) {
+      // The stream's end, once a loop step: its two gates read at most the padding's 8 bytes past it.
+      if (in > end) [[unlikely]]
+        corrupted(where, "symbols end early");
+      if (!gate(x, y)) {
+        std::swap(x, y);  // the next gate's class on y
+        break;
+      }
+      if (!gate(y, x)) break;
     }
-    emit(b, a, c, k);
-    --left;
-    ++e;
   }
   if (!symbols.empty()) {
     // Past the end: the last gates decoded from the padding (a stream of fewer symbols than gates).
-    if (read > end) fail("symbols end early");
-    if (read != end || x != rans::kLow || y != rans::kLow) fail("symbols left over");
+    if (in > end) corrupted(where, "symbols end early");
+    if (in != end || x != rans::kLow || y != rans::kLow) corrupted(where, "symbols left over");
   }
-  if (!refs.at_end()) fail("references left over");
+  if (!refs.at_end()) corrupted(where, "references left over");
   for (; next < V; ++next) {
     const uint32_t from = next > 0 ? next - 1 : V;
     predictors[3 * next] = predictors[3 * next + 1] = predictors[3 * next + 2] = from;

@@ -3,6 +3,7 @@
 // (the decoder checks them all in one branch and finds the reason on the way out).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <set>
 
@@ -44,6 +45,32 @@ TEST(TraversalConnectivity, EverySymbolKindDecodesToTheEncodersTriangles) {
   round_trip(s.indices, uint32_t(s.vertex_count()));
   for (uint32_t seed = 0; seed < 8; ++seed) round_trip(holed_grid(12, seed), 13 * 13);
   EXPECT_EQ(kinds, (std::set<uint32_t>{kVertex, kLeft, kRight, kBoundary, kSplit, kEnd}));
+}
+
+// A record of 31 clusters whose triangles lie scattered (shuffled, then cut into 31 ranges): the traversal
+// meets the clusters in every order, so that the move-to-front ranks of their codes take every path of
+// to_front (ranks below 8, below 16 and up to 30), and the decoder puts every triangle back in its cluster.
+TEST(TraversalConnectivity, ScatteredClustersOfEveryRankDecode) {
+  const Mesh s = sphere(1.0f, 16, 32);
+  const uint32_t T = uint32_t(s.triangle_count()), V = uint32_t(s.vertex_count());
+  std::vector<uint32_t> order(T);
+  for (uint32_t t = 0; t < T; ++t) order[t] = t;
+  std::shuffle(order.begin(), order.end(), std::mt19937(7));
+  std::vector<uint32_t> indices;
+  for (uint32_t t : order)
+    indices.insert(indices.end(), &s.indices[3 * size_t(t)], &s.indices[3 * size_t(t) + 3]);
+  std::vector<uint32_t> clusters(31, T / 31);
+  clusters.back() += T % 31;
+  const TraversalCode code = encode_traversal(indices, V, clusters);
+  std::set<uint32_t> ranks;
+  for (const TraversalStep& step : code.steps)
+    if (step.symbol_class >= 6) ranks.insert(step.rank);
+  EXPECT_GT(*ranks.rbegin(), 24u);
+  EXPECT_GT(std::count_if(ranks.begin(), ranks.end(), [](uint32_t r) { return r >= 16; }), 5);
+  std::vector<uint32_t> decoded(3 * size_t(T)), predictors(3 * size_t(V));
+  decode_traversal(code.symbols, code.references, T, V, decoded.data(), predictors.data(), "node", clusters);
+  EXPECT_EQ(decoded, code.indices);
+  EXPECT_EQ(predictors, code.predictors);
 }
 
 // Fixed tables (traversal_tables.hpp): where vertices have about six triangles each (a sphere's rings, a
