@@ -102,17 +102,19 @@ class ResidualDecoder {
  private:
   [[noreturn]] void fail(const char* what) const;
   // Decodes the next `values` values into planes[0 .. values) (their higher bytes `stride` apart), value at
-  // `out` with the decode table table_of(out); `largest` is the largest value the planes hold.
-  template <typename TableOf>
-  void decode(uint8_t* planes, size_t values, size_t stride, uint64_t largest, TableOf table_of);
+  // `out` with step_of(x, out) (the rANS step of x with the value's table: returns the symbol and steps x);
+  // `largest` is the largest value the planes hold.
+  template <typename StepOf>
+  void decode(uint8_t* planes, size_t values, size_t stride, uint64_t largest, StepOf step_of);
 
   std::string where_;
   bool paired_ = false;
-  // The decode table (null for no stream), or a paired stream's set's kContexts tables one after the other:
-  // per slot of 2^12, bits 0-15 its symbol's frequency, 16-31 the slot minus the symbol's start; and apart,
-  // its symbol (a step takes each with one instruction: 3 fewer a value than with the symbol in the same
-  // word). The symbols (2^12 bytes) follow the slots, so that the decode loop reaches both from one register
-  // (two took one register too many: the loop reloaded them from the stack, two loads a value).
+  // The decode table (null for no stream), or a paired stream's set's kContexts compact tables one after
+  // the other (residual_coder.cpp's paired_tables). A stream's own table: per slot of 2^12, bits 0-15 its
+  // symbol's frequency, 16-31 the slot minus the symbol's start; and apart, its symbol (a step takes each
+  // with one instruction: 3 fewer a value than with the symbol in the same word). The symbols (2^12 bytes)
+  // follow the slots, so that the decode loop reaches both from one register (two took one register too many:
+  // the loop reloaded them from the stack, two loads a value).
   const uint32_t* slots_ = nullptr;
   // The table of a stream with its own, allocated without zero-filling: the constructor writes every slot or
   // throws (zero-filling 2^12 slots for every page part took ~0.9 % of elephant_1m's decode instructions).
