@@ -252,17 +252,29 @@ template <class I>
   return v > limit ? limit : v;
 }
 
-// The normals of 4 (Float4, Int4) or 8 (Float8, Int8) predictions x, y, z from their codes u (first
-// components) and v: each code decoded in its prediction's frame.
-template <class F, class I>
-[[gnu::always_inline]] inline void decode_in_frames(F px, F py, F pz, const int32_t* u_codes,
-                                                    const int32_t* v_codes, float inv_scale, F& x, F& y,
-                                                    F& z) {
-  const Frame<F> f = prediction_frame(px, py, pz);
-  F u, w, h;  // the normal in the frame
-  oct_decode(clamped_codes<I>(u_codes), clamped_codes<I>(v_codes), inv_scale, u, w, h);
-  x = u * f.t[0] + w * f.b[0] + h * f.p[0], y = u * f.t[1] + w * f.b[1] + h * f.p[1];
-  z = u * f.t[2] + w * f.b[2] + h * f.p[2];
+// The normals of N steps of 4 (Float4, Int4) or 8 (Float8, Int8) vertices from their sums (sum[0 ..
+// N * lanes)) and codes u (first components) and v: each code decoded in its prediction's frame, written to
+// out[0 .. N * lanes). Each phase (transposes, frames, decodes, rotations into the frames) is written for
+// all N steps before the next, so that the next step's square roots and divisions enter the out-of-order
+// window while the first step's chain is still in flight (a step is one chain of 2 square roots and 3
+// divisions; consecutive steps written one after the other barely overlapped).
+template <class F, class I, size_t N>
+[[gnu::always_inline]] inline void decode_steps(const NormalSum* sum, const int32_t* u_codes,
+                                                const int32_t* v_codes, float inv_scale, glm::vec3* out) {
+  constexpr size_t lanes = sizeof(F) / sizeof(float);
+  F px[N], py[N], pz[N], u[N], w[N], h[N];  // the prediction, the normal in its frame
+  Frame<F> f[N];
+  for (size_t k = 0; k < N; ++k) transpose(&sum[lanes * k], px[k], py[k], pz[k]);
+  for (size_t k = 0; k < N; ++k) f[k] = prediction_frame(px[k], py[k], pz[k]);
+  for (size_t k = 0; k < N; ++k)
+    oct_decode(clamped_codes<I>(&u_codes[lanes * k]), clamped_codes<I>(&v_codes[lanes * k]), inv_scale, u[k],
+               w[k], h[k]);
+  for (size_t k = 0; k < N; ++k) {
+    const F x = u[k] * f[k].t[0] + w[k] * f[k].b[0] + h[k] * f[k].p[0],
+            y = u[k] * f[k].t[1] + w[k] * f[k].b[1] + h[k] * f[k].p[1],
+            z = u[k] * f[k].t[2] + w[k] * f[k].b[2] + h[k] * f[k].p[2];
+    store_normals(x, y, z, &out[lanes * k]);
+  }
 }
 
 }  // namespace
@@ -286,18 +298,12 @@ __attribute__((target_clones("avx2", "default"))) void decode_predicted_normals(
   read_planes(planes, V, 2, width, residual.data());
   const float inv_scale = 1.0f / frame_scale(bits);
   size_t i = 0;
-  for (; i + 8 <= lanes; i += 8) {
-    Float8 px, py, pz, nx, ny, nz;
-    transpose(&sum[i], px, py, pz);
-    decode_in_frames<Float8, Int8>(px, py, pz, &residual[i], &residual[V + i], inv_scale, nx, ny, nz);
-    store_normals(nx, ny, nz, &out[i]);
-  }
-  for (; i < lanes; i += 4) {
-    Float4 px, py, pz, nx, ny, nz;
-    transpose(&sum[i], px, py, pz);
-    decode_in_frames<Float4, Int4>(px, py, pz, &residual[i], &residual[V + i], inv_scale, nx, ny, nz);
-    store_normals(nx, ny, nz, &out[i]);
-  }
+  for (; i + 16 <= lanes; i += 16)
+    decode_steps<Float8, Int8, 2>(&sum[i], &residual[i], &residual[V + i], inv_scale, &out[i]);
+  for (; i + 8 <= lanes; i += 8)
+    decode_steps<Float8, Int8, 1>(&sum[i], &residual[i], &residual[V + i], inv_scale, &out[i]);
+  for (; i < lanes; i += 4)
+    decode_steps<Float4, Int4, 1>(&sum[i], &residual[i], &residual[V + i], inv_scale, &out[i]);
   normals.resize(V);
 }
 

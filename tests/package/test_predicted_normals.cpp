@@ -80,11 +80,12 @@ TEST(PredictedNormals, EveryNormalComesBackInAnyFrame) {
 }
 
 TEST(PredictedNormals, EightLanesDecodeTheBitsOfFour) {
-  // decode_predicted_normals takes 8 vertices a step and the last 4 alone: each group of 4 decoded alone (4
-  // lanes) gives the same bits as within the whole (8 lanes), in every frame of the test above.
+  // decode_predicted_normals takes 16 vertices a step (two 8-lane steps interleaved), then 8, then the last 4
+  // alone: each group of 4 decoded alone (4 lanes) gives the same bits as within the whole (8 lanes, alone or
+  // interleaved), in every frame of the test above.
   std::mt19937 rng(7);
   std::normal_distribution<float> g;
-  const uint32_t V = 36, bits = 9;  // 4 steps of 8, then one of 4
+  const uint32_t V = 44, bits = 9;  // 2 steps of 16, one of 8, one of 4
   std::vector<NormalSum> sum(V);
   std::vector<glm::vec3> normals(V);
   for (uint32_t v = 0; v < V; ++v) {
