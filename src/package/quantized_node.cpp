@@ -10,20 +10,6 @@
 
 namespace lodstream::package {
 
-namespace {
-
-// std::round (halves away from zero) of an x with |x| < 2^62, inline: the baseline x86-64 target has no
-// rounding instruction, so std::round is a libm call (~30 instructions with the call, 4 M calls in an
-// elephant_1m bake). x - trunc(x) is exact for every double (below 2^52 both are representable, above it x
-// is an integer), so comparing it with 1/2 rounds as std::round does.
-inline int64_t round_half_away(double x) {
-  const int64_t t = int64_t(x);  // toward zero
-  const double fraction = x - double(t);
-  return t + (fraction >= 0.5) - (fraction <= -0.5);
-}
-
-}  // namespace
-
 QuantizedNode order_node(const NodeGeometry& g, const PositionGrid& grid) {
   if (!g.mesh) throw Error("node codec: no mesh given");
   const Mesh& m = *g.mesh;

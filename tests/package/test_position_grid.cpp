@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <vector>
 
 #include "package/node_codec.hpp"
 
@@ -113,6 +114,27 @@ TEST(PositionGrid, SnappedPositionsAreWhatTheCodecDecodes) {
   std::sort(a.begin(), a.end(), less);
   std::sort(b.begin(), b.end(), less);
   EXPECT_EQ(a, b) << "decoding a snapped mesh gives its positions bit for bit";
+}
+
+// round_half_away (inline, used by separating() and snap() in place of libm's llround and round) rounds as
+// std::llround does: halves away from zero, just below and above them, past 2^52 where every double is whole.
+TEST(PositionGrid, RoundHalfAwayMatchesLibm) {
+  std::vector<double> xs = {0.0,
+                            -0.0,
+                            0.5,
+                            -0.5,
+                            1.5,
+                            -1.5,
+                            2.5,
+                            -2.5,
+                            1048575.5,
+                            0x1p52 + 1.0,
+                            -0x1p52 - 1.0,
+                            0x1p61 + 0x1p10,
+                            0.49999999999999994};
+  for (double h = 0.5; h < 3e6; h = h * 3.0 + 1.0)
+    for (double x : {h, std::nextafter(h, 0.0), std::nextafter(h, 1e9)}) xs.push_back(x), xs.push_back(-x);
+  for (double x : xs) EXPECT_EQ(round_half_away(x), std::llround(x)) << x;
 }
 
 }  // namespace
