@@ -33,8 +33,9 @@ nlohmann::json bake_and_verify(const std::string& model, const std::filesystem::
   for (size_t start = 0; start < bake.err.size();) {
     size_t end = bake.err.find_first_of("\r\n", start);
     if (end == std::string::npos) end = bake.err.size();
-    if (end > start)
+    if (end > start) {
       EXPECT_EQ(bake.err.compare(start, 6, "bake: "), 0) << bake.err.substr(start, end - start);
+    }
     start = end + 1;
   }
 

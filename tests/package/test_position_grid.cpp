@@ -85,7 +85,9 @@ TEST(PositionGrid, SeparatingOnALargeMeshMatchesAPlainCheck) {
     // grid separates, the one returned does.
     EXPECT_LE(bits, whole + 1e-6) << "gap " << gap;
     EXPECT_GE(bits, whole == 14 ? 14 - 1e-6 : whole - 1 + 0.125 - 1e-6) << "gap " << gap;
-    if (whole < 20) EXPECT_TRUE(separates_plainly(m, g)) << "gap " << gap;
+    if (whole < 20) {
+      EXPECT_TRUE(separates_plainly(m, g)) << "gap " << gap;
+    }
     whole_bits.push_back(whole);
     found_bits.push_back(bits);
   }
