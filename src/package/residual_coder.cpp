@@ -38,7 +38,7 @@ inline uint32_t symbol_of(uint64_t z, uint32_t D) {
   return symbol_of(z, bit_length(z), D);
 }
 // The raw bits of symbol s >= 2^D: k - 1.
-inline uint32_t raw_bits_of(uint32_t s, uint32_t D) {
+constexpr uint32_t raw_bits_of(uint32_t s, uint32_t D) {
   return s - (1u << D) + D;
 }
 inline uint32_t symbols_for(uint32_t D) {
@@ -209,6 +209,39 @@ constexpr std::array<uint32_t, 256> kContextOffset = [] {
   return out;
 }();
 
+// Per D, per symbol: what a value's raw bits make of it when it has at most 7 (its bit length 8 or less, a
+// byte). n: its raw bits (0 for a direct value); the value is lead | (the n raw bits & mask), lead s for a
+// direct value and 2^n (the leading one) for the others, mask 2^n - 1. Symbols of 8 raw bits or more have
+// their n only (the decoder takes them one by one).
+struct RawCodes {
+  std::array<uint8_t, kMaxSymbols> n{}, lead{}, mask{};
+};
+constexpr std::array<RawCodes, kMaxDirect + 1> kRawCodes = [] {
+  std::array<RawCodes, kMaxDirect + 1> out{};
+  for (uint32_t D = kMinDirect; D <= kMaxDirect; ++D)
+    for (uint32_t s = 0; s < kMaxSymbols; ++s) {
+      const uint32_t n = s < (1u << D) ? 0 : raw_bits_of(s, D);
+      out[D].n[s] = uint8_t(n);
+      if (n == 0) out[D].lead[s] = uint8_t(s);
+      if (n > 0 && n < 8) out[D].lead[s] = uint8_t(1u << n), out[D].mask[s] = uint8_t((1u << n) - 1);
+    }
+  return out;
+}();
+
+// The share of a table's 2^12 (frequencies f of symbols 0..A-1, D direct bits) above which its values of raw
+// bits are common enough for the decoder to take them without a branch (ResidualDecoder::decode).
+constexpr uint32_t kCommonRaw = kScale / 16;
+// Whether a paired set's values of raw bits are common: in any of its contexts' tables.
+bool paired_raw_common(uint32_t set) {
+  for (uint32_t c = 0; c < residual_tables::kContexts; ++c) {
+    uint32_t raw = 0;
+    for (uint32_t s = 1u << residual_tables::kDirectBits; s < kMaxSymbols; ++s)
+      raw += residual_tables::kFrequencies[set][c][s];
+    if (raw >= kCommonRaw) return true;
+  }
+  return false;
+}
+
 // The decoder's step (rANS, Duda 2013, eq. 9: D(x) = (s, f_s floor(x / 2^12) + x mod 2^12 - start_s)) with a
 // table of fill_table's layout at `slots`: returns s and steps x.
 inline __attribute__((always_inline)) uint32_t own_step(uint32_t& x, const uint32_t* slots) {
@@ -314,15 +347,21 @@ ResidualDecoder::ResidualDecoder(std::span<const uint8_t> stream, const std::str
     const uint32_t set = r.u8();
     if (set >= residual_tables::kSets) r.fail("residual table set out of range");
     direct_bits_ = residual_tables::kDirectBits, slots_ = paired_tables(set);
+    raw_common_ = paired_raw_common(set);
   } else {
     const uint32_t D = r.u8(), A = r.u8();
     if (D < kMinDirect || D > kMaxDirect) r.fail("residual direct bits out of range");
     direct_bits_ = D;
     if (A == 0 || A > symbols_for(D)) r.fail("residual table of an invalid size");
     own_slots_ = std::make_unique_for_overwrite<uint32_t[]>(kTableWords);
-    if (!fill_table(own_slots_.get(), A, [&r](uint32_t) { return r.varint(); }))
+    uint64_t raw = 0;  // the raw-bit symbols' frequencies (each at most 2^12 once the table adds up)
+    if (!fill_table(own_slots_.get(), A, [&r, &raw, D](uint32_t s) {
+          const uint64_t f = r.varint();
+          if (s >= (1u << D)) raw += f;
+          return f;
+        }))
       r.fail("residual frequencies do not add up to the scale");
-    slots_ = own_slots_.get();
+    slots_ = own_slots_.get(), raw_common_ = raw >= kCommonRaw;
   }
   const uint64_t size = r.varint();
   if (size < 4 * kStates || size > r.remaining()) r.fail("residual rANS stream past the stream's end");
@@ -352,24 +391,30 @@ void ResidualDecoder::planes(size_t count, uint32_t components, uint32_t width, 
   // The higher planes are zero but for values of raw bits, which write their higher bytes themselves.
   for (uint32_t b = 1; b < width; ++b) std::memset(planes + b * stride, 0, values);
   const uint64_t largest = width >= 8 ? ~uint64_t(0) : (uint64_t(1) << (8 * width)) - 1;
+  // The stream's step, then its raw bits' way (decode).
+  const auto decode_with = [&](uint8_t* at, size_t n, auto step_of) {
+    if (raw_common_)
+      decode<true>(at, n, stride, largest, step_of);
+    else
+      decode<false>(at, n, stride, largest, step_of);
+  };
   if (!paired_) {
-    decode(planes, values, stride, largest,
-           [slots = slots_](uint32_t& x, const uint8_t*) { return own_step(x, slots); });
+    decode_with(planes, values, [slots = slots_](uint32_t& x, const uint8_t*) { return own_step(x, slots); });
     return;
   }
   // Component 0 with the first context's table, then component 1 with the table of its vertex's component-0
   // low byte, count bytes back (residual_tables.hpp).
   const uint32_t* const tables = slots_;
-  decode(planes, count, stride, largest,
-         [first = tables + residual_tables::kFirstContext * kPairedWords](uint32_t& x, const uint8_t*) {
-           return paired_step(x, first);
-         });
-  decode(planes + count, count, stride, largest, [tables, count](uint32_t& x, const uint8_t* out) {
+  decode_with(planes, count,
+              [first = tables + residual_tables::kFirstContext * kPairedWords](uint32_t& x, const uint8_t*) {
+                return paired_step(x, first);
+              });
+  decode_with(planes + count, count, [tables, count](uint32_t& x, const uint8_t* out) {
     return paired_step(x, tables + kContextOffset[out[-ptrdiff_t(count)]]);
   });
 }
 
-template <typename StepOf>
+template <bool kRawCommon, typename StepOf>
 void ResidualDecoder::decode(uint8_t* planes, size_t values, size_t stride, uint64_t largest,
                              StepOf step_of) {
   // The decoder's state in locals (registers) for the loop, written back after it; x0 decodes next.
@@ -382,16 +427,20 @@ void ResidualDecoder::decode(uint8_t* planes, size_t values, size_t stride, uint
   uint32_t x0 = state_[0], x1 = state_[1], x2 = state_[2], x3 = state_[3];
   // One step (rANS, Duda 2013, eq. 9: D(x) = (s, f_s floor(x / 2^12) + x mod 2^12 - start_s), s the
   // symbol of slot x mod 2^12 of the value's table), then x read back up to kLow from the next 2 rANS bytes;
-  // a value's raw bits, rare (residual_coder.hpp), take a branch too.
-  const auto step = [&](uint32_t & x, uint8_t * out) __attribute__((always_inline)) {
+  // returns s.
+  const auto step = [&](uint32_t & x, const uint8_t* out) __attribute__((always_inline)) {
     const uint32_t s = step_of(x, out);
     uint16_t next;
     std::memcpy(&next, bytes + at, 2);
     rans::renormalize(x, at, next);
+    return s;
+  };
+  // The value of symbol s at `out`, its raw bits (when it has) taken with a branch.
+  const auto raw = [&](uint32_t s, uint8_t * out) __attribute__((always_inline)) {
     *out = uint8_t(s);
     if (s >= direct) [[unlikely]] {
       const uint32_t n = s - direct + D;  // k - 1 raw bits below the leading one
-      if (raw_end - raw_at < n) fail("residual raw bits end early");
+      if (raw_at + n > raw_end) fail("residual raw bits end early");
       uint64_t word;  // 8 bytes from the one holding the next bit: at least 57 bits, n <= 39 needed
       std::memcpy(&word, bytes + (raw_at >> 3), 8);
       const uint64_t z = uint64_t(1) << n | ((word >> (raw_at & 7)) & ((uint64_t(1) << n) - 1));
@@ -403,17 +452,44 @@ void ResidualDecoder::decode(uint8_t* planes, size_t values, size_t stride, uint
       for (uint32_t b = 1; b <= n / 8; ++b) out[b * stride] = uint8_t(z >> (8 * b));
     }
   };
+  // The next raw bits from raw_at on, at least 57 (raw_at <= raw_end: the read stays in the padding).
+  const auto raw_word = [&]() __attribute__((always_inline)) {
+    uint64_t word;
+    std::memcpy(&word, bytes + (raw_at >> 3), 8);
+    return word >> (raw_at & 7);
+  };
+  // The same without a branch when s has at most 7 raw bits (a byte; at most 28 a block of kStates), taken
+  // from `word` (raw_word at the block's start).
+  const RawCodes& codes = kRawCodes[D];
+  const auto raw_common = [&](uint32_t s, uint8_t * out, uint64_t & word) __attribute__((always_inline)) {
+    const uint32_t n = codes.n[s];
+    if (n >= 8) [[unlikely]] {
+      raw(s, out);
+      if (raw_at <= raw_end) word = raw_word();
+      return;
+    }
+    *out = uint8_t(codes.lead[s] | (word & codes.mask[s]));
+    word >>= n, raw_at += n;
+  };
   // Values in blocks of kStates, then one by one, rotating the states. A block reads at most 8 bytes:
   // started only while at is within the rANS bytes, so that no read leaves the padding.
   uint8_t* out = planes;
   uint8_t* const blocks_end = planes + (values - values % kStates);
   for (; out != blocks_end; out += kStates) {
     if (at > rans_end) break;
-    step(x0, out), step(x1, out + 1), step(x2, out + 2), step(x3, out + 3);
+    if constexpr (kRawCommon) {
+      uint64_t word = raw_word();
+      raw_common(step(x0, out), out, word), raw_common(step(x1, out + 1), out + 1, word);
+      raw_common(step(x2, out + 2), out + 2, word), raw_common(step(x3, out + 3), out + 3, word);
+      if (raw_at > raw_end) fail("residual raw bits end early");
+    } else {
+      raw(step(x0, out), out), raw(step(x1, out + 1), out + 1);
+      raw(step(x2, out + 2), out + 2), raw(step(x3, out + 3), out + 3);
+    }
   }
   if (at <= rans_end)
     for (; out != planes + values; ++out) {
-      step(x0, out);
+      raw(step(x0, out), out);
       const uint32_t t = x0;
       x0 = x1, x1 = x2, x2 = x3, x3 = t;
     }
