@@ -104,9 +104,8 @@ class ResidualDecoder {
   // Decodes the next `values` values into planes[0 .. values) (their higher bytes `stride` apart), value at
   // `out` with step_of(x, out) (the rANS step of x with the value's table: returns the symbol and steps x);
   // `largest` is the largest value the planes hold.
-  // kRawCommon: the values of raw bits are common (raw_common_), taken a block of 4 at a time without a
-  // branch where they can be.
-  template <bool kRawCommon, typename StepOf>
+  // kRawBytes: raw_bytes_, or 1 where the planes have one byte.
+  template <uint32_t kRawBytes, typename StepOf>
   void decode(uint8_t* planes, size_t values, size_t stride, uint64_t largest, StepOf step_of);
 
   std::string where_;
@@ -122,8 +121,9 @@ class ResidualDecoder {
   // throws (zero-filling 2^12 slots for every page part took ~0.9 % of elephant_1m's decode instructions).
   std::unique_ptr<uint32_t[]> own_slots_;
   uint32_t direct_bits_ = 0;  // D
-  // Whether the stream's table gives its raw-bit symbols kCommonRaw of 2^12 or more (residual_coder.cpp).
-  bool raw_common_ = false;
+  // How decode takes the stream's values of raw bits (residual_coder.cpp's raw_bytes_of): 0 with a branch,
+  // 1 or 2 without one where they fit that many bytes (when the planes have them).
+  uint32_t raw_bytes_ = 0;
   // The rANS bytes then the raw bits, followed by 8 zero bytes, so that reads a few bytes past the rANS
   // bytes' end stay in the buffer (the decoder checks after each block of 4 values that they were not used)
   // and a raw-bit read is one 8-byte load.

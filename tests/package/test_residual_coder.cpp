@@ -152,6 +152,48 @@ TEST(ResidualCoder, EveryDirectWidthTheEncoderPicksDecodes) {
   EXPECT_EQ(picked, (std::set<uint8_t>{1, 2, 3, 4, 5, 6}));
 }
 
+// The decoder takes a stream's values of raw bits with a branch, or without one in one byte or in two
+// (residual_coder.cpp's raw_bytes_of, by their share in the stream's table): every way decodes to the planes,
+// values of more raw bits than the way takes included, in nodes of 1 to 3 bytes and odd counts (values one
+// by one after the blocks of 4), and a stream cut short is an error in each. Values: small (below 2^6) but
+// for a share `raw` of values of 6 to 7 raw bits, `wide` of 8 to 14 and `huge` of 15 to 23 (where they fit).
+TEST(ResidualCoder, ValuesOfRawBitsDecodeAlikeWhicheverWayTheDecoderTakes) {
+  struct Mix {
+    double raw, wide, huge;
+  };
+  // A branch (0.5 %, 3 %), one byte (10 %, 40 %), two bytes (wide 3 %, 10 %), either with huge values.
+  const Mix mixes[] = {{0.005, 0, 0},  {0.03, 0.002, 0}, {0.1, 0, 0},        {0.4, 0.003, 0},
+                       {0.1, 0.03, 0}, {0.3, 0.1, 0},    {0.3, 0.004, 0.01}, {0.3, 0.1, 0.02}};
+  uint32_t seed = 0;
+  for (const Mix& mix : mixes)
+    for (uint32_t width = 1; width <= 3; ++width) {
+      std::mt19937_64 rng(++seed);
+      std::uniform_real_distribution<double> u(0, 1);
+      auto draw = [&](uint32_t low, uint32_t high) {  // a value of bit length low + 1 .. high
+        const uint32_t k = low + 1 + uint32_t(rng() % (high - low));
+        return uint64_t(1) << (k - 1) | (rng() & ((uint64_t(1) << (k - 1)) - 1));
+      };
+      Residuals r;
+      for (uint32_t node = 0; node < 6; ++node) {
+        const size_t count = 301 + rng() % 700;
+        r.counts.push_back(count), r.widths.push_back(width);
+        for (size_t i = 0; i < 3 * count; ++i) {
+          const double x = u(rng);
+          r.values.push_back(x < mix.huge && width >= 3              ? draw(15, 23)
+                             : x < mix.huge + mix.wide && width >= 2 ? draw(8, 15)
+                             : x < mix.huge + mix.wide + mix.raw     ? draw(6, 8)
+                                                                     : rng() % 64);
+        }
+      }
+      const std::vector<uint8_t> stream = encode_residuals(r.values);
+      EXPECT_EQ(decoded_planes(stream, r), expected_planes(r)) << "mix " << seed / 3 << " width " << width;
+      for (size_t n : {stream.size() - 1, stream.size() - 9, stream.size() / 2})
+        expect_error_naming("stream 3", "a prefix", [&] {
+          decoded_planes(std::vector<uint8_t>(stream.begin(), stream.begin() + n), r);
+        });
+    }
+}
+
 TEST(ResidualCoder, MostlyZeroResidualsTakeWellUnderABitEach) {
   std::mt19937 rng(1);
   std::vector<uint64_t> values(30000);
