@@ -155,8 +155,9 @@ TEST(ResidualCoder, EveryDirectWidthTheEncoderPicksDecodes) {
 // The decoder takes a stream's values of raw bits with a branch, or without one in one byte or in two
 // (residual_coder.cpp's raw_bytes_of, by their share in the stream's table): every way decodes to the planes,
 // values of more raw bits than the way takes included, in nodes of 1 to 3 bytes and odd counts (values one
-// by one after the blocks of 4), and a stream cut short is an error in each. Values: small (below 2^6) but
-// for a share `raw` of values of 6 to 7 raw bits, `wide` of 8 to 14 and `huge` of 15 to 23 (where they fit).
+// by one after the blocks of 4), and a stream cut short is an error in each (its raw bits: one that says so).
+// Values: small (below 2^3) but for a share `raw` of values of 6 to 7 raw bits, `wide` of 8 to 14 and `huge`
+// of 15 to 22 (where they fit).
 TEST(ResidualCoder, ValuesOfRawBitsDecodeAlikeWhicheverWayTheDecoderTakes) {
   struct Mix {
     double raw, wide, huge;
@@ -182,15 +183,19 @@ TEST(ResidualCoder, ValuesOfRawBitsDecodeAlikeWhicheverWayTheDecoderTakes) {
           r.values.push_back(x < mix.huge && width >= 3              ? draw(15, 23)
                              : x < mix.huge + mix.wide && width >= 2 ? draw(8, 15)
                              : x < mix.huge + mix.wide + mix.raw     ? draw(6, 8)
-                                                                     : rng() % 64);
+                                                                     : rng() % 8);
         }
       }
       const std::vector<uint8_t> stream = encode_residuals(r.values);
       EXPECT_EQ(decoded_planes(stream, r), expected_planes(r)) << "mix " << seed / 3 << " width " << width;
-      for (size_t n : {stream.size() - 1, stream.size() - 9, stream.size() / 2})
-        expect_error_naming("stream 3", "a prefix", [&] {
-          decoded_planes(std::vector<uint8_t>(stream.begin(), stream.begin() + n), r);
+      // Cut in its raw bits (the stream's last bytes), then in its rANS bytes.
+      for (size_t cut : {1, 9})
+        expect_error_naming("stream 3: residual raw bits end early", "raw bits cut", [&] {
+          decoded_planes(std::vector<uint8_t>(stream.begin(), stream.end() - cut), r);
         });
+      expect_error_naming("stream 3", "cut in half", [&] {
+        decoded_planes(std::vector<uint8_t>(stream.begin(), stream.begin() + stream.size() / 2), r);
+      });
     }
 }
 
