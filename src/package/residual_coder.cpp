@@ -300,10 +300,17 @@ std::vector<uint8_t> encode_residuals(std::span<const uint64_t> values) {
   const double fewest = *std::min_element(bits.begin() + kMinDirect, bits.end());
   uint32_t D = kMaxDirect;
   while (bits[D] > fewest * (1 + kDirectTolerance)) --D;
-
-  const std::array<uint32_t, kMaxSymbols> counts = symbol_counts(low, lengths, D);
+  // Unless its values of raw bits are common enough for the decoder to take them without a branch
+  // (raw_bytes_of): then they are with any smaller D too (more values with raw bits, each as many), and the
+  // decode costs the same; the smallest D is taken.
+  std::array<uint32_t, kMaxSymbols> counts = symbol_counts(low, lengths, D);
   uint32_t A = symbols_for(D);
   while (counts[A - 1] == 0) --A;
+  if (raw_bytes_of(normalized(counts, values.size()), A, D) > 0) {
+    D = uint32_t(std::min_element(bits.begin() + kMinDirect, bits.end()) - bits.begin());
+    counts = symbol_counts(low, lengths, D), A = symbols_for(D);
+    while (counts[A - 1] == 0) --A;
+  }
   const Coding c = coding_of(normalized(counts, values.size()));
   ByteWriter w;
   w.u8(uint8_t(D));

@@ -134,10 +134,16 @@ TEST(ResidualCoder, OneSymbolAloneAndNoResiduals) {
 }
 
 TEST(ResidualCoder, EveryDirectWidthTheEncoderPicksDecodes) {
-  // Geometric residuals of growing scale, in short and longer streams: the encoder's D (the stream's first
-  // byte) follows the scale and the table's cost, every D occurs, and each stream decodes back, its values
-  // of raw bits included.
+  // Geometric residuals of growing scale, in short and longer streams, and residuals 0, 1, 2^(d-1) + 1 and
+  // 2^d - 1 with 2 % of 13 bits (values of raw bits rare: D = d): the encoder's D (the stream's first byte)
+  // follows the scale and the table's cost, every D occurs, and each stream decodes back, its values of raw
+  // bits included.
   std::set<uint8_t> picked;
+  auto check = [&](const Residuals& r, uint32_t scale) {
+    const std::vector<uint8_t> stream = encode_residuals(r.values);
+    picked.insert(stream[0]);
+    EXPECT_EQ(decoded_planes(stream, r), expected_planes(r)) << "scale " << scale;
+  };
   for (size_t count : {100, 1000})
     for (uint32_t scale = 0; scale < 12; ++scale) {
       std::mt19937_64 rng(scale);
@@ -145,10 +151,19 @@ TEST(ResidualCoder, EveryDirectWidthTheEncoderPicksDecodes) {
       Residuals r;
       r.counts = {count}, r.widths = {5};
       for (size_t i = 0; i < 3 * count; ++i) r.values.push_back(geometric(rng) & ((uint64_t(1) << 40) - 1));
-      const std::vector<uint8_t> stream = encode_residuals(r.values);
-      picked.insert(stream[0]);
-      EXPECT_EQ(decoded_planes(stream, r), expected_planes(r)) << "scale " << scale;
+      check(r, scale);
     }
+  for (uint32_t d = 1; d <= 6; ++d) {
+    std::mt19937_64 rng(d);
+    Residuals r;
+    r.counts = {300}, r.widths = {2};
+    const uint64_t top = (uint64_t(1) << d) - 1, middle = (uint64_t(1) << (d - 1)) | 1;
+    for (size_t i = 0; i < 900; ++i) {
+      const uint32_t x = uint32_t(rng() % 100);
+      r.values.push_back(x < 2 ? 4096 + rng() % 4096 : x < 50 ? 0 : x < 70 ? 1 : x < 85 ? top : middle);
+    }
+    check(r, 100 + d);
+  }
   EXPECT_EQ(picked, (std::set<uint8_t>{1, 2, 3, 4, 5, 6}));
 }
 
