@@ -277,48 +277,76 @@ inline __attribute__((always_inline)) uint32_t paired_step(uint32_t& x, const ui
 
 }  // namespace
 
-std::vector<uint8_t> encode_residuals(std::span<const uint64_t> values) {
-  if (values.empty()) return {};
+namespace {
+
+// The values' counts below 2^kMaxDirect (`low`) and of each bit length above (`lengths`), and each value's
+// bit length (`symbols`, which write_codes makes its symbol). Throws lodstream::Error on a value of more
+// than 40 bits.
+struct Histogram {
   std::array<uint32_t, 1u << kMaxDirect> low{};
   std::array<uint32_t, kMaxBits + 1> lengths{};
-  // Each value's bit length, kept for the symbol pass (becomes its symbol there).
-  std::vector<uint8_t> symbols(values.size());
+  std::vector<uint8_t> symbols;
+};
+Histogram histogram_of(std::span<const uint64_t> values) {
+  Histogram h;
+  h.symbols.resize(values.size());
   for (size_t i = 0; i < values.size(); ++i) {
     const uint64_t z = values[i];
     const uint32_t k = bit_length(z);
     if (k > kMaxBits) throw Error("residual coder: a residual of more than 40 bits");
-    symbols[i] = uint8_t(k);
+    h.symbols[i] = uint8_t(k);
     if (k <= kMaxDirect)
-      ++low[z];
+      ++h.low[z];
     else
-      ++lengths[k];
+      ++h.lengths[k];
   }
-  // D: the largest whose estimate is within kDirectTolerance of the smallest (residual_coder.hpp).
-  std::array<double, kMaxDirect + 1> bits{};
-  for (uint32_t d = kMinDirect; d <= kMaxDirect; ++d)
-    bits[d] = estimated_bits(low, lengths, d, values.size());
-  const double fewest = *std::min_element(bits.begin() + kMinDirect, bits.end());
-  uint32_t D = kMaxDirect;
-  while (bits[D] > fewest * (1 + kDirectTolerance)) --D;
-  // Unless its values of raw bits are common enough for the decoder to take them without a branch
-  // (raw_bytes_of): then they are with any smaller D too (more values with raw bits, each as many), and the
-  // decode costs the same; the smallest D is taken.
-  std::array<uint32_t, kMaxSymbols> counts = symbol_counts(low, lengths, D);
+  return h;
+}
+
+// The stream of `values` (histogram h) with D direct bits.
+std::vector<uint8_t> encode_with(std::span<const uint64_t> values, Histogram& h, uint32_t D) {
+  const std::array<uint32_t, kMaxSymbols> counts = symbol_counts(h.low, h.lengths, D);
   uint32_t A = symbols_for(D);
   while (counts[A - 1] == 0) --A;
-  if (raw_bytes_of(normalized(counts, values.size()), A, D) > 0) {
-    D = uint32_t(std::min_element(bits.begin() + kMinDirect, bits.end()) - bits.begin());
-    counts = symbol_counts(low, lengths, D), A = symbols_for(D);
-    while (counts[A - 1] == 0) --A;
-  }
   const Coding c = coding_of(normalized(counts, values.size()));
   ByteWriter w;
   w.u8(uint8_t(D));
   w.u8(uint8_t(A));
   for (uint32_t s = 0; s < A; ++s) w.varint(c.f[s]);
   write_codes(
-      values, symbols, D, [&c](size_t) -> const Coding& { return c; }, w);
+      values, h.symbols, D, [&c](size_t) -> const Coding& { return c; }, w);
   return std::move(w.bytes);
+}
+
+}  // namespace
+
+std::vector<uint8_t> encode_residuals(std::span<const uint64_t> values) {
+  if (values.empty()) return {};
+  Histogram h = histogram_of(values);
+  // D: the largest whose estimate is within kDirectTolerance of the smallest (residual_coder.hpp).
+  std::array<double, kMaxDirect + 1> bits{};
+  for (uint32_t d = kMinDirect; d <= kMaxDirect; ++d)
+    bits[d] = estimated_bits(h.low, h.lengths, d, values.size());
+  const double fewest = *std::min_element(bits.begin() + kMinDirect, bits.end());
+  uint32_t D = kMaxDirect;
+  while (bits[D] > fewest * (1 + kDirectTolerance)) --D;
+  // Unless its values of raw bits are common enough for the decoder to take them without a branch
+  // (raw_bytes_of): then they are with any smaller D too (more values with raw bits, each as many), and the
+  // decode costs the same; the smallest D is taken.
+  const std::array<uint32_t, kMaxSymbols> counts = symbol_counts(h.low, h.lengths, D);
+  uint32_t A = symbols_for(D);
+  while (counts[A - 1] == 0) --A;
+  if (raw_bytes_of(normalized(counts, values.size()), A, D) > 0)
+    D = uint32_t(std::min_element(bits.begin() + kMinDirect, bits.end()) - bits.begin());
+  return encode_with(values, h, D);
+}
+
+std::vector<uint8_t> encode_residuals(std::span<const uint64_t> values, uint32_t direct_bits) {
+  if (direct_bits < kMinDirect || direct_bits > kMaxDirect)
+    throw Error("residual coder: direct bits out of range");
+  if (values.empty()) return {};
+  Histogram h = histogram_of(values);
+  return encode_with(values, h, direct_bits);
 }
 
 std::vector<uint8_t> encode_paired_residuals(std::span<const uint64_t> values,

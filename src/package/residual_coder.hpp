@@ -19,13 +19,14 @@
 // most lost to their tables, so the coder is order 0.
 //
 // Direct values are for speed: a decode step of one is a table lookup, a multiply and a conditional 16-bit
-// read, with no branch; only values of raw bits take a (rarely taken) branch. The encoder estimates the size
-// for each D (codes, raw bits, table) and takes the largest D within 0.5 % of the smallest: on the pages of
-// bench_package (refined_elephant) that is D = 5-6 for positions and 3-5 for normals, leaving about 1 % of
-// the values with raw bits (a D of 1-3 would be up to 1 % smaller and leave 10-70 %, each a mispredicted
-// branch). The first form of this coder (every value a class and raw bits, two states, a renormalization
-// branch) cost 600 instructions a triangle in BM_Decode/4 against 382 with zstd'd planes; this one ~440
-// when both parts are coded (callgrind, decode_node + unpack_page). Packages, format 5 -> 6 (`lodstream bake
+// read, with no branch. The encoder estimates the size for each D (codes, raw bits, table) and takes the
+// largest D within 0.5 % of the smallest, for fewer values of raw bits (in format 6, on the pages of
+// bench_package (refined_elephant): D = 5-6 for positions and 3-5 for normals, about 1 % of the values with
+// raw bits, where a D of 1-3 would be up to 1 % smaller and leave 10-70 %), unless they are common anyway
+// (below: then the smallest D). The first form of this coder (every value a class and raw bits, two states, a
+// renormalization branch) cost 600 instructions a triangle in BM_Decode/4 against 382 with zstd'd planes;
+// this one ~440 when both parts are coded (callgrind, decode_node + unpack_page). Packages, format 5 -> 6
+// (`lodstream bake
 // --json`, with page_parts.hpp's 0.2-bit rule): elephant_5m 18,485,383 -> 17,511,877 B (-5.3 %),
 // elephant_1m -4.7 %, refined_elephant -2.9 %, motorBike -2.9 %, bunny -2.6 %, horse -2.3 %, city -2.7 %.
 //
@@ -51,6 +52,19 @@
 // L1 as one table (20 KB) does: the L1 read misses of planes() in refined_elephant's decode, 28.6 k -> 62.7 k
 // (cachegrind, its default caches; 71.3 k with 9 contexts).
 //
+// Values of raw bits (helper "rawbits", 2026-12-03), counted in format 14's whole decodes: refined_elephant
+// 41,587 of its 244,459 residuals (17 %), all in its positions' streams (48.6 % of their 85,539 values: split
+// form, component 0 at D = 3 (63 % of the values with raw bits) or 5 (24 %), components 1-2 at D = 5 (64 %)
+// or 6 (41 %); raw bits 3-7, 8 %% of them more), none in its normals (paired, D = 6); elephant_1m 156 k of
+// 6.47 M (2.4 %): positions' whole-form streams (D = 4) 0.25 %, split components 0 0.5-1.7 %, components 1-2
+// 45 % in 33 streams (D = 5) and 5.6 % in 111 (D = 6), normals 0.08 % (own tables) and none (paired). Each
+// took a branch that mispredicts where they are common, so the decoder chooses per stream from its table
+// (residual_coder.cpp's raw_bytes_of): the branch where they are rare, else a way without it (the raw bits
+// of a block of 4 values from one 8-byte read, per-symbol tables of the bit count, leading one and mask),
+// in one byte or, where values of 8 raw bits or more are not rare, two; and the encoder, where they are
+// common, takes the smallest D (the decode costs the same). refined_elephant's decode (`bench/decode-pairs`,
+// 20 pairs): RESULTS
+//
 // A stream (no bytes for no values): u8 D (1..6), u8 A (symbols in the table, 1..2^D + 40 - D), A varint
 // frequencies adding up to 2^12, varint size of the rANS bytes, the rANS bytes (the four final states
 // first, u32 LE each; then u16 LE reads), then the raw bits (LSB first, in value order). A paired stream: u8
@@ -68,6 +82,9 @@ namespace lodstream::package {
 // The stream of `values` (zigzagged, each below 2^40). Cost: O(values.size()), two passes, and 6 estimates
 // over a histogram for D.
 std::vector<uint8_t> encode_residuals(std::span<const uint64_t> values);
+// The same with D = direct_bits whatever the values (encode_residuals' choice to compare with). Throws
+// lodstream::Error unless 1 <= direct_bits <= 6. Cost: O(values.size()), two passes.
+std::vector<uint8_t> encode_residuals(std::span<const uint64_t> values, uint32_t direct_bits);
 
 // The paired stream (residual_coder.hpp) of `values`: per count n of `counts` in turn, n values of component
 // 0 then the n of component 1 of the same vertices (a page's normal residuals, node by node), each below
@@ -90,7 +107,8 @@ class ResidualDecoder {
   // other, as `width` byte planes (put_planes' layout: byte b of component a of value i at
   // planes[(b * components + a) * count + i]; the other components' planes are left as they are); a value
   // needing more than `width` bytes throws; a paired stream's only components are 0 and 1 of 2, taken
-  // together. Cost: O(count * taken * width); about 25 instructions a direct value.
+  // together. Cost: O(count * taken * width); about 25 instructions a direct value, about 30 a value where
+  // values of raw bits are common (residual_coder.hpp).
   void planes(size_t count, uint32_t components, uint32_t width, uint8_t* planes, uint32_t first,
               uint32_t taken);
   void planes(size_t count, uint32_t components, uint32_t width, uint8_t* planes) {
