@@ -251,7 +251,8 @@ uint32_t raw_bytes_of(const Frequencies& f, uint32_t A, uint32_t D) {
 uint32_t paired_raw_bytes(uint32_t set) {
   uint32_t bytes = 0;
   for (uint32_t c = 0; c < residual_tables::kContexts; ++c)
-    bytes = std::max(bytes, raw_bytes_of(residual_tables::kFrequencies[set][c], kMaxSymbols, kMaxDirect));
+    bytes = std::max(bytes, raw_bytes_of(residual_tables::kFrequencies[set][c], kMaxSymbols,
+                                         residual_tables::kDirectBits));
   return bytes;
 }
 
@@ -274,10 +275,6 @@ inline __attribute__((always_inline)) uint32_t paired_step(uint32_t& x, const ui
   x = f * (x >> kScaleBits) - start + uint32_t(slot);
   return s;
 }
-
-}  // namespace
-
-namespace {
 
 // The values' counts below 2^kMaxDirect (`low`) and of each bit length above (`lengths`), and each value's
 // bit length (`symbols`, which write_codes makes its symbol). Throws lodstream::Error on a value of more
@@ -485,6 +482,12 @@ void ResidualDecoder::decode(uint8_t* planes, size_t values, size_t stride, uint
     rans::renormalize(x, at, next);
     return s;
   };
+  // The next raw bits from raw_at on, at least 57 (raw_at <= raw_end: the read stays in the padding).
+  const auto raw_word = [&]() __attribute__((always_inline)) {
+    uint64_t word;
+    std::memcpy(&word, bytes + (raw_at >> 3), 8);
+    return word >> (raw_at & 7);
+  };
   // The value of symbol s at `out`, its raw bits (when it has) taken with a branch.
   const auto raw = [&](uint32_t s, uint8_t * out) __attribute__((always_inline)) {
     *out = uint8_t(s);
@@ -501,12 +504,6 @@ void ResidualDecoder::decode(uint8_t* planes, size_t values, size_t stride, uint
       *out = uint8_t(z);
       for (uint32_t b = 1; b <= n / 8; ++b) out[b * stride] = uint8_t(z >> (8 * b));
     }
-  };
-  // The next raw bits from raw_at on, at least 57 (raw_at <= raw_end: the read stays in the padding).
-  const auto raw_word = [&]() __attribute__((always_inline)) {
-    uint64_t word;
-    std::memcpy(&word, bytes + (raw_at >> 3), 8);
-    return word >> (raw_at & 7);
   };
   // The same without a branch when s has at most 7 raw bits (kRawBytes 1) or kFastRawBits (2; the value's
   // second byte written as well, 0 for most), taken from `word` (raw_word at the block's start, at most 56

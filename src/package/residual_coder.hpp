@@ -26,9 +26,9 @@
 // (below: then the smallest D). The first form of this coder (every value a class and raw bits, two states, a
 // renormalization branch) cost 600 instructions a triangle in BM_Decode/4 against 382 with zstd'd planes;
 // this one ~440 when both parts are coded (callgrind, decode_node + unpack_page). Packages, format 5 -> 6
-// (`lodstream bake
-// --json`, with page_parts.hpp's 0.2-bit rule): elephant_5m 18,485,383 -> 17,511,877 B (-5.3 %),
-// elephant_1m -4.7 %, refined_elephant -2.9 %, motorBike -2.9 %, bunny -2.6 %, horse -2.3 %, city -2.7 %.
+// (`lodstream bake --json`, with page_parts.hpp's 0.2-bit rule): elephant_5m 18,485,383 -> 17,511,877 B
+// (-5.3 %), elephant_1m -4.7 %, refined_elephant -2.9 %, motorBike -2.9 %, bunny -2.6 %, horse -2.3 %, city
+// -2.7 %.
 //
 // Format 13 (helper "restables", 2026-12-03): a page's normal residuals may also be one paired stream
 // (encode_paired_residuals), with no stored tables: component 1 of a vertex is coded with the table of its
@@ -55,15 +55,21 @@
 // Values of raw bits (helper "rawbits", 2026-12-03), counted in format 14's whole decodes: refined_elephant
 // 41,587 of its 244,459 residuals (17 %), all in its positions' streams (48.6 % of their 85,539 values: split
 // form, component 0 at D = 3 (63 % of the values with raw bits) or 5 (24 %), components 1-2 at D = 5 (64 %)
-// or 6 (41 %); raw bits 3-7, 8 %% of them more), none in its normals (paired, D = 6); elephant_1m 156 k of
+// or 6 (41 %); raw bits 3-7, 8 % of them more), none in its normals (paired, D = 6); elephant_1m 156 k of
 // 6.47 M (2.4 %): positions' whole-form streams (D = 4) 0.25 %, split components 0 0.5-1.7 %, components 1-2
 // 45 % in 33 streams (D = 5) and 5.6 % in 111 (D = 6), normals 0.08 % (own tables) and none (paired). Each
 // took a branch that mispredicts where they are common, so the decoder chooses per stream from its table
-// (residual_coder.cpp's raw_bytes_of): the branch where they are rare, else a way without it (the raw bits
-// of a block of 4 values from one 8-byte read, per-symbol tables of the bit count, leading one and mask),
-// in one byte or, where values of 8 raw bits or more are not rare, two; and the encoder, where they are
-// common, takes the smallest D (the decode costs the same). refined_elephant's decode (`bench/decode-pairs`,
-// 20 pairs): RESULTS
+// (residual_coder.cpp's raw_bytes_of): the branch where they are rare, else a way without it (the raw bits of
+// a block of 4 values from one 8-byte read, per-symbol tables of the bit count, leading one and mask), in one
+// byte or, where values of 8 raw bits or more are not rare, two; and the encoder, where they are common,
+// takes the smallest D (the decode costs the same). Decode (`bench/decode-pairs`, main c806a13 on its package
+// against this on its own, triangles a second): refined_elephant 1.052 and 1.059 (20 pairs each; its pages'
+// time, decompress_page, 0.71), motorBike 1.063, horse 1.052, bunny 1.018, elephant_1m 1.004 (12 pairs each);
+// instructions (`bench decode --runs 1`, callgrind) refined_elephant 86.77 -> 87.11 M, elephant_1m 1,021.8 ->
+// 1,030.4 M (more than with the branch, but no mispredictions). Packages (`lodstream bake`): refined_elephant
+// 225,434 -> 225,155 B (-0.12 %), bunny 214,701 -> 213,908 (-0.37 %), horse 280,746 -> 279,849 (-0.32 %),
+// motorBike 1,305,234 -> 1,302,988 (-0.17 %), elephant_1m 2,535,327 -> 2,532,569 (-0.11 %), elephant_5m
+// 9,838,557 -> 9,829,619 (-0.09 %), city 17,811,588 -> 17,787,740 B (-0.13 %); renders identical.
 //
 // A stream (no bytes for no values): u8 D (1..6), u8 A (symbols in the table, 1..2^D + 40 - D), A varint
 // frequencies adding up to 2^12, varint size of the rANS bytes, the rANS bytes (the four final states
