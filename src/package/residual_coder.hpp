@@ -65,7 +65,7 @@
 // takes the smallest D (the decode costs the same). Decode (`bench/decode-pairs`, main c806a13 on its package
 // against this on its own, triangles a second): refined_elephant 1.052 and 1.059 (20 pairs each; its pages'
 // time, decompress_page, 0.71), motorBike 1.063, horse 1.052, bunny 1.018, elephant_1m 1.004 (12 pairs each);
-// instructions (`bench decode --runs 1`, callgrind) refined_elephant 86.77 -> 87.11 M, elephant_1m 1,021.8 ->
+// instructions (`bench decode --runs 1`, callgrind) refined_elephant 86.77 -> 87.12 M, elephant_1m 1,021.8 ->
 // 1,030.4 M (more than with the branch, but no mispredictions). Packages (`lodstream bake`): refined_elephant
 // 225,434 -> 225,155 B (-0.12 %), bunny 214,701 -> 213,908 (-0.37 %), horse 280,746 -> 279,849 (-0.32 %),
 // motorBike 1,305,234 -> 1,302,988 (-0.17 %), elephant_1m 2,535,327 -> 2,532,569 (-0.11 %), elephant_5m
