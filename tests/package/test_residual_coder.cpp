@@ -134,10 +134,16 @@ TEST(ResidualCoder, OneSymbolAloneAndNoResiduals) {
 }
 
 TEST(ResidualCoder, EveryDirectWidthTheEncoderPicksDecodes) {
-  // Geometric residuals of growing scale, in short and longer streams: the encoder's D (the stream's first
-  // byte) follows the scale and the table's cost, every D occurs, and each stream decodes back, its values
-  // of raw bits included.
+  // Geometric residuals of growing scale, in short and longer streams, and residuals 0, 1, 2^(d-1) + 1 and
+  // 2^d - 1 with 2 % of 13 bits (values of raw bits rare: D = d): the encoder's D (the stream's first byte)
+  // follows the scale and the table's cost, every D occurs, and each stream decodes back, its values of raw
+  // bits included.
   std::set<uint8_t> picked;
+  auto check = [&](const Residuals& r, uint32_t scale) {
+    const std::vector<uint8_t> stream = encode_residuals(r.values);
+    picked.insert(stream[0]);
+    EXPECT_EQ(decoded_planes(stream, r), expected_planes(r)) << "scale " << scale;
+  };
   for (size_t count : {100, 1000})
     for (uint32_t scale = 0; scale < 12; ++scale) {
       std::mt19937_64 rng(scale);
@@ -145,11 +151,97 @@ TEST(ResidualCoder, EveryDirectWidthTheEncoderPicksDecodes) {
       Residuals r;
       r.counts = {count}, r.widths = {5};
       for (size_t i = 0; i < 3 * count; ++i) r.values.push_back(geometric(rng) & ((uint64_t(1) << 40) - 1));
-      const std::vector<uint8_t> stream = encode_residuals(r.values);
-      picked.insert(stream[0]);
-      EXPECT_EQ(decoded_planes(stream, r), expected_planes(r)) << "scale " << scale;
+      check(r, scale);
     }
+  for (uint32_t d = 1; d <= 6; ++d) {
+    std::mt19937_64 rng(d);
+    Residuals r;
+    r.counts = {300}, r.widths = {2};
+    const uint64_t top = (uint64_t(1) << d) - 1, middle = (uint64_t(1) << (d - 1)) | 1;
+    for (size_t i = 0; i < 900; ++i) {
+      const uint32_t x = uint32_t(rng() % 100);
+      r.values.push_back(x < 2 ? 4096 + rng() % 4096 : x < 50 ? 0 : x < 70 ? 1 : x < 85 ? top : middle);
+    }
+    check(r, 100 + d);
+  }
   EXPECT_EQ(picked, (std::set<uint8_t>{1, 2, 3, 4, 5, 6}));
+}
+
+// The decoder takes a stream's values of raw bits with a branch, or without one in one byte or in two
+// (residual_coder.cpp's raw_bytes_of, by their share in the stream's table): every way decodes to the planes,
+// values of more raw bits than the way takes included, in nodes of 1 to 3 bytes and odd counts (values one
+// by one after the blocks of 4), and a stream cut short is an error in each (its raw bits: one that says so).
+// Values: small (below 2^3) but for a share `raw` of values of 6 to 7 raw bits, `wide` of 8 to 14 and `huge`
+// of 15 to 22 (where they fit).
+TEST(ResidualCoder, ValuesOfRawBitsDecodeAlikeWhicheverWayTheDecoderTakes) {
+  struct Mix {
+    double raw, wide, huge;
+  };
+  // A branch (0.5 %, 3 %), one byte (10 %, 40 %), two bytes (wide 3 %, 10 %), either with huge values.
+  const Mix mixes[] = {{0.005, 0, 0},  {0.03, 0.002, 0}, {0.1, 0, 0},        {0.4, 0.003, 0},
+                       {0.1, 0.03, 0}, {0.3, 0.1, 0},    {0.3, 0.004, 0.01}, {0.3, 0.1, 0.02}};
+  uint32_t seed = 0;
+  for (const Mix& mix : mixes)
+    for (uint32_t width = 1; width <= 3; ++width) {
+      std::mt19937_64 rng(++seed);
+      std::uniform_real_distribution<double> u(0, 1);
+      auto draw = [&](uint32_t low, uint32_t high) {  // a value of bit length low + 1 .. high
+        const uint32_t k = low + 1 + uint32_t(rng() % (high - low));
+        return uint64_t(1) << (k - 1) | (rng() & ((uint64_t(1) << (k - 1)) - 1));
+      };
+      Residuals r;
+      for (uint32_t node = 0; node < 6; ++node) {
+        const size_t count = 301 + rng() % 700;
+        r.counts.push_back(count), r.widths.push_back(width);
+        for (size_t i = 0; i < 3 * count; ++i) {
+          const double x = u(rng);
+          r.values.push_back(x < mix.huge && width >= 3              ? draw(15, 23)
+                             : x < mix.huge + mix.wide && width >= 2 ? draw(8, 15)
+                             : x < mix.huge + mix.wide + mix.raw     ? draw(6, 8)
+                                                                     : rng() % 8);
+        }
+      }
+      const std::vector<uint8_t> stream = encode_residuals(r.values);
+      EXPECT_EQ(decoded_planes(stream, r), expected_planes(r)) << "mix " << seed / 3 << " width " << width;
+      // Cut in its raw bits (the stream's last bytes), then in its rANS bytes.
+      for (size_t cut : {1, 9})
+        expect_error_naming("stream 3: residual raw bits end early", "raw bits cut", [&] {
+          decoded_planes(std::vector<uint8_t>(stream.begin(), stream.end() - cut), r);
+        });
+      expect_error_naming("stream 3", "cut in half", [&] {
+        decoded_planes(std::vector<uint8_t>(stream.begin(), stream.begin() + stream.size() / 2), r);
+      });
+    }
+}
+
+// Where values of raw bits are common whatever D (geometric residuals of scale 2^5 to 2^9: most have raw
+// bits even with D = 6), the decoder takes them without a branch at any D, and the encoder takes the
+// smallest stream rather than the largest D within 0.5 % of it (its estimate: within 0.2 % and 4 bytes of
+// the smallest of the six D's streams, and smaller than D = 6's); each decodes back.
+TEST(ResidualCoder, WhereRawBitsAreCommonTheSmallestStreamIsTaken) {
+  for (size_t count : {300, 1000, 3000})
+    for (uint32_t scale = 5; scale < 10; ++scale) {
+      std::mt19937_64 rng(scale);
+      std::geometric_distribution<uint64_t> geometric(1.0 / (1 + (uint64_t(1) << scale)));
+      Residuals r;
+      r.counts = {count}, r.widths = {3};
+      for (size_t i = 0; i < 3 * count; ++i) r.values.push_back(geometric(rng));
+      const std::vector<uint8_t> chosen = encode_residuals(r.values);
+      size_t smallest = chosen.size();
+      for (uint32_t D = 1; D <= 6; ++D) {
+        const std::vector<uint8_t> stream = encode_residuals(r.values, D);
+        ASSERT_EQ(stream[0], D);
+        EXPECT_EQ(decoded_planes(stream, r), expected_planes(r)) << "D " << D;
+        smallest = std::min(smallest, stream.size());
+        if (D == 6) {
+          EXPECT_LT(chosen.size(), stream.size()) << count << " " << scale;
+        }
+      }
+      EXPECT_LE(double(chosen.size()), 1.002 * double(smallest) + 4) << count << " " << scale;
+      EXPECT_EQ(decoded_planes(chosen, r), expected_planes(r));
+    }
+  EXPECT_THROW(encode_residuals(std::vector<uint64_t>{1}, 0), Error);
+  EXPECT_THROW(encode_residuals(std::vector<uint64_t>{1}, 7), Error);
 }
 
 TEST(ResidualCoder, MostlyZeroResidualsTakeWellUnderABitEach) {
