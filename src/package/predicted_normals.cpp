@@ -318,11 +318,14 @@ template <class F, class I, size_t N>
 }
 
 // The V normals from their sums and code planes, L vertices a step (F, I: Float4 and Int4, Float8 and Int8 or
-// Float16 and Int16), two steps interleaved, then single steps of 16, 8 and 4: their sums transposed to
-// lanes, their frames built, the codes decoded in them, transposed back into 3 floats each. sum holds a
-// multiple of 4 entries; residual and normals take the last step's spare lanes, dropped at the end (written
-// in place: a reused `normals` is zero-filled only where it grows, where decoding into scratch copied every
-// normal, refined_elephant's bench decode 0.9 M of memcpy).
+// Float16 and Int16), four steps interleaved, then single steps of 16, 8 and 4: their sums transposed to
+// lanes, their frames built, the codes decoded in them, transposed back into 3 floats each. Four steps
+// interleaved, where two took 3.7 ticks a vertex in the AVX-512 build and 4.7 in the AVX2 one, four 3.5 and
+// 4.5 (rdtsc as at store_normals, both variants in one process, the machine slower than there): a step's
+// chain of square roots and divisions is long, and the registers four steps spill cost less than the latency
+// they hide. sum holds a multiple of 4 entries; residual and normals take the last step's spare lanes,
+// dropped at the end (written in place: a reused `normals` is zero-filled only where it grows, where decoding
+// into scratch copied every normal, refined_elephant's bench decode 0.9 M of memcpy).
 template <class F, class I>
 [[gnu::always_inline]] inline void decode_normals(std::span<const NormalSum> sum, uint32_t V,
                                                   const uint8_t* planes, uint32_t width, uint32_t bits,
@@ -335,8 +338,8 @@ template <class F, class I>
   read_planes(planes, V, 2, width, residual.data());
   const float inv_scale = 1.0f / frame_scale(bits);
   size_t i = 0;
-  for (; i + 2 * L <= lanes; i += 2 * L)
-    decode_steps<F, I, 2>(&sum[i], &residual[i], &residual[V + i], inv_scale, &out[i]);
+  for (; i + 4 * L <= lanes; i += 4 * L)
+    decode_steps<F, I, 4>(&sum[i], &residual[i], &residual[V + i], inv_scale, &out[i]);
   if constexpr (L == 16)
     for (; i + 16 <= lanes; i += 16)
       decode_steps<Float16, Int16, 1>(&sum[i], &residual[i], &residual[V + i], inv_scale, &out[i]);
@@ -348,7 +351,7 @@ template <class F, class I>
   normals.resize(V);
 }
 
-// The AVX-512 (x86-64-v4) build: 16 vertices a step, 3.5 ticks a vertex where the AVX2 build takes 4.4 (rdtsc
+// The AVX-512 (x86-64-v4) build: 16 vertices a step, 3.3 ticks a vertex where the AVX2 build takes 4.2 (rdtsc
 // as at store_normals; this EPYC divides and takes square roots of 16 lanes as fast as of 8). Without FMA
 // contraction (CMakeLists.txt's -ffp-contract=off: x86-64-v4 includes FMA), so the same bits as the others.
 __attribute__((target("arch=x86-64-v4"))) void decode_normals_avx512(std::span<const NormalSum> sum,

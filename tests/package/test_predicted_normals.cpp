@@ -80,13 +80,13 @@ TEST(PredictedNormals, EveryNormalComesBackInAnyFrame) {
 }
 
 TEST(PredictedNormals, WideLanesDecodeTheBitsOfFour) {
-  // decode_predicted_normals takes two steps of 16 (AVX-512), 8 (AVX2) or 4 vertices (the baseline build)
+  // decode_predicted_normals takes four steps of 16 (AVX-512), 8 (AVX2) or 4 vertices (the baseline build)
   // interleaved, then single steps of 16, 8 and 4 for the rest: each group of 4 decoded alone (4 lanes) gives
   // the same bits as within the whole (in a wide step, alone or interleaved), in every frame of the test
   // above, in the build this CPU runs and in the baseline one.
   std::mt19937 rng(7);
   std::normal_distribution<float> g;
-  const uint32_t V = 92, bits = 9;  // 2 x 32 + 16 + 8 + 4, 5 x 16 + 8 + 4, 11 x 8 + 4
+  const uint32_t V = 92, bits = 9;  // 64 + 16 + 8 + 4, 2 x 32 + 3 x 8 + 4, 5 x 16 + 3 x 4
   std::vector<NormalSum> sum(V);
   std::vector<glm::vec3> normals(V);
   for (uint32_t v = 0; v < V; ++v) {
