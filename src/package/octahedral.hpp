@@ -59,8 +59,7 @@ inline glm::vec3 oct_decode(int x, int y, float inv_scale) {
 // computes in each lane exactly what the scalar one computes (the same operations in the same order).
 using Float4 = float __attribute__((vector_size(16)));
 using Int4 = int32_t __attribute__((vector_size(16)));
-// Eight lanes: decode_predicted_normals takes 8 vertices a step (one AVX register in its AVX2 build, two SSE
-// registers in the baseline one).
+// Eight lanes: decode_predicted_normals' AVX2 build takes 8 vertices a step (one AVX register).
 using Float8 = float __attribute__((vector_size(32)));
 using Int8 = int32_t __attribute__((vector_size(32)));
 // Sixteen lanes: decode_predicted_normals' AVX-512 build takes 16 vertices a step (one AVX-512 register).
@@ -111,10 +110,9 @@ inline Float4 sqrt(Float4 v) {
 // Float8 and Float16 lane by lane (a template, instantiated only where they are used: a function of Float8
 // values draws GCC's ABI note, -Wpsabi, in a translation unit built without AVX). With -fno-math-errno
 // (predicted_normals.cpp, the one user) GCC makes it one vsqrtps of all lanes in an AVX2 (8) or AVX-512 (16)
-// build and two sqrtps of 8 lanes in the baseline one; as two Float4 sqrts, the AVX2 build split and joined
-// the lanes around two 4-lane ones (`bench decode --runs 1` under callgrind, decode_predicted_normals:
-// refined_elephant 2.46 -> 2.11 M, elephant_1m 39.3 -> 33.6 M). The same bits: sqrt is correctly rounded
-// whatever the width.
+// build; as two Float4 sqrts, the AVX2 build split and joined the lanes around two 4-lane ones (`bench decode
+// --runs 1` under callgrind, decode_predicted_normals: refined_elephant 2.46 -> 2.11 M, elephant_1m 39.3
+// -> 33.6 M). The same bits: sqrt is correctly rounded whatever the width.
 template <class V>
 requires(sizeof(V) > sizeof(Float4)) inline V sqrt(V v) {
   V r;
