@@ -55,14 +55,16 @@ inline glm::vec3 oct_decode(int x, int y, float inv_scale) {
   return {fx * inv_length, fy * inv_length, fz * inv_length};
 }
 
-// Four lanes (GCC / Clang vector extensions, one SSE register). The 4- and 8-lane oct_decode below computes
-// in each lane exactly what the scalar one computes (the same operations in the same order).
+// Four lanes (GCC / Clang vector extensions, one SSE register). The 4-, 8- and 16-lane oct_decode below
+// computes in each lane exactly what the scalar one computes (the same operations in the same order).
 using Float4 = float __attribute__((vector_size(16)));
 using Int4 = int32_t __attribute__((vector_size(16)));
-// Eight lanes: decode_predicted_normals takes 8 vertices a step (one AVX register in its AVX2 build, two SSE
-// registers in the baseline one).
+// Eight lanes: decode_predicted_normals' AVX2 build takes 8 vertices a step (one AVX register).
 using Float8 = float __attribute__((vector_size(32)));
 using Int8 = int32_t __attribute__((vector_size(32)));
+// Sixteen lanes: decode_predicted_normals' AVX-512 build takes 16 vertices a step (one AVX-512 register).
+using Float16 = float __attribute__((vector_size(64)));
+using Int16 = int32_t __attribute__((vector_size(64)));
 
 // Lane i of the result is lane I[i] of the concatenation (a, b).
 template <int... I>
@@ -73,14 +75,16 @@ inline Float4 shuffle(Float4 a, Float4 b) {
   return __builtin_shuffle(a, b, Int4{I...});
 #endif
 }
-// Every lane v, in any of the vector types above.
+// Every lane v, in any of the vector types above. Forced inline: a Float8 or Float16 returned out of line
+// draws GCC's ABI warning (-Wpsabi) where the caller is not built for AVX or AVX-512.
 template <class V>
-inline V splat_as(float v) {
+[[gnu::always_inline]] inline V splat_as(float v) {
   V r;
   for (size_t i = 0; i < sizeof(V) / sizeof(float); ++i) r[i] = v;
   return r;
 }
-// The lanes and masks below for Float4 / Int4 and Float8 / Int8 alike (M the mask type of V).
+// The lanes and masks below for Float4 / Int4, Float8 / Int8 and Float16 / Int16 alike (M the mask type of
+// V).
 template <class M, class V>
 inline V select(M mask, V yes, V no) {
   return V((M(yes) & mask) | (M(no) & ~mask));
@@ -103,20 +107,20 @@ inline Float4 sqrt(Float4 v) {
   return Float4{std::sqrt(v[0]), std::sqrt(v[1]), std::sqrt(v[2]), std::sqrt(v[3])};
 #endif
 }
-// Float8 lane by lane (a template, instantiated only where Float8 is used: a function of Float8 values draws
-// GCC's ABI note, -Wpsabi, in a translation unit built without AVX). With -fno-math-errno
-// (predicted_normals.cpp, the one user) GCC makes it one vsqrtps of 8 lanes in an AVX2 build and two sqrtps
-// in the baseline one; as two Float4 sqrts, the AVX2 build split and joined the lanes around two 4-lane ones
-// (`bench decode --runs 1` under callgrind, decode_predicted_normals: refined_elephant 2.46 -> 2.11 M,
-// elephant_1m 39.3 -> 33.6 M). The same bits: sqrt is correctly rounded whatever the width.
+// Float8 and Float16 lane by lane (a template, instantiated only where they are used: a function of Float8
+// values draws GCC's ABI note, -Wpsabi, in a translation unit built without AVX). With -fno-math-errno
+// (predicted_normals.cpp, the one user) GCC makes it one vsqrtps of all lanes in an AVX2 (8) or AVX-512 (16)
+// build; as two Float4 sqrts, the AVX2 build split and joined the lanes around two 4-lane ones (`bench decode
+// --runs 1` under callgrind, decode_predicted_normals: refined_elephant 2.46 -> 2.11 M, elephant_1m 39.3
+// -> 33.6 M). The same bits: sqrt is correctly rounded whatever the width.
 template <class V>
-requires(sizeof(V) == sizeof(Float8)) inline V sqrt(V v) {
+requires(sizeof(V) > sizeof(Float4)) inline V sqrt(V v) {
   V r;
-  for (int i = 0; i < 8; ++i) r[i] = __builtin_sqrtf(v[i]);
+  for (size_t i = 0; i < sizeof(V) / sizeof(float); ++i) r[i] = __builtin_sqrtf(v[i]);
   return r;
 }
 
-// oct_decode of 4 or 8 codes (x[i], y[i]: Int4 or Int8) into (nx[i], ny[i], nz[i]).
+// oct_decode of 4, 8 or 16 codes (x[i], y[i]: Int4, Int8 or Int16) into (nx[i], ny[i], nz[i]).
 template <class I, class V>
 inline void oct_decode(I x, I y, float inv_scale, V& nx, V& ny, V& nz) {
   const V zero = splat_as<V>(0.0f), one = splat_as<V>(1.0f);

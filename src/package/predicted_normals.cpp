@@ -39,7 +39,11 @@ template <class V>
 [[gnu::always_inline]] inline Frame<V> prediction_frame(V x, V y, V z) {
   const V zero = splat_as<V>(0.0f), one = splat_as<V>(1.0f);
   const V length2 = x * x + y * y + z * z;
-  const auto usable = (length2 > zero) & (length2 <= splat_as<V>(std::numeric_limits<float>::max()));
+  // Usable: 0 < length2 <= FLT_MAX (not zero, NaN or infinite), as one unsigned comparison of its bits
+  // minus 1 (bits 1 .. 0x7f7fffff, the positive finite floats): GCC 12 scalarizes the AND of two 16-lane
+  // float comparisons in the AVX-512 build.
+  typedef uint32_t U __attribute__((vector_size(sizeof(V))));
+  const decltype(x < x) usable = U(length2) - 1 <= 0x7f7ffffe;
   const V inv_length = one / sqrt(select(usable, length2, one));
   Frame<V> f;
   f.p[0] = select(usable, x * inv_length, zero), f.p[1] = select(usable, y * inv_length, zero);
@@ -82,38 +86,64 @@ float rounding_offset(uint32_t bits) {
   return bits > 9 ? 0.5f : bits == 9 ? 0.2f : 0.4f;
 }
 
-// in_halves<I0, I1, I2, I3>(a, b): shuffle<I...> of Float4s, and of Float8s the same in each 4-lane half
-// (lanes 0-3 from the halves' low lanes, 4-7 from their high ones: AVX's in-lane unpacks and shuffles).
+// in_lanes<I0, I1, I2, I3>(a, b): shuffle<I...> of Float4s, and of Float8s and Float16s the same in each
+// 4-lane (128-bit) lane (lanes 4j .. 4j+3 from the lanes 4j .. 4j+3 of a and b: AVX's and AVX-512's in-lane
+// unpacks and shuffles).
 template <int... I>
-[[gnu::always_inline]] inline Float4 in_halves(Float4 a, Float4 b) {
+[[gnu::always_inline]] inline Float4 in_lanes(Float4 a, Float4 b) {
   return shuffle<I...>(a, b);
 }
 template <int... I>
-[[gnu::always_inline]] inline Float8 in_halves(Float8 a, Float8 b) {
+[[gnu::always_inline]] inline Float8 in_lanes(Float8 a, Float8 b) {
 #if defined(__clang__)
   return __builtin_shufflevector(a, b, (I < 4 ? I : I + 4)..., (I < 4 ? I + 4 : I + 8)...);
 #else
   return __builtin_shuffle(a, b, Int8{(I < 4 ? I : I + 4)..., (I < 4 ? I + 4 : I + 8)...});
 #endif
 }
+template <int... I>
+[[gnu::always_inline]] inline Float16 in_lanes(Float16 a, Float16 b) {
+#if defined(__clang__)
+  return __builtin_shufflevector(a, b, (I < 4 ? I : I + 12)..., (I < 4 ? I + 4 : I + 16)...,
+                                 (I < 4 ? I + 8 : I + 20)..., (I < 4 ? I + 12 : I + 24)...);
+#else
+  return __builtin_shuffle(a, b,
+                           Int16{(I < 4 ? I : I + 12)..., (I < 4 ? I + 4 : I + 16)...,
+                                 (I < 4 ? I + 8 : I + 20)..., (I < 4 ? I + 12 : I + 24)...});
+#endif
+}
 
-// Lanes 0-2 of sum[i .. i+3] (Float4) or sum[i .. i+7] (Float8) transposed into x, y, z, lane k from vertex
-// i + k: a 4 x 4 transpose in each half, a Float8's registers loaded as (sum[i+k] | sum[i+4+k]). In 8 lanes
+// Lanes 0-2 of sum[i .. i+3] (Float4), sum[i .. i+7] (Float8) or sum[i .. i+15] (Float16) transposed into
+// x, y, z, lane k from vertex i + k: a 4 x 4 transpose in each 128-bit lane, a Float8's registers loaded as
+// (sum[i+k] | sum[i+4+k]), a Float16's as (sum[i+k] | sum[i+4+k] | sum[i+8+k] | sum[i+12+k]). In 8 lanes
 // ~13 instructions, where two 4-lane transposes joined took ~30 (GCC gathered the joined lanes one float at a
 // time; `bench decode --runs 1` under callgrind, decode_predicted_normals with store_normals' 8 lanes below:
 // refined_elephant 2.11 -> 1.87 M, elephant_1m 33.6 -> 29.7 M).
 template <class V>
 [[gnu::always_inline]] inline void transpose(const NormalSum* s, V& x, V& y, V& z) {
-  constexpr size_t halves = sizeof(V) / sizeof(NormalSum);
   V r[4];
   for (size_t k = 0; k < 4; ++k)
-    for (size_t h = 0; h < halves; ++h)
+    for (size_t h = 0; h < sizeof(V) / sizeof(NormalSum); ++h)
       std::memcpy(reinterpret_cast<char*>(&r[k]) + h * sizeof(NormalSum), &s[4 * h + k], sizeof(NormalSum));
-  const V xy01 = in_halves<0, 4, 1, 5>(r[0], r[1]), xy23 = in_halves<0, 4, 1, 5>(r[2], r[3]);
-  const V z01 = in_halves<2, 6, 3, 7>(r[0], r[1]), z23 = in_halves<2, 6, 3, 7>(r[2], r[3]);
-  x = in_halves<0, 1, 4, 5>(xy01, xy23), y = in_halves<2, 3, 6, 7>(xy01, xy23);
-  z = in_halves<0, 1, 4, 5>(z01, z23);
+  const V xy01 = in_lanes<0, 4, 1, 5>(r[0], r[1]), xy23 = in_lanes<0, 4, 1, 5>(r[2], r[3]);
+  const V z01 = in_lanes<2, 6, 3, 7>(r[0], r[1]), z23 = in_lanes<2, 6, 3, 7>(r[2], r[3]);
+  x = in_lanes<0, 1, 4, 5>(xy01, xy23), y = in_lanes<2, 3, 6, 7>(xy01, xy23);
+  z = in_lanes<0, 1, 4, 5>(z01, z23);
 }
+
+// sum[v] += n, as a load-add and a store that each address sum + 16 v (x86's base + index form): with one
+// pointer for both, GCC added the base to each corner's offset first, 3 instructions a triangle more; `to`
+// passes through an empty asm so that GCC cannot tell it equals `from`. In predicted_normals' accumulate
+// loop only: in its smoothing loop the same form ran 3 % slower (rdtsc over elephant_1m's nodes).
+class Scatter {
+ public:
+  explicit Scatter(NormalSum* sum) : from_(sum), to_(sum) { asm("" : "+r"(to_)); }
+  [[gnu::always_inline]] void add(uint32_t v, NormalSum n) const { to_[v] = from_[v] + n; }
+
+ private:
+  const NormalSum* from_;
+  NormalSum* to_;
+};
 
 }  // namespace
 
@@ -134,6 +164,7 @@ __attribute__((target_clones("avx2", "default"))) void predicted_normals(
   // With all_inside, first_vertex is 0 (the caller's condition below): a constant, so no subtraction.
   auto accumulate = [&](auto all_inside) {
     const uint32_t base = all_inside ? 0 : first_vertex;
+    const Scatter to(sum.data());
     for (size_t i = 0; i + 2 < indices.size(); i += 3) {
       const uint32_t a = indices[i] - base, b = indices[i + 1] - base, c = indices[i + 2] - base;
       if (!all_inside && (a >= V || b >= V || c >= V)) continue;
@@ -141,9 +172,14 @@ __attribute__((target_clones("avx2", "default"))) void predicted_normals(
       // rotation of e * f.yzx - e.yzx * f (lane i: e[i] f[i + 1] - e[i + 1] f[i], the same products and
       // difference): three shuffles a triangle instead of four (refined_elephant's `bench decode --runs 1`
       // under callgrind: predicted_normals 6.22 -> 6.07 M instructions).
-      const NormalSum pa = p(a), e = p(b) - pa, f = p(c) - pa;
+      // The edges negated (a - b, a - c), so that the loads of b and c fold into the subtractions: the
+      // products of two negated factors are the same bits. With Scatter, 27 instructions a triangle where 33
+      // were (AVX2 build), in the same time (rdtsc over refined_elephant's nodes: 3.33 -> 3.31 ticks a
+      // triangle: the loop waits on its loads and the sums' store-to-load forwarding as much as on its
+      // instructions).
+      const NormalSum pa = p(a), e = pa - p(b), f = pa - p(c);
       const NormalSum n = rotate(e * rotate(f) - rotate(e) * f);
-      sum[a] += n, sum[b] += n, sum[c] += n;
+      to.add(a, n), to.add(b, n), to.add(c, n);
     }
   };
   // s'[v] = 2 s[v] + sum over v's triangles of the other two corners' s: with t = s[a] + s[b] + s[c], corner
@@ -226,23 +262,26 @@ NormalCodes code_normals(std::span<const glm::vec3> normals, std::span<const uin
 
 namespace {
 
-// Lanes 0-3 (Float4) or 0-7 (Float8) of x, y, z as 4 or 8 normals (12 or 24 floats) at out: in each half,
-// three rows (x0 y0 z0 x1) (y1 z1 x2 y2) (z2 x3 y3 z3) of its 4 vertices.
+// The lanes of x, y, z (Float4, Float8 or Float16) as 4, 8 or 16 normals (3 floats each) at out: in each
+// 128-bit lane, three rows (x0 y0 z0 x1) (y1 z1 x2 y2) (z2 x3 y3 z3) of its 4 vertices, each row's 16 bytes
+// copied out of its register as they are (one lane extract, to memory), where a Float4 built from the row's 4
+// floats took GCC a shuffle a float in 16 lanes and more in 8 (rdtsc around decode_predicted_normals over
+// the nodes of refined_elephant and elephant_1m: AVX2 build 5.0 -> 4.4 ticks a vertex).
 template <class V>
 [[gnu::always_inline]] inline void store_normals(V x, V y, V z, glm::vec3* out) {
-  const V xy = in_halves<0, 4, 1, 5>(x, y), yz = in_halves<3, 5, 3, 5>(xy, z),
-          high = in_halves<2, 6, 3, 7>(x, y);
-  const V rows[3] = {in_halves<0, 1, 4, 2>(xy, z), in_halves<0, 1, 4, 5>(yz, high),
-                     in_halves<6, 2, 3, 7>(high, z)};
+  const V xy = in_lanes<0, 4, 1, 5>(x, y), yz = in_lanes<3, 5, 3, 5>(xy, z),
+          high = in_lanes<2, 6, 3, 7>(x, y);
+  const V rows[3] = {in_lanes<0, 1, 4, 2>(xy, z), in_lanes<0, 1, 4, 5>(yz, high),
+                     in_lanes<6, 2, 3, 7>(high, z)};
   for (size_t h = 0; h < sizeof(V) / sizeof(Float4); ++h)
     for (int k = 0; k < 3; ++k) {
-      const Float4 row = {rows[k][4 * h], rows[k][4 * h + 1], rows[k][4 * h + 2], rows[k][4 * h + 3]};
-      std::memcpy(reinterpret_cast<char*>(out + 4 * h) + sizeof row * k, &row, sizeof row);
+      std::memcpy(reinterpret_cast<char*>(out + 4 * h) + sizeof(Float4) * k,
+                  reinterpret_cast<const char*>(&rows[k]) + sizeof(Float4) * h, sizeof(Float4));
     }
 }
 
-// The codes r[0 .. lanes) as an Int4 or Int8: codes of a valid node are below 2^16, hostile ones are clamped
-// to +-2^18 first (oct_decode clamps them again).
+// The codes r[0 .. lanes) as an Int4, Int8 or Int16: codes of a valid node are below 2^16, hostile ones are
+// clamped to +-2^18 first (oct_decode clamps them again).
 template <class I>
 [[gnu::always_inline]] inline I clamped_codes(const int32_t* r) {
   const I limit = I{} + (1 << 18);
@@ -252,7 +291,8 @@ template <class I>
   return v > limit ? limit : v;
 }
 
-// The normals of N steps of 4 (Float4, Int4) or 8 (Float8, Int8) vertices from their sums (sum[0 ..
+// The normals of N steps of 4 (Float4, Int4), 8 (Float8, Int8) or 16 (Float16, Int16) vertices from their
+// sums (sum[0 ..
 // N * lanes)) and codes u (first components) and v: each code decoded in its prediction's frame, written to
 // out[0 .. N * lanes). Each phase (transposes, frames, decodes, rotations into the frames) is written for
 // all N steps before the next, so that the next step's square roots and divisions enter the out-of-order
@@ -277,20 +317,20 @@ template <class F, class I, size_t N>
   }
 }
 
-}  // namespace
-
-// An AVX2 build besides the baseline one, as predicted_normals; 8 vertices a step in both (the baseline
-// build's 8 lanes are two SSE registers), where 4 a step took more instructions for the frames and decodes
-// (`bench decode --runs 1` under callgrind, decode_node: refined_elephant 45.80 -> 45.49 M, elephant_1m
-// 687.9 -> 682.8 M).
-__attribute__((target_clones("avx2", "default"))) void decode_predicted_normals(
-    std::span<const NormalSum> sum, uint32_t V, const uint8_t* planes, uint32_t width, uint32_t bits,
-    std::vector<glm::vec3>& normals) {
-  // Eight vertices a step, then four: their sums transposed to lanes, their frames built, the codes decoded
-  // in them, transposed back into 3 floats each. sum holds a multiple of 4 entries; residual and normals
-  // take the last step's spare lanes, dropped at the end (written in place: a reused `normals` is
-  // zero-filled only where it grows, where decoding into scratch copied every normal, refined_elephant's
-  // bench decode 0.9 M of memcpy).
+// The V normals from their sums and code planes, L vertices a step (F, I: Float4 and Int4, Float8 and Int8 or
+// Float16 and Int16), four steps interleaved, then single steps of 16, 8 and 4: their sums transposed to
+// lanes, their frames built, the codes decoded in them, transposed back into 3 floats each. Four steps
+// interleaved, where two took 3.7 ticks a vertex in the AVX-512 build and 4.7 in the AVX2 one, four 3.5 and
+// 4.5 (rdtsc as at store_normals, both variants in one process, the machine slower than there): a step's
+// chain of square roots and divisions is long, and the registers four steps spill cost less than the latency
+// they hide. sum holds a multiple of 4 entries; residual and normals take the last step's spare lanes,
+// dropped at the end (written in place: a reused `normals` is zero-filled only where it grows, where decoding
+// into scratch copied every normal, refined_elephant's bench decode 0.9 M of memcpy).
+template <class F, class I>
+[[gnu::always_inline]] inline void decode_normals(std::span<const NormalSum> sum, uint32_t V,
+                                                  const uint8_t* planes, uint32_t width, uint32_t bits,
+                                                  std::vector<glm::vec3>& normals) {
+  constexpr size_t L = sizeof(F) / sizeof(float);
   const size_t lanes = (size_t(V) + 3) & ~size_t(3);
   thread_local std::vector<int32_t> residual;
   residual.resize(2 * size_t(V) + 4), normals.resize(lanes);
@@ -298,13 +338,56 @@ __attribute__((target_clones("avx2", "default"))) void decode_predicted_normals(
   read_planes(planes, V, 2, width, residual.data());
   const float inv_scale = 1.0f / frame_scale(bits);
   size_t i = 0;
-  for (; i + 16 <= lanes; i += 16)
-    decode_steps<Float8, Int8, 2>(&sum[i], &residual[i], &residual[V + i], inv_scale, &out[i]);
-  for (; i + 8 <= lanes; i += 8)
-    decode_steps<Float8, Int8, 1>(&sum[i], &residual[i], &residual[V + i], inv_scale, &out[i]);
+  for (; i + 4 * L <= lanes; i += 4 * L)
+    decode_steps<F, I, 4>(&sum[i], &residual[i], &residual[V + i], inv_scale, &out[i]);
+  if constexpr (L == 16)
+    for (; i + 16 <= lanes; i += 16)
+      decode_steps<Float16, Int16, 1>(&sum[i], &residual[i], &residual[V + i], inv_scale, &out[i]);
+  if constexpr (L >= 8)
+    for (; i + 8 <= lanes; i += 8)
+      decode_steps<Float8, Int8, 1>(&sum[i], &residual[i], &residual[V + i], inv_scale, &out[i]);
   for (; i < lanes; i += 4)
     decode_steps<Float4, Int4, 1>(&sum[i], &residual[i], &residual[V + i], inv_scale, &out[i]);
   normals.resize(V);
+}
+
+// The AVX-512 (x86-64-v4) build: 16 vertices a step, 3.3 ticks a vertex where the AVX2 build takes 4.2 (rdtsc
+// as at store_normals; this EPYC divides and takes square roots of 16 lanes as fast as of 8). Without FMA
+// contraction (CMakeLists.txt's -ffp-contract=off: x86-64-v4 includes FMA), so the same bits as the others.
+__attribute__((target("arch=x86-64-v4"))) void decode_normals_avx512(std::span<const NormalSum> sum,
+                                                                     uint32_t V, const uint8_t* planes,
+                                                                     uint32_t width, uint32_t bits,
+                                                                     std::vector<glm::vec3>& normals) {
+  decode_normals<Float16, Int16>(sum, V, planes, width, bits, normals);
+}
+
+// An AVX2 build: 8 vertices a step, where 4 a step took more instructions for the frames and decodes (`bench
+// decode --runs 1` under callgrind, decode_node: refined_elephant 45.80 -> 45.49 M, elephant_1m 687.9 ->
+// 682.8 M).
+__attribute__((target("avx2"))) void decode_normals_avx2(std::span<const NormalSum> sum, uint32_t V,
+                                                         const uint8_t* planes, uint32_t width, uint32_t bits,
+                                                         std::vector<glm::vec3>& normals) {
+  decode_normals<Float8, Int8>(sum, V, planes, width, bits, normals);
+}
+
+}  // namespace
+
+// 4 lanes a step, one SSE register: GCC compares vectors wider than the target's one float at a time (8 lanes
+// took 37 ticks a vertex, 4 take 11; rdtsc as at store_normals).
+void decode_predicted_normals_baseline(std::span<const NormalSum> sum, uint32_t V, const uint8_t* planes,
+                                       uint32_t width, uint32_t bits, std::vector<glm::vec3>& normals) {
+  decode_normals<Float4, Int4>(sum, V, planes, width, bits, normals);
+}
+
+// libgcc's CPU model, read once per node (two loads and tests).
+void decode_predicted_normals(std::span<const NormalSum> sum, uint32_t V, const uint8_t* planes,
+                              uint32_t width, uint32_t bits, std::vector<glm::vec3>& normals) {
+  if (__builtin_cpu_supports("x86-64-v4"))
+    decode_normals_avx512(sum, V, planes, width, bits, normals);
+  else if (__builtin_cpu_supports("avx2"))
+    decode_normals_avx2(sum, V, planes, width, bits, normals);
+  else
+    decode_predicted_normals_baseline(sum, V, planes, width, bits, normals);
 }
 
 }  // namespace lodstream::package

@@ -79,13 +79,14 @@ TEST(PredictedNormals, EveryNormalComesBackInAnyFrame) {
   }
 }
 
-TEST(PredictedNormals, EightLanesDecodeTheBitsOfFour) {
-  // decode_predicted_normals takes 16 vertices a step (two 8-lane steps interleaved), then 8, then the last 4
-  // alone: each group of 4 decoded alone (4 lanes) gives the same bits as within the whole (8 lanes, alone or
-  // interleaved), in every frame of the test above.
+TEST(PredictedNormals, WideLanesDecodeTheBitsOfFour) {
+  // decode_predicted_normals takes four steps of 16 (AVX-512), 8 (AVX2) or 4 vertices (the baseline build)
+  // interleaved, then single steps of 16, 8 and 4 for the rest: each group of 4 decoded alone (4 lanes) gives
+  // the same bits as within the whole (in a wide step, alone or interleaved), in every frame of the test
+  // above, in the build this CPU runs and in the baseline one.
   std::mt19937 rng(7);
   std::normal_distribution<float> g;
-  const uint32_t V = 44, bits = 9;  // 2 steps of 16, one of 8, one of 4
+  const uint32_t V = 92, bits = 9;  // 64 + 16 + 8 + 4, 2 x 32 + 3 x 8 + 4, 5 x 16 + 3 x 4
   std::vector<NormalSum> sum(V);
   std::vector<glm::vec3> normals(V);
   for (uint32_t v = 0; v < V; ++v) {
@@ -96,19 +97,57 @@ TEST(PredictedNormals, EightLanesDecodeTheBitsOfFour) {
   const std::vector<uint64_t> codes = encode(normals, sum, bits, width);
   std::vector<uint8_t> planes;
   put_planes(planes, codes, 2, width);
-  std::vector<glm::vec3> whole;
-  decode_predicted_normals(sum, V, planes.data(), width, bits, whole);
-  for (uint32_t first = 0; first < V; first += 4) {
-    const std::vector<uint64_t> group(codes.begin() + 2 * first, codes.begin() + 2 * (first + 4));
-    std::vector<uint8_t> group_planes;
-    put_planes(group_planes, group, 2, width);
-    std::vector<glm::vec3> alone;
-    decode_predicted_normals(std::span(sum).subspan(first, 4), 4, group_planes.data(), width, bits, alone);
-    for (uint32_t v = 0; v < 4; ++v)
-      for (int a = 0; a < 3; ++a)
-        EXPECT_EQ(std::bit_cast<uint32_t>(alone[v][a]), std::bit_cast<uint32_t>(whole[first + v][a]))
-            << first + v;
+  for (auto decode : {decode_predicted_normals, decode_predicted_normals_baseline}) {
+    std::vector<glm::vec3> whole;
+    decode(sum, V, planes.data(), width, bits, whole);
+    for (uint32_t first = 0; first < V; first += 4) {
+      const std::vector<uint64_t> group(codes.begin() + 2 * first, codes.begin() + 2 * (first + 4));
+      std::vector<uint8_t> group_planes;
+      put_planes(group_planes, group, 2, width);
+      std::vector<glm::vec3> alone;
+      decode(std::span(sum).subspan(first, 4), 4, group_planes.data(), width, bits, alone);
+      for (uint32_t v = 0; v < 4; ++v)
+        for (int a = 0; a < 3; ++a)
+          EXPECT_EQ(std::bit_cast<uint32_t>(alone[v][a]), std::bit_cast<uint32_t>(whole[first + v][a]))
+              << first + v;
+    }
   }
+}
+
+TEST(PredictedNormals, TheWidestBuildDecodesTheBaselineBits) {
+  // decode_predicted_normals (on a CPU with AVX-512 its 16-lane build, else the 8-lane AVX2 one) gives the
+  // baseline build's bits: random and degenerate sums (zero, tiny, huge, infinite, NaN, at the frame's seam),
+  // with any codes (random planes, hostile ones included) of 1 to 3 bytes, at every count of the steps'
+  // tails.
+  std::mt19937 rng(11);
+  std::normal_distribution<float> g;
+  const NormalSum special[] = {
+      {0, 0, 0, 0},   {0, 0, -0.0f, 0}, {1e-30f, 0, 0, 0},    {3e38f, 3e38f, 1, 0},   {INFINITY, 0, 0, 0},
+      {NAN, 0, 1, 0}, {0, 0, -1, 0},    {-1, -1, -1e-30f, 0}, {1e-20f, 1e-20f, 0, 0}, {-INFINITY, 1, 0, 0}};
+  size_t compared = 0;
+  for (uint32_t V : {1u, 3u, 4u, 5u, 8u, 12u, 15u, 16u, 17u, 28u, 31u, 32u, 33u, 47u, 60u, 64u, 77u, 1001u})
+    for (uint32_t width = 1; width <= 3; ++width)
+      for (uint32_t bits : {8u, 9u, 12u}) {
+        std::vector<NormalSum> sum((V + 3) & ~3u, NormalSum{0, 0, 0, 0});
+        for (uint32_t v = 0; v < V; ++v)
+          sum[v] = v % 3 == 0 ? special[(v / 3 + width) % std::size(special)]
+                              : NormalSum{g(rng), g(rng), g(rng), 0} * float(1 << (v % 20));
+        std::vector<uint8_t> planes(2 * width * V);
+        for (uint8_t& b : planes) b = uint8_t(rng());
+        std::vector<glm::vec3> widest, baseline;
+        decode_predicted_normals(sum, V, planes.data(), width, bits, widest);
+        decode_predicted_normals_baseline(sum, V, planes.data(), width, bits, baseline);
+        ASSERT_EQ(widest.size(), V);
+        ASSERT_EQ(baseline.size(), V);
+        for (uint32_t v = 0; v < V; ++v)
+          for (int a = 0; a < 3; ++a) {
+            EXPECT_EQ(std::bit_cast<uint32_t>(widest[v][a]), std::bit_cast<uint32_t>(baseline[v][a]))
+                << V << " vertices, " << width << " bytes, " << bits << " bits: vertex " << v;
+            EXPECT_TRUE(std::isfinite(widest[v][a]));
+          }
+        compared += V;
+      }
+  EXPECT_GT(compared, 10000u);
 }
 
 TEST(PredictedNormals, AWellPredictedNormalStoresZeros) {
