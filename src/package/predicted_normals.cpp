@@ -131,20 +131,6 @@ template <class V>
   z = in_lanes<0, 1, 4, 5>(z01, z23);
 }
 
-// sum[v] += n, as a load-add and a store that each address sum + 16 v (x86's base + index form): with one
-// pointer for both, GCC added the base to each corner's offset first, 3 instructions a triangle more; `to`
-// passes through an empty asm so that GCC cannot tell it equals `from`. In predicted_normals' accumulate
-// loop only: in its smoothing loop the same form ran 3 % slower (rdtsc over elephant_1m's nodes).
-class Scatter {
- public:
-  explicit Scatter(NormalSum* sum) : from_(sum), to_(sum) { asm("" : "+r"(to_)); }
-  [[gnu::always_inline]] void add(uint32_t v, NormalSum n) const { to_[v] = from_[v] + n; }
-
- private:
-  const NormalSum* from_;
-  NormalSum* to_;
-};
-
 }  // namespace
 
 // target_clones: an AVX2 build of the function besides the baseline one, chosen once at load time (ifunc);
@@ -164,7 +150,6 @@ __attribute__((target_clones("avx2", "default"))) void predicted_normals(
   // With all_inside, first_vertex is 0 (the caller's condition below): a constant, so no subtraction.
   auto accumulate = [&](auto all_inside) {
     const uint32_t base = all_inside ? 0 : first_vertex;
-    const Scatter to(sum.data());
     for (size_t i = 0; i + 2 < indices.size(); i += 3) {
       const uint32_t a = indices[i] - base, b = indices[i + 1] - base, c = indices[i + 2] - base;
       if (!all_inside && (a >= V || b >= V || c >= V)) continue;
@@ -172,14 +157,9 @@ __attribute__((target_clones("avx2", "default"))) void predicted_normals(
       // rotation of e * f.yzx - e.yzx * f (lane i: e[i] f[i + 1] - e[i + 1] f[i], the same products and
       // difference): three shuffles a triangle instead of four (refined_elephant's `bench decode --runs 1`
       // under callgrind: predicted_normals 6.22 -> 6.07 M instructions).
-      // The edges negated (a - b, a - c), so that the loads of b and c fold into the subtractions: the
-      // products of two negated factors are the same bits. With Scatter, 27 instructions a triangle where 33
-      // were (AVX2 build), in the same time (rdtsc over refined_elephant's nodes: 3.33 -> 3.31 ticks a
-      // triangle: the loop waits on its loads and the sums' store-to-load forwarding as much as on its
-      // instructions).
-      const NormalSum pa = p(a), e = pa - p(b), f = pa - p(c);
+      const NormalSum pa = p(a), e = p(b) - pa, f = p(c) - pa;
       const NormalSum n = rotate(e * rotate(f) - rotate(e) * f);
-      to.add(a, n), to.add(b, n), to.add(c, n);
+      sum[a] += n, sum[b] += n, sum[c] += n;
     }
   };
   // s'[v] = 2 s[v] + sum over v's triangles of the other two corners' s: with t = s[a] + s[b] + s[c], corner
