@@ -633,10 +633,12 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     }
     // The gates from here until a piece start, two a loop step: the first one's class on x, the second one's
     // on y (each step on the state the step before did not take), so that the states need no swap but after
-    // a tagged class's rank. gate(s, t) decodes the gate e, its class on s, and goes on to the next one;
-    // false when there is none before a piece start, or no triangle is left. (In an inner loop, out of the
-    // piece starts' one, GCC 12 gave the gate's state fewer stack slots; with the swap in every gate, the
-    // states went to the stack: elephant_1m's decode_traversal 353.5 (one loop) -> 344.7 (two) -> 337.8 M
+    // a tagged class's rank. gate(s, t) decodes the gate e, its class on s, and goes on to the next one, or
+    // to front.end() when there is none before a piece start or no triangle is left (where a returned bool
+    // took GCC 12 a setne and a test a gate: elephant_1m's decode_traversal 304.6 -> 288.8 M instructions,
+    // `bench decode --runs 1` under callgrind). (In an inner loop, out
+    // of the piece starts' one, GCC 12 gave the gate's state fewer stack slots; with the swap in every gate,
+    // the states went to the stack: elephant_1m's decode_traversal 353.5 (one loop) -> 344.7 (two) -> 337.8 M
     // instructions (two gates a step), `bench decode --runs 1` under callgrind.)
     auto gate = [&](uint32_t & s, uint32_t & t) __attribute__((always_inline)) {
       const Front::Edge& g = *e;
@@ -683,7 +685,7 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
       } else if (kind == kBoundary) {  // the gate stays in its loop, processed
         previous = tag + 16 * 64 * kBoundary;
         e = front.gate(e + 1);
-        return e != front.end();
+        return;
       } else if (kind == kLeft) {
         previous = tag + 16 * 64 * kLeft;
         c = front.left(g);
@@ -707,19 +709,19 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
         if (kind != kVertex) join(a, b, g.o, c);  // the gate (a kVertex's is its predictor)
       }
       emit(b, a, c, k);
-      if (--left == 0) return false;
-      e = front.gate(e + 1);
-      return e != front.end();
+      e = --left > 0 ? front.gate(e + 1) : front.end();
     };
     for (;;) {
       // The stream's end, once a loop step: its two gates read at most the padding's 8 bytes past it.
       if (in > end) [[unlikely]]
         corrupted(where, "symbols end early");
-      if (!gate(x, y)) {
+      gate(x, y);
+      if (e == front.end()) {
         std::swap(x, y);  // the next gate's class on y
         break;
       }
-      if (!gate(y, x)) break;
+      gate(y, x);
+      if (e == front.end()) break;
     }
   }
   if (!symbols.empty()) {
