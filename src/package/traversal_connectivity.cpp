@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <new>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -38,29 +40,40 @@ class Front {
   // (elephant_1m), 16.99 -> 16.35 M (refined_elephant).
   static constexpr uint32_t kTaken = kNone;
 
-  // Edges for a front, kept per thread between calls; they grow uninitialized (a vector's resize
-  // zero-filled them: 0.84 MB on refined_elephant's `bench decode`), and nothing is read before written.
+  // Edges for a front, kept per thread between calls, as calloc's memory: zero where it comes fresh from
+  // the system, with no pass over it (a vector's resize zero-filled and copied its edges as it grew: 0.84 M
+  // instructions of refined_elephant's `bench decode --runs 1`), and initialized all the same: gate() reads
+  // the edge at end().
   class Storage {
    public:
     Edge* reserve(size_t n) {
-      if (capacity_ < n) edges_.reset(new Edge[n]), capacity_ = n;
-      return edges_.get();
+      if (capacity_ < n) {
+        block_.reset(std::calloc(n + 1, sizeof(Edge)));  // one more for the alignment
+        if (!block_) throw std::bad_alloc();
+        capacity_ = n;
+      }
+      const uintptr_t at = reinterpret_cast<uintptr_t>(block_.get()) + alignof(Edge) - 1;
+      return reinterpret_cast<Edge*>(at & ~uintptr_t(alignof(Edge) - 1));
     }
 
    private:
-    std::unique_ptr<Edge[]> edges_;
+    struct Free {
+      void operator()(void* p) const { std::free(p); }
+    };
+    std::unique_ptr<void, Free> block_;
     size_t capacity_ = 0;
   };
 
   // A front for T triangles in `storage`: a piece start adds 3 edges, every other triangle at most 2: no
-  // more than 3T edges, whatever the symbols; gate reads one more. Its top lives in the Front, a local of
+  // more than 3T edges, whatever the symbols; gate() reads one more. Its top lives in the Front, a local of
   // the caller, so that the compiler keeps it in a register.
   Front(Storage& storage, size_t triangles) : first_(storage.reserve(3 * triangles + 1)), top_(first_) {}
   // The first edge, where the callers' gates start.
   Edge* first() const { return first_; }
   // The first edge at or after e still in its loop (edges are processed in creation order), or end() when
   // none is. The bound is tested only for a taken edge (the storage's edge at end(), of no meaning, is
-  // read): one test and branch fewer a gate.
+  // read): one test and branch fewer a gate (bound first: elephant_1m's decode_traversal 288.8 -> 293.7 M
+  // instructions, `bench decode --runs 1` under callgrind).
   Edge* gate(Edge* e) const {
     while (e->o == kTaken && e < top_) ++e;
     return e;
@@ -556,7 +569,9 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     std::swap(x, y);
     set_rows = all_rows[kTraversalContexts * set];
   }
-  uint32_t previous = 0;
+  // The offset of the previous class's rows, 64 bits: added to a pointer with no extension (one instruction
+  // a gate: elephant_1m's decode_traversal 288.8 -> 286.1 M, `bench decode --runs 1` under callgrind).
+  size_t previous = 0;
   // Clusters of a record: each triangle goes straight to the next free place in its cluster's range of
   // `indices` (the ranges are consecutive, in cluster order, sized by `cluster_triangles`), so the triangles
   // of each cluster stay in traversal order, as the encoder's counting sort leaves them; C = 1 otherwise
@@ -648,7 +663,8 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
       // The next gate's row offset (previous) is set in each kind's branch from constants, so that its row
       // waits on the branch (predicted) and not on this class (the chain row, compare, class, row took
       // about 18 cycles a gate; paired rdtsc around decode_traversal, elephant_1m, new / old 0.95 -> 0.89).
-      uint32_t kind = symbol_class, tag = 0;
+      uint32_t kind = symbol_class;
+      size_t tag = 0;
       // Untagged: the gate's cluster (below C, checked when its triangle was decoded), else the code's - 1.
       uint32_t k = g.cluster;
       if (symbol_class >= kKinds) [[unlikely]] {
