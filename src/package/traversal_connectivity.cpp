@@ -26,8 +26,9 @@ constexpr uint32_t kNone = UINT32_MAX;
 class Front {
  public:
   // 32 bytes (aligned), its loop neighbours as addresses: a gate reads them with no index to scale, and
-  // the front needs no base register (`bench decode --runs 1` under callgrind, decode_traversal against
-  // indices into the storage: elephant_1m 335.4 -> 303.3 M instructions, refined_elephant 24.3 -> 22.0 M).
+  // the front needs no base register (decode_traversal over every record of a package under callgrind,
+  // against indices into the storage: elephant_1m 335.4 -> 303.3 M instructions, refined_elephant 24.3 ->
+  // 22.0 M; paired timings of the same, new / old, elephant_1m 0.95).
   struct alignas(32) Edge {
     uint32_t a, b, o;
     uint32_t cluster;  // of its triangle (records of several clusters; 0 otherwise)
@@ -73,7 +74,7 @@ class Front {
   // The first edge at or after e still in its loop (edges are processed in creation order), or end() when
   // none is. The bound is tested only for a taken edge (the storage's edge at end(), of no meaning, is
   // read): one test and branch fewer a gate (bound first: elephant_1m's decode_traversal 288.8 -> 293.7 M
-  // instructions, `bench decode --runs 1` under callgrind).
+  // instructions, callgrind as above).
   Edge* gate(Edge* e) const {
     while (e->o == kTaken && e < top_) ++e;
     return e;
@@ -570,7 +571,7 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     set_rows = all_rows[kTraversalContexts * set];
   }
   // The offset of the previous class's rows, 64 bits: added to a pointer with no extension (one instruction
-  // a gate: elephant_1m's decode_traversal 288.8 -> 286.1 M, `bench decode --runs 1` under callgrind).
+  // a gate: elephant_1m's decode_traversal 288.8 -> 286.1 M, over every record under callgrind).
   size_t previous = 0;
   // Clusters of a record: each triangle goes straight to the next free place in its cluster's range of
   // `indices` (the ranges are consecutive, in cluster order, sized by `cluster_triangles`), so the triangles
@@ -650,8 +651,8 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     // on y (each step on the state the step before did not take), so that the states need no swap but after
     // a tagged class's rank. gate(s, t) decodes the gate e, its class on s, and goes on to the next one, or
     // to front.end() when there is none before a piece start or no triangle is left (where a returned bool
-    // took GCC 12 a setne and a test a gate: elephant_1m's decode_traversal 304.6 -> 288.8 M instructions,
-    // `bench decode --runs 1` under callgrind). (In an inner loop, out
+    // took GCC 12 a setne and a test a gate: elephant_1m's decode_traversal over every record under
+    // callgrind, 304.6 -> 288.8 M instructions). (In an inner loop, out
     // of the piece starts' one, GCC 12 gave the gate's state fewer stack slots; with the swap in every gate,
     // the states went to the stack: elephant_1m's decode_traversal 353.5 (one loop) -> 344.7 (two) -> 337.8 M
     // instructions (two gates a step), `bench decode --runs 1` under callgrind.)
@@ -661,8 +662,10 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
       const uint32_t symbol_class = decode_class(
           s, set_rows + previous + kGateOffsets.first[count[a]] + kGateOffsets.second[count[b]], in);
       // The next gate's row offset (previous) is set in each kind's branch from constants, so that its row
-      // waits on the branch (predicted) and not on this class (the chain row, compare, class, row took
-      // about 18 cycles a gate; paired rdtsc around decode_traversal, elephant_1m, new / old 0.95 -> 0.89).
+      // waits on the branch (predicted) and not on this class: the chain row load, compare, class, next
+      // row (about 18 cycles of latency a gate by the instruction tables) is gone. Paired timings of
+      // decode_traversal over every record of elephant_1m, new / old: 0.95 (edges linked by address) -> 0.89
+      // (and this), for 1.3 M instructions more.
       uint32_t kind = symbol_class;
       size_t tag = 0;
       // Untagged: the gate's cluster (below C, checked when its triangle was decoded), else the code's - 1.
