@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdlib>
 #include <cstring>
+#include <memory>
+#include <new>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -22,11 +25,14 @@ constexpr uint32_t kNone = UINT32_MAX;
 // The front of traversal_connectivity.hpp, shared by encoder and decoder so that both apply the same rules.
 class Front {
  public:
-  // 32 bytes (6 fields, aligned): an edge's address is its index shifted, where 28 took three instructions
-  // at every look-up.
+  // 32 bytes (aligned), its loop neighbours as addresses: a gate reads them with no index to scale, and
+  // the front needs no base register (decode_traversal over every record of a package under callgrind,
+  // against indices into the storage: elephant_1m 335.4 -> 303.3 M instructions, refined_elephant 24.3 ->
+  // 22.0 M; paired timings of the same, new / old, elephant_1m 0.95).
   struct alignas(32) Edge {
-    uint32_t a, b, o, prev, next;
+    uint32_t a, b, o;
     uint32_t cluster;  // of its triangle (records of several clusters; 0 otherwise)
+    Edge *prev, *next;
   };
   // The callers process the gates in order, each once, so the edges below the gate need no mark: only an
   // edge that a kLeft, kRight or kEnd takes out of its loop before its turn does, kTaken in its o (a field
@@ -35,91 +41,97 @@ class Front {
   // (elephant_1m), 16.99 -> 16.35 M (refined_elephant).
   static constexpr uint32_t kTaken = kNone;
 
-  // A front for T triangles in `storage` (reused between calls): its edges pointer and size live in the
-  // Front, a local of the caller, so that the compiler keeps them in registers.
-  Front(std::vector<Edge>& storage, size_t triangles) {
-    // A piece start adds 3 edges, every other triangle at most 2: no more than 3T edges, whatever the
-    // symbols; gate reads one more.
-    if (storage.size() < 3 * triangles + 1) storage.resize(3 * triangles + 1);
-    edges_ = storage.data();
-  }
-  // The first edge at or after e still in its loop (edges are processed in creation order), or size() when
-  // none is. The bound is tested only for a taken edge (the storage's edge at size(), of no meaning, is
-  // read): one test and branch fewer a gate.
-  uint32_t gate(uint32_t e) const {
-    while (edges_[e].o == kTaken && e < size_) ++e;
+  // Edges for a front, kept per thread between calls, as calloc's memory: zero where it comes fresh from
+  // the system, with no pass over it (a vector's resize zero-filled and copied its edges as it grew: 0.84 M
+  // instructions of refined_elephant's `bench decode --runs 1`), and initialized all the same: gate() reads
+  // the edge at end().
+  class Storage {
+   public:
+    Edge* reserve(size_t n) {
+      if (capacity_ < n) {
+        block_.reset(std::calloc(n + 1, sizeof(Edge)));  // one more for the alignment
+        if (!block_) throw std::bad_alloc();
+        capacity_ = n;
+      }
+      const uintptr_t at = reinterpret_cast<uintptr_t>(block_.get()) + alignof(Edge) - 1;
+      return reinterpret_cast<Edge*>(at & ~uintptr_t(alignof(Edge) - 1));
+    }
+
+   private:
+    struct Free {
+      void operator()(void* p) const { std::free(p); }
+    };
+    std::unique_ptr<void, Free> block_;
+    size_t capacity_ = 0;
+  };
+
+  // A front for T triangles in `storage`: a piece start adds 3 edges, every other triangle at most 2: no
+  // more than 3T edges, whatever the symbols; gate() reads one more. Its top lives in the Front, a local of
+  // the caller, so that the compiler keeps it in a register.
+  Front(Storage& storage, size_t triangles) : first_(storage.reserve(3 * triangles + 1)), top_(first_) {}
+  // The first edge, where the callers' gates start.
+  Edge* first() const { return first_; }
+  // The first edge at or after e still in its loop (edges are processed in creation order), or end() when
+  // none is. The bound is tested only for a taken edge (the storage's edge at end(), of no meaning, is
+  // read): one test and branch fewer a gate (bound first: elephant_1m's decode_traversal 288.8 -> 293.7 M
+  // instructions, callgrind as above).
+  Edge* gate(Edge* e) const {
+    while (e->o == kTaken && e < top_) ++e;
     return e;
   }
-  uint32_t size() const { return size_; }
-  const Edge& edge(uint32_t e) const { return edges_[e]; }
+  Edge* end() const { return top_; }
   // p of the gate's kLeft, n of its kRight (kNone unless its loop has 3 edges or more), and whether its loop
   // has exactly 3 (kEnd).
-  uint32_t left(uint32_t e) const {
-    const Edge& g = edges_[e];
-    return g.prev != g.next ? edges_[g.prev].a : kNone;
-  }
-  uint32_t right(uint32_t e) const {
-    const Edge& g = edges_[e];
-    return g.prev != g.next ? edges_[g.next].b : kNone;
-  }
-  bool closes(uint32_t e) const {
-    const Edge& g = edges_[e];
-    return g.prev != g.next && edges_[g.next].next == g.prev;
-  }
+  static uint32_t left(const Edge& g) { return g.prev != g.next ? g.prev->a : kNone; }
+  static uint32_t right(const Edge& g) { return g.prev != g.next ? g.next->b : kNone; }
+  static bool closes(const Edge& g) { return g.prev != g.next && g.next->next == g.prev; }
 
   // The new triangle's edges get its cluster k.
   void start(uint32_t v0, uint32_t v1, uint32_t v2, uint32_t k) {
-    const uint32_t at = size_;
-    push(v0, v1, v2, at + 2, at + 1, k);
-    push(v1, v2, v0, at, at + 2, k);
-    push(v2, v0, v1, at + 1, at, k);
+    Edge* const to = top_;
+    to[0] = {v0, v1, v2, k, to + 2, to + 1};
+    to[1] = {v1, v2, v0, k, to, to + 2};
+    to[2] = {v2, v0, v1, k, to + 1, to};
+    top_ += 3;
   }
   // kVertex and kSplit: the gate a -> b becomes a -> c, c -> b.
   // The two new edges stored through one address (elephant_1m's decode_traversal 358.0 -> 353.7 M
   // instructions, `bench decode --runs 1` under callgrind: ~3 a kVertex).
-  void attach(uint32_t e, uint32_t c, uint32_t k) {
-    const uint32_t a = edges_[e].a, b = edges_[e].b, prev = edges_[e].prev, next = edges_[e].next;
-    const uint32_t x = size_, y = x + 1;
-    Edge* const to = edges_ + x;
-    to[0] = {a, c, b, prev, y, k};
-    to[1] = {c, b, a, x, next, k};
-    size_ += 2;
-    edges_[prev].next = x;  // a loop has 2 edges or more: prev and next are not the gate
-    edges_[next].prev = y;
+  void attach(const Edge& g, uint32_t c, uint32_t k) {
+    const uint32_t a = g.a, b = g.b;
+    Edge *const prev = g.prev, *const next = g.next, *const to = top_;
+    to[0] = {a, c, b, k, prev, to + 1};
+    to[1] = {c, b, a, k, to, next};
+    top_ += 2;
+    prev->next = to;  // a loop has 2 edges or more: prev and next are not the gate
+    next->prev = to + 1;
   }
   // kLeft: P = p -> a and the gate become p -> b.
-  void close_left(uint32_t e, uint32_t k) {
-    Edge &g = edges_[e], &p = edges_[g.prev];
+  void close_left(const Edge& g, uint32_t k) {
+    Edge& p = *g.prev;
     link(p.prev, g.next, p.a, g.b, g.a, k);
     p.o = kTaken;
   }
   // kRight: the gate and N = b -> n become a -> n.
-  void close_right(uint32_t e, uint32_t k) {
-    Edge &g = edges_[e], &n = edges_[g.next];
+  void close_right(const Edge& g, uint32_t k) {
+    Edge& n = *g.next;
     link(g.prev, n.next, g.a, n.b, g.b, k);
     n.o = kTaken;
   }
   // kEnd: the loop of 3 is gone.
-  void close_loop(uint32_t e) {
-    const Edge& g = edges_[e];
-    edges_[g.prev].o = edges_[g.next].o = kTaken;
-  }
+  static void close_loop(const Edge& g) { g.prev->o = g.next->o = kTaken; }
 
  private:
-  void push(uint32_t a, uint32_t b, uint32_t o, uint32_t prev, uint32_t next, uint32_t k) {
-    Edge& x = edges_[size_++];
-    x.a = a, x.b = b, x.o = o, x.prev = prev, x.next = next, x.cluster = k;
-  }
   // A new edge a -> b (third corner o) between `before` and `after`.
-  void link(uint32_t before, uint32_t after, uint32_t a, uint32_t b, uint32_t o, uint32_t k) {
-    const uint32_t x = size_;
-    push(a, b, o, before, after, k);
-    edges_[before].next = x;
-    edges_[after].prev = x;
+  void link(Edge* before, Edge* after, uint32_t a, uint32_t b, uint32_t o, uint32_t k) {
+    Edge* const x = top_++;
+    *x = {a, b, o, k, before, after};
+    before->next = x;
+    after->prev = x;
   }
 
-  Edge* edges_;
-  uint32_t size_ = 0;
+  Edge* first_;
+  Edge* top_;
 };
 
 void put_varint(std::vector<uint8_t>& out, uint32_t v) {
@@ -409,15 +421,15 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
     ++done;
   };
 
-  thread_local std::vector<Front::Edge> edges;
+  thread_local Front::Storage edges;
   Front front(edges, T);
-  uint32_t scan = 0;      // triangles below it are encoded
-  uint32_t e = 0;         // the gate
-  uint32_t previous = 0;  // the previous gate's class
+  uint32_t scan = 0;               // triangles below it are encoded
+  Front::Edge* e = front.first();  // the gate
+  uint32_t previous = 0;           // the previous gate's class
   RecentClusterCodes recent = kFirstClusterCodes;
   while (done < T) {
     e = front.gate(e);
-    if (e == front.size()) {
+    if (e == front.end()) {
       while (encoded[scan]) ++scan;
       encoded[scan] = 1;
       const uint8_t k = cluster_of[scan];
@@ -438,7 +450,7 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
       emit(corner[0], corner[1], corner[2], k);
       continue;
     }
-    const Front::Edge g = front.edge(e);
+    const Front::Edge g = *e;
     const uint32_t context = traversal_context(previous, triangles_at[g.a], triangles_at[g.b]);
     // The gate's step: class `kind` (+ 6 with the rank of cluster k's code when k is not the gate's).
     auto step = [&](TraversalSymbol kind, uint32_t k) {
@@ -473,20 +485,20 @@ TraversalCode encode_traversal(std::span<const uint32_t> indices, uint32_t V,
     if (c == kNone) {
       step(kVertex, k);
       c = add_vertex(c_in, g.a, g.b, g.o);
-      front.attach(e, c, k);
-    } else if (front.closes(e) && c == front.left(e)) {
+      front.attach(g, c, k);
+    } else if (front.closes(g) && c == front.left(g)) {
       step(kEnd, k);
-      front.close_loop(e);
-    } else if (c == front.left(e)) {
+      front.close_loop(g);
+    } else if (c == front.left(g)) {
       step(kLeft, k);
-      front.close_left(e, k);
-    } else if (c == front.right(e)) {
+      front.close_left(g, k);
+    } else if (c == front.right(g)) {
       step(kRight, k);
-      front.close_right(e, k);
+      front.close_right(g, k);
     } else {
       step(kSplit, k);
       put_varint(code.references, next - 1 - c);
-      front.attach(e, c, k);
+      front.attach(g, c, k);
     }
     emit(g.b, g.a, c, k);
     ++e;  // the gate is out of its loop
@@ -521,7 +533,7 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
                     uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where,
                     std::span<const uint32_t> cluster_triangles, Parallelograms* extra) {
   ByteReader refs(references, where);
-  thread_local std::vector<Front::Edge> edges;
+  thread_local Front::Storage edges;
   Front front(edges, T);
   uint32_t next = 0;  // the next new vertex
   // The symbols' rANS stream (encode_traversal_steps), copied with 8 bytes of padding: a gate reads at most 4
@@ -558,7 +570,9 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     std::swap(x, y);
     set_rows = all_rows[kTraversalContexts * set];
   }
-  uint32_t previous = 0;
+  // The offset of the previous class's rows, 64 bits: added to a pointer with no extension (one instruction
+  // a gate: elephant_1m's decode_traversal 288.8 -> 286.1 M, over every record under callgrind).
+  size_t previous = 0;
   // Clusters of a record: each triangle goes straight to the next free place in its cluster's range of
   // `indices` (the ranges are consecutive, in cluster order, sized by `cluster_triangles`), so the triangles
   // of each cluster stay in traversal order, as the encoder's counting sort leaves them; C = 1 otherwise
@@ -605,10 +619,10 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     extra->found.assign(V, 0);
     extra->corners.resize(3 * size_t(V));
   }
-  uint32_t e = 0;  // the gate
+  Front::Edge* e = front.first();  // the gate
   for (uint32_t left = T; left > 0;) {
     e = front.gate(e);
-    if (e == front.size()) {
+    if (e == front.end()) {
       uint32_t k = 0;
       if (C > 1) {
         const uint64_t read = refs.varint();
@@ -635,22 +649,29 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     }
     // The gates from here until a piece start, two a loop step: the first one's class on x, the second one's
     // on y (each step on the state the step before did not take), so that the states need no swap but after
-    // a tagged class's rank. gate(s, t) decodes the gate e, its class on s, and goes on to the next one;
-    // false when there is none before a piece start, or no triangle is left. (In an inner loop, out of the
-    // piece starts' one, GCC 12 gave the gate's state fewer stack slots; with the swap in every gate, the
-    // states went to the stack: elephant_1m's decode_traversal 353.5 (one loop) -> 344.7 (two) -> 337.8 M
+    // a tagged class's rank. gate(s, t) decodes the gate e, its class on s, and goes on to the next one, or
+    // to front.end() when there is none before a piece start or no triangle is left (where a returned bool
+    // took GCC 12 a setne and a test a gate: elephant_1m's decode_traversal over every record under
+    // callgrind, 304.6 -> 288.8 M instructions). (In an inner loop, out
+    // of the piece starts' one, GCC 12 gave the gate's state fewer stack slots; with the swap in every gate,
+    // the states went to the stack: elephant_1m's decode_traversal 353.5 (one loop) -> 344.7 (two) -> 337.8 M
     // instructions (two gates a step), `bench decode --runs 1` under callgrind.)
     auto gate = [&](uint32_t & s, uint32_t & t) __attribute__((always_inline)) {
-      const Front::Edge& g = front.edge(e);
+      const Front::Edge& g = *e;
       const uint32_t a = g.a, b = g.b;
       const uint32_t symbol_class = decode_class(
           s, set_rows + previous + kGateOffsets.first[count[a]] + kGateOffsets.second[count[b]], in);
-      previous = 16 * 64 * symbol_class;
+      // The next gate's row offset (previous) is set in each kind's branch from constants, so that its row
+      // waits on the branch (predicted) and not on this class: the chain row load, compare, class, next
+      // row (about 18 cycles of latency a gate by the instruction tables) is gone. Paired timings of
+      // decode_traversal over every record of elephant_1m, new / old: 0.95 (edges linked by address) -> 0.89
+      // (and this), for 1.3 M instructions more.
       uint32_t kind = symbol_class;
+      size_t tag = 0;
       // Untagged: the gate's cluster (below C, checked when its triangle was decoded), else the code's - 1.
       uint32_t k = g.cluster;
       if (symbol_class >= kKinds) [[unlikely]] {
-        kind -= kKinds;
+        kind -= kKinds, tag = 16 * 64 * kKinds;
         k = to_front(recent, decode_rank(t, ranks, in)) - 1;
         std::swap(s, t);  // the next gate's class on this gate's state
         if (k >= C) corrupted(where, "cluster out of range");
@@ -664,56 +685,62 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
       // scan's first step: 48.9 M, 186 K, wall 0.99-1.01 (noise +-1.5 %): the CPU predicts most of what the
       // simulation counts as mispredicted.
       if (kind == kVertex) {
+        previous = tag + 16 * 64 * kVertex;
         if (next == V) corrupted(where, "more vertices than the node holds");
         c = next++;
         // The front first: it reads the gate's fields that a, b were loaded from, and no store lies between.
         const uint32_t o = g.o;
-        front.attach(e, c, k);
+        front.attach(g, c, k);
         uint32_t* const predictor = predictors + 3 * size_t(c);
         predictor[0] = a, predictor[1] = b, predictor[2] = o;
       } else if (kind == kRight) {
         // The others by frequency, a chain of tests (a switch took GCC 12's search by value, 4 tests for a
         // kRight: elephant_1m's decode_traversal 337.8 -> 334.3 M instructions).
-        c = front.right(e);
+        previous = tag + 16 * 64 * kRight;
+        c = front.right(g);
         if (c == kNone) corrupted(where, "right turn in a loop of 2");
-        if constexpr (multi) join(b, c, front.edge(g.next).o, a);  // N = b -> c
-        front.close_right(e, k);
+        if constexpr (multi) join(b, c, g.next->o, a);  // N = b -> c
+        front.close_right(g, k);
       } else if (kind == kBoundary) {  // the gate stays in its loop, processed
+        previous = tag + 16 * 64 * kBoundary;
         e = front.gate(e + 1);
-        return e != front.size();
+        return;
       } else if (kind == kLeft) {
-        c = front.left(e);
+        previous = tag + 16 * 64 * kLeft;
+        c = front.left(g);
         if (c == kNone) corrupted(where, "left turn in a loop of 2");
-        if constexpr (multi) join(c, a, front.edge(g.prev).o, b);  // P = c -> a
-        front.close_left(e, k);
+        if constexpr (multi) join(c, a, g.prev->o, b);  // P = c -> a
+        front.close_left(g, k);
       } else if (kind == kEnd) {
-        if (!front.closes(e)) corrupted(where, "end of a loop that is not 3 edges");
-        c = front.left(e);
-        if constexpr (multi) join(c, a, front.edge(g.prev).o, b), join(b, c, front.edge(g.next).o, a);
-        front.close_loop(e);
+        previous = tag + 16 * 64 * kEnd;
+        if (!front.closes(g)) corrupted(where, "end of a loop that is not 3 edges");
+        c = front.left(g);
+        if constexpr (multi) join(c, a, g.prev->o, b), join(b, c, g.next->o, a);
+        front.close_loop(g);
       } else {  // kSplit, the kind left
+        previous = tag + 16 * 64 * kSplit;
         const uint64_t r = refs.varint();
         if (r >= next) corrupted(where, "reference to a vertex not decoded yet");
         c = next - 1 - uint32_t(r);
-        front.attach(e, c, k);
+        front.attach(g, c, k);
       }
       if constexpr (multi) {
         if (kind != kVertex) join(a, b, g.o, c);  // the gate (a kVertex's is its predictor)
       }
       emit(b, a, c, k);
-      if (--left == 0) return false;
-      e = front.gate(e + 1);
-      return e != front.size();
+      e = --left > 0 ? front.gate(e + 1) : front.end();
     };
     for (;;) {
       // The stream's end, once a loop step: its two gates read at most the padding's 8 bytes past it.
       if (in > end) [[unlikely]]
         corrupted(where, "symbols end early");
-      if (!gate(x, y)) {
+      gate(x, y);
+      if (e == front.end()) {
         std::swap(x, y);  // the next gate's class on y
         break;
       }
-      if (!gate(y, x)) break;
+      gate(y, x);
+      if (e == front.end()) break;
     }
   }
   if (!symbols.empty()) {

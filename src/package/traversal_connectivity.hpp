@@ -152,7 +152,8 @@ struct Parallelograms {
 // 1, at most 31: the caller checks; the decoded triangles of each cluster then form its range); every
 // symbol, reference, cluster and vertex count is checked: corrupted streams throw lodstream::Error starting
 // with `where`. With `extra`, also the second parallelograms above (the predictors of single-predictor
-// vertices replaced as said). Cost: O(T + V), one pass over the symbols.
+// vertices replaced as said). Cost: O(T + V), one pass over the symbols; its scratch (the front, up to 96
+// bytes a triangle, and a byte a vertex) is kept per thread between calls.
 void decode_traversal(std::span<const uint8_t> symbols, std::span<const uint8_t> references, uint32_t T,
                       uint32_t V, uint32_t* indices, uint32_t* predictors, const std::string& where,
                       std::span<const uint32_t> cluster_triangles = {}, Parallelograms* extra = nullptr);

@@ -73,6 +73,37 @@ TEST(TraversalConnectivity, ScatteredClustersOfEveryRankDecode) {
   EXPECT_EQ(predictors, code.predictors);
 }
 
+// The front's storage is kept per thread between calls: a smaller node after a larger one (every piece's end
+// reading an edge the larger one left there, taken ones among them) and a larger one after it (the storage
+// grown) decode as each does alone, in both decoders (with and without the further parallelograms).
+TEST(TraversalConnectivity, FrontStorageKeptBetweenCallsOfAnySize) {
+  struct Node {
+    std::vector<uint32_t> indices;
+    uint32_t V;
+  };
+  const Mesh large = sphere(1.0f, 24, 48);
+  const std::vector<Node> nodes = {{large.indices, uint32_t(large.vertex_count())},
+                                   {holed_grid(8, 1), 9 * 9},
+                                   {holed_grid(16, 2), 17 * 17},
+                                   {holed_grid(6, 3), 7 * 7}};
+  for (int repeat = 0; repeat < 2; ++repeat) {
+    for (const Node& n : nodes) {
+      const uint32_t T = uint32_t(n.indices.size() / 3);
+      const TraversalCode code = encode_traversal(n.indices, n.V);
+      for (bool multi : {false, true}) {
+        std::vector<uint32_t> decoded(3 * size_t(T)), predictors(3 * size_t(n.V));
+        Parallelograms extra;
+        decode_traversal(code.symbols, code.references, T, n.V, decoded.data(), predictors.data(), "node", {},
+                         multi ? &extra : nullptr);
+        EXPECT_EQ(decoded, code.indices) << T << " triangles, multi " << multi;
+        if (!multi) {
+          EXPECT_EQ(predictors, code.predictors) << T << " triangles";
+        }
+      }
+    }
+  }
+}
+
 // Fixed tables (traversal_tables.hpp): where vertices have about six triangles each (a sphere's rings, a
 // grid), the gate's context names the kind most of the time, and the stream holds under a bit a gate (12
 // classes alike would take 3.6; sphere(16, 32) 0.68, its poles' fans of 32 included).
