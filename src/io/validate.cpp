@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/prefault.hpp"
 
 namespace lodstream {
 
@@ -43,7 +44,9 @@ ValidationCounts validate_mesh(Mesh& mesh, const std::string& what) {
   // Triangles are checked on every core (the double-precision cross product is most of the cost) and kept in
   // order afterwards; the error names the first bad triangle, as a serial scan would.
   const size_t nt = mesh.indices.size() / 3;
-  std::vector<uint8_t> keep(nt);
+  std::vector<uint8_t> keep;
+  reserve_prefaulted(keep, nt);  // core/prefault.hpp
+  keep.resize(nt);
   std::atomic<size_t> first_bad{nt};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nt, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t t = r.begin(); t < r.end(); ++t) {
