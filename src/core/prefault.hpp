@@ -4,6 +4,9 @@
 // every element on the calling thread), the other core waits. Here the pages are populated first, the
 // address range split across the cores (madvise MADV_POPULATE_WRITE, Linux 5.14), and the serial write that
 // follows finds them present. Where the kernel lacks it, nothing happens and the write faults as before.
+// Measured (perf samples per thread of `lodstream info data/elephant_5m.ply`, 3 interleaved pairs, the
+// import's arrays prefaulted): main thread minus worker 562 / 480 / 372 -> 213 / 203 / 182 ms of CPU, the
+// total the same (1,586 -> 1,592 ms mean): about 0.14 s of the import's wall time no longer on one core.
 #pragma once
 
 #include <sys/mman.h>

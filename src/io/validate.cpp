@@ -67,8 +67,11 @@ ValidationCounts validate_mesh(Mesh& mesh, const std::string& what) {
                 std::to_string(std::max({i[0], i[1], i[2]})) + ", but there are only " + std::to_string(nv) +
                 " vertices");
   }
-  size_t out = 0;
-  for (size_t t = 0; t < nt; ++t) {
+  // Usually no triangle is dropped: the compaction starts at the first one that is (it copied every index
+  // onto itself on one core before; callgrind, lodstream info data/elephant_1m.ply: validate_mesh's serial
+  // part 29.5 -> 13.6 M instructions).
+  size_t out = size_t(std::find(keep.begin(), keep.end(), uint8_t(0)) - keep.begin());
+  for (size_t t = out; t < nt; ++t) {
     if (!keep[t]) {
       ++counts.degenerate_triangles;
       continue;
