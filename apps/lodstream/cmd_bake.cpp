@@ -56,6 +56,7 @@
 #include "bake_textures.hpp"
 #include "command.hpp"
 #include "core/error.hpp"
+#include "core/prefault.hpp"
 #include "hierarchy/bounding_sphere.hpp"
 #include "hierarchy/cluster_dag.hpp"
 #include "hierarchy/hlod.hpp"
@@ -635,7 +636,9 @@ int run_bake(const BakeArgs& args) {
   for (const Object& o : scene.objects) ps.objects.push_back({o.name, o.transform, o.mesh});
 
   // Records.
-  std::vector<NodeRecord> records(order.size());
+  std::vector<NodeRecord> records;
+  reserve_prefaulted(records, order.size());  // core/prefault.hpp: constructed on this thread
+  records.resize(order.size());
   tbb::parallel_for(size_t(0), order.size(), [&](size_t id) {
     NodeRecord& n = records[id];
     if (order[id].mesh == kNone) {

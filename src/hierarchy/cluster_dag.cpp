@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "core/prefault.hpp"
 #include "hierarchy/bounding_sphere.hpp"
 #include "hierarchy/clusterize.hpp"
 #include "hierarchy/component_removal.hpp"
@@ -134,6 +135,7 @@ void build_level0(Builder& b, Mesh mesh) {
   tbb::parallel_invoke(
       [&] { vertex_id = weld_positions(mesh.positions, b.next_position_id); },
       [&] { parts = clusterize(mesh, b.options.max_cluster_vertices, b.options.max_cluster_triangles); });
+  reserve_prefaulted(b.dag.clusters, parts.size());
   b.dag.clusters.resize(parts.size());
   b.position_ids.resize(parts.size());
   tbb::parallel_for(size_t(0), parts.size(), [&](size_t c) {
@@ -381,7 +383,7 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
     size_t boundary_edges = 0;
     for (const std::vector<uint64_t>& once : boundary) boundary_edges += once.size();
     edges.clear();
-    edges.reserve(boundary_edges);
+    reserve_prefaulted(edges, boundary_edges);  // filled on this thread below
     for (uint32_t i = 0; i < active.size(); ++i)
       for (uint64_t e : boundary[i]) edges.emplace_back(e, i);
     boundary.clear();
@@ -417,8 +419,10 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
     std::vector<uint32_t>& owner = b.owner;
     std::vector<uint8_t>& border = b.border;
     if (owner.size() < b.next_position_id) {
-      if (owner.capacity() < b.next_position_id)  // ids grow by about half the active positions a level
+      if (owner.capacity() < b.next_position_id) {  // ids grow by about half the active positions a level
         owner.reserve(b.next_position_id * 3 / 2), border.reserve(b.next_position_id * 3 / 2);
+        prefault(owner.data(), owner.capacity() * sizeof(uint32_t));  // filled on this thread below
+      }
       owner.resize(b.next_position_id, UINT32_MAX), border.resize(b.next_position_id, 0);
     }
     // Groups on every core (these scattered reads of every active position, on one core, left the other

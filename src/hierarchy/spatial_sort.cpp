@@ -13,6 +13,7 @@
 
 #include "core/counting_sort.hpp"
 #include "core/morton.hpp"
+#include "core/prefault.hpp"
 
 namespace lodstream::hierarchy {
 
@@ -58,7 +59,11 @@ void sort_run(std::span<uint64_t> keys, std::vector<uint64_t>& scratch) {
 std::vector<uint32_t> spatial_sort_triangles(std::span<const glm::vec3> positions,
                                              std::span<const uint32_t> indices) {
   const size_t n = indices.size() / 3;
-  std::vector<uint32_t> sorted(n * 3);
+  // The large arrays zero-filled on the calling thread are prefaulted on every core first (core/prefault.hpp;
+  // elephant_5m's level 0: 136 MB, cleared by the kernel on one core while the other waited).
+  std::vector<uint32_t> sorted;
+  reserve_prefaulted(sorted, n * 3);
+  sorted.resize(n * 3);
   if (n == 0) return sorted;
   // Centroids, with the same operations in the same order as meshoptimizer, and their bounding box.
   auto centroid = std::make_unique_for_overwrite<glm::vec3[]>(n);  // every entry written below
@@ -104,7 +109,9 @@ std::vector<uint32_t> spatial_sort_triangles(std::span<const glm::vec3> position
     // run is sorted in cache.
     constexpr int kRunBits = 10;
     constexpr size_t kRuns = size_t(1) << kRunBits;
-    std::vector<uint32_t> code(n);
+    std::vector<uint32_t> code;
+    reserve_prefaulted(code, n), reserve_prefaulted(order, n);
+    code.resize(n);
     tbb::parallel_for(size_t(0), n, [&](size_t t) { code[t] = code_of(t); });
     centroid.reset();
     std::vector<uint32_t> run_begin;

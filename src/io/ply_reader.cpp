@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/prefault.hpp"
 #include "io/mapped_file.hpp"
 #include "io/text_cursor.hpp"
 
@@ -266,10 +267,14 @@ struct MeshBuilder {
         normals(l.has[NX] && l.has[NY] && l.has[NZ]),
         uvs(l.has[U] && l.has[V]),
         colors(l.has[R] && l.has[G] && l.has[B]) {
-    mesh.positions.resize(n);
-    if (normals) mesh.normals.resize(n);
-    if (uvs) mesh.uvs.resize(n);
-    if (colors) mesh.colors.resize(n);
+    auto allocate = [n](auto& array) {  // pages faulted in on every core (core/prefault.hpp)
+      reserve_prefaulted(array, n);
+      array.resize(n);
+    };
+    allocate(mesh.positions);
+    if (normals) allocate(mesh.normals);
+    if (uvs) allocate(mesh.uvs);
+    if (colors) allocate(mesh.colors);
   }
   void set(size_t i, const double* v) {
     mesh.positions[i] = glm::vec3(v[X], v[Y], v[Z]);
@@ -327,6 +332,7 @@ bool read_triangles_with(const char* data, size_t size, size_t offset, const Ele
   const size_t cs = type_size(prop.count_type), is = type_size(prop.type), stride = cs + 3 * is;
   if (e.count > (size - offset) / stride) return false;
   const size_t base = mesh.indices.size();
+  if (base == 0) reserve_prefaulted(mesh.indices, 3 * e.count);  // core/prefault.hpp
   mesh.indices.resize(base + 3 * e.count);
   std::atomic<bool> ok{true};
   tbb::parallel_for(

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/prefault.hpp"
 
 namespace lodstream {
 
@@ -43,7 +44,9 @@ ValidationCounts validate_mesh(Mesh& mesh, const std::string& what) {
   // Triangles are checked on every core (the double-precision cross product is most of the cost) and kept in
   // order afterwards; the error names the first bad triangle, as a serial scan would.
   const size_t nt = mesh.indices.size() / 3;
-  std::vector<uint8_t> keep(nt);
+  std::vector<uint8_t> keep;
+  reserve_prefaulted(keep, nt);  // core/prefault.hpp
+  keep.resize(nt);
   std::atomic<size_t> first_bad{nt};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nt, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t t = r.begin(); t < r.end(); ++t) {
@@ -64,8 +67,11 @@ ValidationCounts validate_mesh(Mesh& mesh, const std::string& what) {
                 std::to_string(std::max({i[0], i[1], i[2]})) + ", but there are only " + std::to_string(nv) +
                 " vertices");
   }
-  size_t out = 0;
-  for (size_t t = 0; t < nt; ++t) {
+  // Usually no triangle is dropped: the compaction starts at the first one that is (it copied every index
+  // onto itself on one core before; callgrind, lodstream info data/elephant_1m.ply: validate_mesh's serial
+  // part 29.5 -> 13.6 M instructions).
+  size_t out = size_t(std::find(keep.begin(), keep.end(), uint8_t(0)) - keep.begin());
+  for (size_t t = out; t < nt; ++t) {
     if (!keep[t]) {
       ++counts.degenerate_triangles;
       continue;

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <glm/gtc/matrix_transform.hpp>
 #include <iterator>
@@ -7,6 +8,7 @@
 #include "core/camera.hpp"
 #include "core/error.hpp"
 #include "core/image.hpp"
+#include "core/prefault.hpp"
 #include "core/scene.hpp"
 #include "support/run.hpp"
 #include "support/shapes.hpp"
@@ -126,4 +128,23 @@ TEST(Image, DecodesAFileHeldInMemoryAndNamesGarbage) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("scene.lods: texture blob 0"), std::string::npos) << e.what();
   }
+}
+
+TEST(Prefault, KeepsContentsAndLeavesReservedStorageUsable) {
+  // Prefaulting a range that starts and ends inside pages (and in the middle of an array) changes no byte,
+  // its own or its neighbours'.
+  std::vector<uint32_t> filled(3'000'000);
+  for (size_t i = 0; i < filled.size(); ++i) filled[i] = uint32_t(i * 2654435761u);
+  prefault(filled.data() + 1'001, (filled.size() - 2'003) * sizeof(uint32_t));
+  for (size_t i = 0; i < filled.size(); ++i) ASSERT_EQ(filled[i], uint32_t(i * 2654435761u)) << i;
+  // What the bake does with it: reserve, prefault, then fill on one thread, as without it.
+  std::vector<uint32_t> v;
+  reserve_prefaulted(v, 5'000'000);
+  EXPECT_TRUE(v.empty());
+  EXPECT_GE(v.capacity(), 5'000'000u);
+  v.assign(5'000'000, 7u);
+  EXPECT_EQ(std::count(v.begin(), v.end(), 7u), 5'000'000);
+  std::vector<uint8_t> small;  // under kPrefaultMinBytes: a plain reserve
+  reserve_prefaulted(small, 100);
+  EXPECT_GE(small.capacity(), 100u);
 }
