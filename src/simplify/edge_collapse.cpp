@@ -25,6 +25,7 @@
 #include "core/morton.hpp"
 #include "core/representatives.hpp"
 #include "simplify/cluster.hpp"
+#include "simplify/cost_order.hpp"
 #include "simplify/quadric.hpp"
 #include "simplify/simplify.hpp"
 #include "simplify/uninitialized.hpp"
@@ -104,12 +105,6 @@ void for_slots_in(const Slot* slots, size_t begin, size_t end, uint32_t lo, uint
   for (; i < end; ++i)
     if (const uint32_t bits = slots[i].cost_bits(); bits >= lo && bits <= hi) f(i);
 }
-
-// A candidate in a pass's collapse order: its cost and its slot (Simplifier::slots_).
-struct Ranked {
-  float cost;
-  uint32_t slot;
-};
 
 // One planned collapse: a -> b and, on a seam, its twin a2 -> b2; x is where b (and b2) end up.
 struct Plan {
@@ -340,7 +335,8 @@ class Simplifier {
   // load 6); now their pages are first touched by the parallel writes of gather_candidates and
   // counting_sort. Every element is written before it is read.
   UninitializedVector<Ranked> order_, sorted_;
-  std::vector<float> bucket_;  // goal_cost's candidate costs in one histogram bucket
+  std::vector<float> bucket_;        // goal_cost's candidate costs in one histogram bucket
+  std::vector<uint64_t> sort_keys_;  // sort_by_cost's keys
   // Regions of the collapse loop's parallel part (region_of): runs of region_vertices_ vertex numbers in
   // Morton order (about kRegionVertices alive vertices, at least kMinRegions regions on a smaller mesh; the
   // run grows as the mesh shrinks), shifted by region_shift_, which turns each pass so that no band of the
@@ -1104,7 +1100,7 @@ class Simplifier {
       const size_t goal = (alive_triangles_ - target + 1) / 2;
       const float limit = limited ? 1.5f * goal_cost(goal) : std::numeric_limits<float>::infinity();
       gather_candidates(limit);
-      radix_sort_by_cost();
+      sort_by_cost(order_, sorted_, sort_keys_);
       collapsed = collapse_in_order(limit, target);
       if (collapsed > 0 || std::isinf(limit)) break;
     }
@@ -1132,7 +1128,7 @@ class Simplifier {
   }
 
   // The candidates under `limit` into order_, scattered from slot order by i -> i * P mod n (P prime > n, so
-  // a permutation): the radix sort keeps this order among equal costs, so that flat regions (all costs equal)
+  // a permutation): the cost sort keeps this order among equal costs, so that flat regions (all costs equal)
   // collapse spread out rather than row by row in face order, the same way on every run. Blocks of slots
   // count theirs, then write from their prefix sum: O(T / cores).
   void gather_candidates(float limit) {
@@ -1507,24 +1503,6 @@ class Simplifier {
     for (const auto& f : found) bucket_.insert(bucket_.end(), f.begin(), f.end());
     std::nth_element(bucket_.begin(), bucket_.begin() + goal, bucket_.end());
     return bucket_[goal];
-  }
-
-  // Sorts order_ by cost: LSD radix sort on the float bits (costs are >= 0, so their bits order like them),
-  // 11 + 11 + 10 bits, each digit a counting_sort on both cores.
-  void radix_sort_by_cost() {
-    sorted_.resize(order_.size());
-    UninitializedVector<Ranked>*src = &order_, *dst = &sorted_;
-    for (int shift : {0, 11, 22}) {
-      auto digit = [&, shift](size_t i) {
-        uint32_t u;
-        std::memcpy(&u, &(*src)[i].cost, 4);
-        return (u >> shift) & 2047u;
-      };
-      counting_sort(src->size(), 2048, digit,
-                    [&](size_t i, uint32_t position) { (*dst)[position] = (*src)[i]; });
-      std::swap(src, dst);
-    }
-    if (src != &order_) order_.swap(sorted_);
   }
 
   // f(face) for each alive face around v's wedges. Always inlined: try_collapse's AVX2 version left it two
