@@ -16,8 +16,10 @@ struct Ranked {
   uint32_t slot;
 };
 
-// Candidates of at most this many are sorted by one std::sort, larger ones by the radix sort (sort_by_cost).
-constexpr size_t kSmallCostSort = 1024;
+// Candidates of at most this many are sorted by one std::sort, larger ones by the radix sort (sort_by_cost):
+// the best of 200 sorts of n random costs on this machine, radix / std::sort, n = 1024: 7.4 / 4.3 us, 2048:
+// 12.1 / 9.2 us, 4096: 21.6 / 20.5 us.
+constexpr size_t kSmallCostSort = 2048;
 
 // Sorts `items` by cost, stably (equal costs keep their order), comparing the costs' float bits (costs are
 // >= 0, so their bits order like them). Up to `small` items: one std::sort of (cost bits, index) keys in
