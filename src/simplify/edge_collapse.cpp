@@ -25,6 +25,7 @@
 #include "core/morton.hpp"
 #include "core/representatives.hpp"
 #include "simplify/cluster.hpp"
+#include "simplify/cost_order.hpp"
 #include "simplify/quadric.hpp"
 #include "simplify/simplify.hpp"
 #include "simplify/uninitialized.hpp"
@@ -104,12 +105,6 @@ void for_slots_in(const Slot* slots, size_t begin, size_t end, uint32_t lo, uint
   for (; i < end; ++i)
     if (const uint32_t bits = slots[i].cost_bits(); bits >= lo && bits <= hi) f(i);
 }
-
-// A candidate in a pass's collapse order: its cost and its slot (Simplifier::slots_).
-struct Ranked {
-  float cost;
-  uint32_t slot;
-};
 
 // One planned collapse: a -> b and, on a seam, its twin a2 -> b2; x is where b (and b2) end up.
 struct Plan {
@@ -277,9 +272,9 @@ class Simplifier {
   const Options& opt_;
   // Meshes of at most kSmallTriangles (a DAG group: 512-1024 triangles, simplified while other groups keep
   // the cores busy) run weld's and build_quadrics' loops and gather_candidates' blocks in plain loops
-  // (for_each), and goal_cost as one selection: there, TBB's tasks, per-thread copies and goal_cost's
-  // 4096-bucket histograms cost more than the loops. (Loops with a grain of 1024 or more are one task there
-  // already.) The results are the same.
+  // (for_each), and goal_cost's select serially with fewer buckets: there, TBB's tasks, per-thread copies
+  // and goal_cost's 4096-bucket histograms cost more than the loops. (Loops with a grain of 1024 or more are
+  // one task there already.) The results are the same.
   static constexpr size_t kSmallTriangles = 4096;
   const bool small_;
 
@@ -340,7 +335,9 @@ class Simplifier {
   // load 6); now their pages are first touched by the parallel writes of gather_candidates and
   // counting_sort. Every element is written before it is read.
   UninitializedVector<Ranked> order_, sorted_;
-  std::vector<float> bucket_;  // goal_cost's candidate costs in one histogram bucket
+  std::vector<float> bucket_;         // goal_cost's candidate costs in one histogram bucket
+  std::vector<uint32_t> histograms_;  // goal_cost's, one per block of slots
+  std::vector<uint64_t> sort_keys_;   // sort_by_cost's keys
   // Regions of the collapse loop's parallel part (region_of): runs of region_vertices_ vertex numbers in
   // Morton order (about kRegionVertices alive vertices, at least kMinRegions regions on a smaller mesh; the
   // run grows as the mesh shrinks), shifted by region_shift_, which turns each pass so that no band of the
@@ -1104,7 +1101,7 @@ class Simplifier {
       const size_t goal = (alive_triangles_ - target + 1) / 2;
       const float limit = limited ? 1.5f * goal_cost(goal) : std::numeric_limits<float>::infinity();
       gather_candidates(limit);
-      radix_sort_by_cost();
+      sort_by_cost(order_, sorted_, sort_keys_);
       collapsed = collapse_in_order(limit, target);
       if (collapsed > 0 || std::isinf(limit)) break;
     }
@@ -1132,7 +1129,7 @@ class Simplifier {
   }
 
   // The candidates under `limit` into order_, scattered from slot order by i -> i * P mod n (P prime > n, so
-  // a permutation): the radix sort keeps this order among equal costs, so that flat regions (all costs equal)
+  // a permutation): the cost sort keeps this order among equal costs, so that flat regions (all costs equal)
   // collapse spread out rather than row by row in face order, the same way on every run. Blocks of slots
   // count theirs, then write from their prefix sum: O(T / cores).
   void gather_candidates(float limit) {
@@ -1462,69 +1459,44 @@ class Simplifier {
 
   // The cost of rank `goal` (0-based) among the valid candidates in slots_, or +inf when there are no more
   // than `goal` of them: a radix select on the float bits (costs are >= 0, so their bits order like them),
-  // a 4096-bucket histogram of the top 12 bits, then nth_element within the one bucket that holds the rank.
-  // Two scans of slots_ (blocks in parallel) and a sort of one bucket, instead of a selection over every
-  // candidate.
+  // a histogram of the top bits, then nth_element within the one bucket that holds the rank. Two scans of
+  // slots_ and a sort of one bucket, instead of a selection over every candidate. 4096 buckets (12 bits),
+  // blocks of slots on every core; on a small mesh 1024 (11 bits: quarter binades), serially. There one
+  // nth_element over every valid cost was about half of this function's time, most of it in its partition
+  // loop (elephant_1m bake, perf: this function 2.04-2.34 -> 1.04-1.16 % of the samples, 3 runs; callgrind,
+  // refined_elephant: 23.9 -> 22.5 M instructions).
   float goal_cost(size_t goal) {
-    auto bits = [](float cost) {
-      uint32_t u;
-      std::memcpy(&u, &cost, 4);
-      return u;
-    };
     constexpr uint32_t kFinite = 0x7f7fffffu;  // the largest finite cost's bits: valid slots
-    if (small_) {  // one selection over the valid costs' bits: the same rank, the same value
-      bucket_.clear();
-      for_slots_in(slots_.data(), 0, slots_.size(), 0, kFinite,
-                   [&](size_t i) { bucket_.push_back(slots_[i].cost()); });
-      if (goal >= bucket_.size()) return std::numeric_limits<float>::infinity();
-      std::nth_element(bucket_.begin(), bucket_.begin() + goal, bucket_.end(),
-                       [&](float x, float y) { return bits(x) < bits(y); });
-      return bucket_[goal];
-    }
-    const size_t blocks = (slots_.size() + kSlotBlock - 1) / kSlotBlock;
-    tbb::enumerable_thread_specific<std::vector<uint32_t>> counts(std::vector<uint32_t>(4096, 0));
-    tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
-      std::vector<uint32_t>& count = counts.local();
-      for_slots_in(slots_.data(), b * kSlotBlock, std::min(slots_.size(), (b + 1) * kSlotBlock), 0, kFinite,
-                   [&](size_t i) { ++count[slots_[i].cost_bits() >> 20]; });
+    const int shift = small_ ? 21 : 20;
+    const uint32_t buckets = (kFinite >> shift) + 1;
+    const size_t blocks = std::max<size_t>(1, (slots_.size() + kSlotBlock - 1) / kSlotBlock);
+    auto block_slots = [&](size_t b, uint32_t lo, uint32_t hi, auto&& f) {
+      for_slots_in(slots_.data(), b * kSlotBlock, std::min(slots_.size(), (b + 1) * kSlotBlock), lo, hi, f);
+    };
+    // A histogram per block (for_each: serially on a small mesh), summed into the first.
+    histograms_.assign(blocks * size_t(buckets), 0);
+    for_each(size_t(0), blocks, [&](size_t b) {
+      uint32_t* c = &histograms_[b * buckets];
+      block_slots(b, 0, kFinite, [&](size_t i) { ++c[slots_[i].cost_bits() >> shift]; });
     });
-    std::vector<uint32_t> count(4096, 0);
-    for (const auto& c : counts)
-      for (size_t k = 0; k < 4096; ++k) count[k] += c[k];
-    size_t total = 0;
-    for (uint32_t c : count) total += c;
-    if (goal >= total) return std::numeric_limits<float>::infinity();
+    uint32_t* const count = histograms_.data();
+    for (size_t b = 1; b < blocks; ++b)
+      for (size_t k = 0; k < buckets; ++k) count[k] += histograms_[b * buckets + k];
     uint32_t bucket = 0;
-    while (goal >= count[bucket]) goal -= count[bucket++];
-    tbb::enumerable_thread_specific<std::vector<float>> found;
-    tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
-      std::vector<float>& f = found.local();
-      // The valid slots in the bucket (bucket <= kFinite >> 20: it holds valid ones).
-      for_slots_in(slots_.data(), b * kSlotBlock, std::min(slots_.size(), (b + 1) * kSlotBlock), bucket << 20,
-                   (bucket << 20) | 0xfffffu, [&](size_t i) { f.push_back(slots_[i].cost()); });
+    while (bucket < buckets && goal >= count[bucket]) goal -= count[bucket++];
+    if (bucket == buckets) return std::numeric_limits<float>::infinity();
+    // The valid slots in the bucket (bucket <= kFinite >> shift: it holds valid ones), the first block's
+    // in bucket_, in any order: the value of rank `goal` does not depend on it.
+    const uint32_t lo = bucket << shift, hi = lo | ((1u << shift) - 1);
+    std::vector<std::vector<float>> found(blocks - 1);  // the later blocks'
+    bucket_.clear();
+    for_each(size_t(0), blocks, [&](size_t b) {
+      std::vector<float>& f = b == 0 ? bucket_ : found[b - 1];
+      block_slots(b, lo, hi, [&](size_t i) { f.push_back(slots_[i].cost()); });
     });
-    bucket_.clear();  // in any order: the value of rank `goal` does not depend on it
     for (const auto& f : found) bucket_.insert(bucket_.end(), f.begin(), f.end());
     std::nth_element(bucket_.begin(), bucket_.begin() + goal, bucket_.end());
     return bucket_[goal];
-  }
-
-  // Sorts order_ by cost: LSD radix sort on the float bits (costs are >= 0, so their bits order like them),
-  // 11 + 11 + 10 bits, each digit a counting_sort on both cores.
-  void radix_sort_by_cost() {
-    sorted_.resize(order_.size());
-    UninitializedVector<Ranked>*src = &order_, *dst = &sorted_;
-    for (int shift : {0, 11, 22}) {
-      auto digit = [&, shift](size_t i) {
-        uint32_t u;
-        std::memcpy(&u, &(*src)[i].cost, 4);
-        return (u >> shift) & 2047u;
-      };
-      counting_sort(src->size(), 2048, digit,
-                    [&](size_t i, uint32_t position) { (*dst)[position] = (*src)[i]; });
-      std::swap(src, dst);
-    }
-    if (src != &order_) order_.swap(sorted_);
   }
 
   // f(face) for each alive face around v's wedges. Always inlined: try_collapse's AVX2 version left it two

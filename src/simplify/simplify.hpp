@@ -11,7 +11,7 @@
 //
 // Operator: edge collapse a -> b with optimal placement x (full edge) or x = b (half edge). Framework: passes
 // of independent collapses in quadric-cost order (a lazy queue: each pass re-evaluates, in parallel, the
-// edges with an end touched by the previous one and radix-sorts the candidates), each pass limited to 1.5x
+// edges with an end touched by the previous one and sorts the candidates), each pass limited to 1.5x
 // the cost of the collapse that would reach the target, which keeps the order close to greedy. A collapse
 // that fails the validity checks is not tried again until an end is touched (or a pass finds nothing). The
 // collapse loop of a large pass runs on many small regions (runs of about 16384 alive vertices in Morton
