@@ -74,7 +74,12 @@ class Front {
   // The first edge at or after e still in its loop (edges are processed in creation order), or end() when
   // none is. The bound is tested only for a taken edge (the storage's edge at end(), of no meaning, is
   // read): one test and branch fewer a gate (bound first: elephant_1m's decode_traversal 288.8 -> 293.7 M
-  // instructions, callgrind as above).
+  // instructions, callgrind as above). The scan's test is predictable where it matters: on elephant_1m every
+  // kRight's next gate skips its N (the gate's pair from a kVertex, 99.7 %), the gates after other kinds 7 %.
+  // Skipping without a branch was slower (decode_traversal over every record of elephant_1m, main d470041,
+  // callgrind and paired thread-CPU times new / old): the first taken edge by a conditional add here, 286.1
+  // -> 304.3 M instructions, 1.066 (the next gate's loads wait on this one's o); a kRight's N when it is the
+  // next edge, 293.5 M, 1.004.
   Edge* gate(Edge* e) const {
     while (e->o == kTaken && e < top_) ++e;
     return e;
@@ -589,7 +594,10 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
     placed += C > 1 ? cluster_triangles[k] : T;
     range_end[k] = indices + 3 * placed;
   }
-  // Per vertex, the triangles decoded at it (wrapping at 2^8, as the encoder counts them).
+  // Per vertex, the triangles decoded at it (wrapping at 2^8, as the encoder counts them), zeroed a record
+  // and incremented. Each new vertex's count set to 1 by its triangle instead (no zeroing, no load for a
+  // kVertex's corner) was slower (elephant_1m's decode_traversal, main d470041): stored in the kinds'
+  // branches, 286.1 -> 304.0 M instructions, paired times 1.037; carried past them to one store, 301.8 M.
   thread_local std::vector<uint8_t> triangles_at;
   triangles_at.assign(V, 0);
   uint8_t* const count = triangles_at.data();
@@ -683,7 +691,9 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
       // -> 58.7 M instructions, simulated mispredictions 255 -> 205 K, wall 0.92; every kind by conditional
       // moves and tables, 82.0 M, 149 K, wall 0.73. Conditional moves for the cluster code and the gate
       // scan's first step: 48.9 M, 186 K, wall 0.99-1.01 (noise +-1.5 %): the CPU predicts most of what the
-      // simulation counts as mispredicted.
+      // simulation counts as mispredicted. A switch over the six kinds as a jump table (one indirect branch a
+      // gate where the chain's tests may mispredict twice): elephant_1m's decode_traversal 286.1 -> 290.0 M
+      // instructions, paired thread-CPU times new / old 1.047 (refined_elephant 1.041), main d470041.
       if (kind == kVertex) {
         previous = tag + 16 * 64 * kVertex;
         if (next == V) corrupted(where, "more vertices than the node holds");
