@@ -10,6 +10,7 @@
 #include "package/derived_normals.hpp"
 #include "package/predicted_normals.hpp"
 #include "package/vertex_attributes.hpp"
+#include "package/widest_build.hpp"
 
 namespace lodstream::package {
 
@@ -406,16 +407,11 @@ void decode_predicted_vertices_baseline(const PredictiveNode& p, std::span<const
   decode_vertices(p, predictors, extra, grid, out, where);
 }
 
-// libgcc's CPU model, read once per node (two loads and tests).
 void decode_predicted_vertices(const PredictiveNode& p, std::span<const uint32_t> predictors,
                                const Parallelograms* extra, const PositionGrid& grid, DecodedNode& out,
                                const std::string& where) {
-  if (__builtin_cpu_supports("x86-64-v4"))
-    decode_vertices_avx512(p, predictors, extra, grid, out, where);
-  else if (__builtin_cpu_supports("avx2"))
-    decode_vertices_avx2(p, predictors, extra, grid, out, where);
-  else
-    decode_predicted_vertices_baseline(p, predictors, extra, grid, out, where);
+  call_widest_build(decode_vertices_avx512, decode_vertices_avx2, decode_predicted_vertices_baseline, p,
+                    predictors, extra, grid, out, where);
 }
 
 }  // namespace lodstream::package
