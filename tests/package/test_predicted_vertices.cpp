@@ -22,17 +22,24 @@ TEST(PredictedVertices, TheWidestBuildDecodesTheBaselineBits) {
   // vector steps' tails.
   std::mt19937 rng(7);
   const PositionGrid grid{glm::vec3(-1.5f, 0.25f, 3.0f), 0.001f};
-  size_t compared = 0, refused = 0;
+  size_t compared = 0, wide_compared = 0, refused = 0;
   for (uint32_t V : {1u, 2u, 3u, 7u, 15u, 16u, 17u, 31u, 33u, 64u, 100u, 1001u})
     for (uint32_t width = 1; width <= 5; ++width)
-      for (uint32_t high_mask : {0u, 3u, 255u})
+      for (uint32_t high_mask : {0u, 3u, 63u, 255u})
         for (uint32_t damping = 2; damping <= 4; ++damping)
           for (int form = 0; form < 4; ++form) {
             const bool plane = form & 1, multi = form & 2;
             std::vector<uint8_t> planes(3 * size_t(width) * V);
             for (size_t i = 0; i < planes.size(); ++i)
               planes[i] = uint8_t(i < 3 * size_t(V) ? rng() : rng() & high_mask);
-            auto below = [&](uint32_t v) { return v == 0 || rng() % 16 == 0 ? V : uint32_t(rng() % v); };
+            // With high bytes masked to 63, the wide case: predictors among the first 8 vertices (those
+            // predicted from cmin alone), so that coordinates spread over up to 2^31 stay in range (the plane
+            // prediction's products then inexact in doubles).
+            const bool wide = high_mask == 63;
+            auto below = [&](uint32_t v) {
+              if (wide) return v < 8 ? V : uint32_t(rng() % 8);
+              return v == 0 || rng() % 16 == 0 ? V : uint32_t(rng() % v);
+            };
             std::vector<uint32_t> predictors(3 * size_t(V));
             Parallelograms extra;
             extra.corners.resize(3 * size_t(V)), extra.found.resize(V);
@@ -72,9 +79,10 @@ TEST(PredictedVertices, TheWidestBuildDecodesTheBaselineBits) {
                           std::bit_cast<uint32_t>(baseline.mesh.positions[v][a]))
                     << V << " vertices, " << width << " bytes, damping " << damping << ", form " << form
                     << ": vertex " << v;
-            compared += V;
+            compared += V, wide_compared += wide ? V : 0;
           }
   EXPECT_GT(compared, 100000u);
+  EXPECT_GT(wide_compared, 10000u);
   EXPECT_GT(refused, 100u);
 }
 
