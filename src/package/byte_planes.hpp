@@ -31,10 +31,11 @@ void put_planes(std::vector<uint8_t>& out, const std::vector<uint64_t>& values, 
 
 // Inverse of put_planes: unzigzags `count` records of `components` components stored as `width` planes into
 // out[a * count + i] (one array per component, so each loop is a plain pass the compiler can vectorize).
-// Forced inline, so that the decoders' AVX2 builds (decode_predicted_vertices, decode_predicted_normals)
-// vectorize it for AVX2, where out of line it stayed baseline code (`bench decode --runs 1` under callgrind,
-// decode_node with predict_positions inlined likewise: refined_elephant 45.49 -> 44.43 M instructions,
-// elephant_1m 682.8 -> 670.1 M). Cost: O(count * components * width).
+// Forced inline, so that the decoders' AVX2 and AVX-512 builds (decode_predicted_vertices,
+// decode_predicted_normals) vectorize it for their targets, where out of line it stayed baseline code (`bench
+// decode --runs 1` under callgrind, decode_node with predict_positions inlined likewise:
+// refined_elephant 45.49 -> 44.43 M instructions, elephant_1m 682.8 -> 670.1 M). Cost: O(count * components *
+// width).
 template <typename T>
 [[gnu::always_inline]] inline void read_planes(const uint8_t* planes, size_t count, uint32_t components,
                                                uint32_t width, T* out) {

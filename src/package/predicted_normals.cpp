@@ -13,6 +13,7 @@
 
 #include "package/byte_planes.hpp"
 #include "package/octahedral.hpp"
+#include "package/widest_build.hpp"
 
 namespace lodstream::package {
 
@@ -359,15 +360,10 @@ void decode_predicted_normals_baseline(std::span<const NormalSum> sum, uint32_t 
   decode_normals<Float4, Int4>(sum, V, planes, width, bits, normals);
 }
 
-// libgcc's CPU model, read once per node (two loads and tests).
 void decode_predicted_normals(std::span<const NormalSum> sum, uint32_t V, const uint8_t* planes,
                               uint32_t width, uint32_t bits, std::vector<glm::vec3>& normals) {
-  if (__builtin_cpu_supports("x86-64-v4"))
-    decode_normals_avx512(sum, V, planes, width, bits, normals);
-  else if (__builtin_cpu_supports("avx2"))
-    decode_normals_avx2(sum, V, planes, width, bits, normals);
-  else
-    decode_predicted_normals_baseline(sum, V, planes, width, bits, normals);
+  call_widest_build(decode_normals_avx512, decode_normals_avx2, decode_predicted_normals_baseline, sum, V,
+                    planes, width, bits, normals);
 }
 
 }  // namespace lodstream::package

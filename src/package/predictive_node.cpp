@@ -10,6 +10,7 @@
 #include "package/derived_normals.hpp"
 #include "package/predicted_normals.hpp"
 #include "package/vertex_attributes.hpp"
+#include "package/widest_build.hpp"
 
 namespace lodstream::package {
 
@@ -108,7 +109,7 @@ struct PlaneGate {
 // 0.57 M ticks for the 47,649 vertices of nodes without the plane prediction, 1.39 -> 1.27 M for the 31,811
 // with it, ~40 ticks a vertex there: the division's chain, predictive_node.hpp).
 // With `extra` (multi), P is the multi-parallelogram (averaged_parallelogram) where a second one was found.
-// Forced inline (and its dispatch below), into decode_predicted_vertices' AVX2 build (as read_planes).
+// Forced inline (and its dispatch below) into decode_predicted_vertices' builds, as read_planes.
 template <uint32_t j, bool plane, bool multi>
 [[gnu::always_inline]] inline void predict_positions(const int64_t* residual, uint32_t V, const uint32_t* o,
                                                      const Parallelograms* extra, uint64_t* c) {
@@ -332,12 +333,13 @@ std::vector<uint8_t> write_predictive_node(const NodeHeader& header, const Predi
   return std::move(w.bytes);
 }
 
-// An AVX2 build besides the baseline one, as predicted_normals (no FMA: the same bits): VEX's 3-operand forms
-// and wider byte-plane reads (`bench decode --runs 1` under callgrind, decode_node: refined_elephant 45.88 ->
-// 45.80 M instructions, elephant_1m 689.6 -> 687.9 M).
-__attribute__((target_clones("avx2", "default"))) void decode_predicted_vertices(
-    const PredictiveNode& p, std::span<const uint32_t> predictors, const Parallelograms* extra,
-    const PositionGrid& grid, DecodedNode& out, const std::string& where) {
+namespace {
+
+// decode_predicted_vertices' body, forced inline into each of its builds below.
+[[gnu::always_inline]] inline void decode_vertices(const PredictiveNode& p,
+                                                   std::span<const uint32_t> predictors,
+                                                   const Parallelograms* extra, const PositionGrid& grid,
+                                                   DecodedNode& out, const std::string& where) {
   const uint32_t V = p.vertices;
   Mesh& m = out.mesh;
   const LockedStream locked = LockedStream::parse(p.locked_stream, V, p.shift, where);
@@ -373,6 +375,43 @@ __attribute__((target_clones("avx2", "default"))) void decode_predicted_vertices
   }
   m.positions.resize(V);
   decode_attribute_stream(p.attribute_stream, p.flags, V, p.uv_min, p.uv_extent, out, where);
+}
+
+// The AVX-512 (x86-64-v4) build: 10.8 TSC ticks a vertex from the residual planes to the range-checked coarse
+// coordinates, where the AVX2 build takes 11.6 (rdtsc around them, each node's fastest of 15 runs summed over
+// elephant_1m's 1.31 M vertices, median of 10 interleaved pairs: 15.2 -> 14.1 M ticks, 0.925x); read_planes
+// and out_of_range take 16 lanes a step. Without contraction (CMakeLists.txt's -ffp-contract=off: x86-64-v4
+// includes FMA), so the plane prediction's doubles give the same bits as the other builds.
+__attribute__((target("arch=x86-64-v4"))) void decode_vertices_avx512(
+    const PredictiveNode& p, std::span<const uint32_t> predictors, const Parallelograms* extra,
+    const PositionGrid& grid, DecodedNode& out, const std::string& where) {
+  decode_vertices(p, predictors, extra, grid, out, where);
+}
+
+// An AVX2 build, as predicted_normals (no FMA: the same bits): VEX's 3-operand forms and wider byte-plane
+// reads (`bench decode --runs 1` under callgrind, decode_node: refined_elephant 45.88 -> 45.80 M
+// instructions, elephant_1m 689.6 -> 687.9 M).
+__attribute__((target("avx2"))) void decode_vertices_avx2(const PredictiveNode& p,
+                                                          std::span<const uint32_t> predictors,
+                                                          const Parallelograms* extra,
+                                                          const PositionGrid& grid, DecodedNode& out,
+                                                          const std::string& where) {
+  decode_vertices(p, predictors, extra, grid, out, where);
+}
+
+}  // namespace
+
+void decode_predicted_vertices_baseline(const PredictiveNode& p, std::span<const uint32_t> predictors,
+                                        const Parallelograms* extra, const PositionGrid& grid,
+                                        DecodedNode& out, const std::string& where) {
+  decode_vertices(p, predictors, extra, grid, out, where);
+}
+
+void decode_predicted_vertices(const PredictiveNode& p, std::span<const uint32_t> predictors,
+                               const Parallelograms* extra, const PositionGrid& grid, DecodedNode& out,
+                               const std::string& where) {
+  call_widest_build(decode_vertices_avx512, decode_vertices_avx2, decode_predicted_vertices_baseline, p,
+                    predictors, extra, grid, out, where);
 }
 
 }  // namespace lodstream::package
