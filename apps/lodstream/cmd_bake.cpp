@@ -637,8 +637,7 @@ int run_bake(const BakeArgs& args) {
 
   // Records.
   std::vector<NodeRecord> records;
-  reserve_prefaulted(records, order.size());  // core/prefault.hpp: constructed on this thread
-  records.resize(order.size());
+  resize_prefaulted(records, order.size());  // core/prefault.hpp: constructed on this thread
   tbb::parallel_for(size_t(0), order.size(), [&](size_t id) {
     NodeRecord& n = records[id];
     if (order[id].mesh == kNone) {

@@ -49,4 +49,12 @@ void reserve_prefaulted(std::vector<T>& v, size_t n) {
   prefault(v.data(), n * sizeof(T));
 }
 
+// reserve_prefaulted, then v.resize(n, value): an array of n values, filled on this thread into present
+// pages. For an empty `v`.
+template <class T>
+void resize_prefaulted(std::vector<T>& v, size_t n, const T& value = T()) {
+  reserve_prefaulted(v, n);
+  v.resize(n, value);
+}
+
 }  // namespace lodstream

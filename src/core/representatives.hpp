@@ -33,12 +33,10 @@ std::vector<uint32_t> representatives(size_t n, const Hash& hash, const Equal& e
     return bucket_bits == 0 ? size_t(0) : size_t(hash(i) >> (64 - bucket_bits));
   };
   std::vector<uint32_t> order, bucket_begin, rep;
-  reserve_prefaulted(order, n), reserve_prefaulted(rep, n);  // written on every core, zero-filled on one
-  order.resize(n);
+  resize_prefaulted(order, n), resize_prefaulted(rep, n);  // written on every core, zero-filled on one
   counting_sort(
       n, uint32_t(buckets), bucket_of, [&](size_t i, uint32_t at) { order[at] = uint32_t(i); },
       &bucket_begin);
-  rep.resize(n);
   auto resolve = [&](const tbb::blocked_range<size_t>& r) {
     constexpr uint64_t kEmpty = UINT64_MAX;
     thread_local std::vector<uint64_t> table;

@@ -135,8 +135,7 @@ void build_level0(Builder& b, Mesh mesh) {
   tbb::parallel_invoke(
       [&] { vertex_id = weld_positions(mesh.positions, b.next_position_id); },
       [&] { parts = clusterize(mesh, b.options.max_cluster_vertices, b.options.max_cluster_triangles); });
-  reserve_prefaulted(b.dag.clusters, parts.size());
-  b.dag.clusters.resize(parts.size());
+  resize_prefaulted(b.dag.clusters, parts.size());
   b.position_ids.resize(parts.size());
   tbb::parallel_for(size_t(0), parts.size(), [&](size_t c) {
     DagCluster& cluster = b.dag.clusters[c];

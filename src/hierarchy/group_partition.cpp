@@ -40,8 +40,7 @@ void sort_edges(std::vector<ClusterEdge>& edges, uint32_t ids) {
   const int digit_bits = std::clamp(int(std::bit_width(edges.size())) - 2, 8, 16);
   const uint32_t digit_mask = (1u << digit_bits) - 1;
   std::vector<ClusterEdge> scratch;
-  reserve_prefaulted(scratch, edges.size());  // core/prefault.hpp: zero-filled here, on one core
-  scratch.resize(edges.size());
+  resize_prefaulted(scratch, edges.size());  // core/prefault.hpp: zero-filled here, on one core
   std::vector<uint32_t> start(size_t(digit_mask) + 2);
   for (int shift = 0; shift < bits; shift += digit_bits) {
     auto digit = [&](const ClusterEdge& e) { return uint32_t(rank(e.first) >> shift) & digit_mask; };

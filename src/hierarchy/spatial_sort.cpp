@@ -62,8 +62,7 @@ std::vector<uint32_t> spatial_sort_triangles(std::span<const glm::vec3> position
   // The large arrays zero-filled on the calling thread are prefaulted on every core first (core/prefault.hpp;
   // elephant_5m's level 0: 136 MB, cleared by the kernel on one core while the other waited).
   std::vector<uint32_t> sorted;
-  reserve_prefaulted(sorted, n * 3);
-  sorted.resize(n * 3);
+  resize_prefaulted(sorted, n * 3);
   if (n == 0) return sorted;
   // Centroids, with the same operations in the same order as meshoptimizer, and their bounding box.
   auto centroid = std::make_unique_for_overwrite<glm::vec3[]>(n);  // every entry written below
@@ -110,8 +109,7 @@ std::vector<uint32_t> spatial_sort_triangles(std::span<const glm::vec3> position
     constexpr int kRunBits = 10;
     constexpr size_t kRuns = size_t(1) << kRunBits;
     std::vector<uint32_t> code;
-    reserve_prefaulted(code, n), reserve_prefaulted(order, n);
-    code.resize(n);
+    resize_prefaulted(code, n), reserve_prefaulted(order, n);
     tbb::parallel_for(size_t(0), n, [&](size_t t) { code[t] = code_of(t); });
     centroid.reset();
     std::vector<uint32_t> run_begin;

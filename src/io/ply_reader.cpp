@@ -267,14 +267,10 @@ struct MeshBuilder {
         normals(l.has[NX] && l.has[NY] && l.has[NZ]),
         uvs(l.has[U] && l.has[V]),
         colors(l.has[R] && l.has[G] && l.has[B]) {
-    auto allocate = [n](auto& array) {  // pages faulted in on every core (core/prefault.hpp)
-      reserve_prefaulted(array, n);
-      array.resize(n);
-    };
-    allocate(mesh.positions);
-    if (normals) allocate(mesh.normals);
-    if (uvs) allocate(mesh.uvs);
-    if (colors) allocate(mesh.colors);
+    resize_prefaulted(mesh.positions, n);  // pages faulted in on every core (core/prefault.hpp)
+    if (normals) resize_prefaulted(mesh.normals, n);
+    if (uvs) resize_prefaulted(mesh.uvs, n);
+    if (colors) resize_prefaulted(mesh.colors, n);
   }
   void set(size_t i, const double* v) {
     mesh.positions[i] = glm::vec3(v[X], v[Y], v[Z]);

@@ -45,8 +45,7 @@ ValidationCounts validate_mesh(Mesh& mesh, const std::string& what) {
   // order afterwards; the error names the first bad triangle, as a serial scan would.
   const size_t nt = mesh.indices.size() / 3;
   std::vector<uint8_t> keep;
-  reserve_prefaulted(keep, nt);  // core/prefault.hpp
-  keep.resize(nt);
+  resize_prefaulted(keep, nt);  // core/prefault.hpp
   std::atomic<size_t> first_bad{nt};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nt, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t t = r.begin(); t < r.end(); ++t) {

@@ -86,8 +86,7 @@ void compact(Mesh& mesh, const std::vector<uint32_t>& keep) {
   auto pick = [&keep](auto& array) {
     if (array.empty()) return;
     std::remove_reference_t<decltype(array)> out;
-    reserve_prefaulted(out, keep.size());
-    out.resize(keep.size());
+    resize_prefaulted(out, keep.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, keep.size(), 1 << 14),
                       [&](const tbb::blocked_range<size_t>& r) {
                         for (size_t i = r.begin(); i < r.end(); ++i) out[i] = array[keep[i]];
@@ -105,8 +104,7 @@ void weld_by(Mesh& mesh, const VertexKey& key) {
   std::vector<uint32_t> rep = representatives(key, n);
   // Renumber in order of first use by a triangle, which also drops unreferenced vertices.
   std::vector<uint32_t> new_index, keep;
-  reserve_prefaulted(new_index, n);
-  new_index.assign(n, kNone);
+  resize_prefaulted(new_index, n, kNone);
   reserve_prefaulted(keep, n);
   for (uint32_t& i : mesh.indices) {
     uint32_t r = rep[i];
@@ -169,14 +167,12 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
   const int slice_bits = std::max(0, int(std::bit_width(nv)) - 11);
   const size_t slices = ((nv - 1) >> slice_bits) + 1;
   std::vector<uint32_t> corners, slice_begin;
-  reserve_prefaulted(corners, nc);
-  corners.resize(nc);
+  resize_prefaulted(corners, nc);
   counting_sort(
       nc, uint32_t(slices), [&](size_t c) { return uint32_t(position[mesh.indices[c]] >> slice_bits); },
       [&](size_t c, uint32_t at) { corners[at] = uint32_t(c); }, &slice_begin);
   std::vector<uint32_t> start;
-  reserve_prefaulted(start, nv + 1);
-  start.assign(nv + 1, 0);
+  resize_prefaulted(start, nv + 1);
   tbb::parallel_for(size_t(0), slices, [&](size_t s) {
     const size_t lo = s << slice_bits, hi = std::min(nv, (s + 1) << slice_bits);
     thread_local std::vector<uint32_t> slice;
@@ -294,8 +290,7 @@ void weld_with_crease_normals(Mesh& mesh, float crease_angle_degrees) {
     first_output[r + 1] = first_output[r] + uint32_t(runs[r].keep.size());
   std::vector<uint32_t> keep;
   std::vector<glm::vec3> normals;
-  reserve_prefaulted(keep, first_output.back()), reserve_prefaulted(normals, first_output.back());
-  keep.resize(first_output.back()), normals.resize(first_output.back());
+  resize_prefaulted(keep, first_output.back()), resize_prefaulted(normals, first_output.back());
   tbb::parallel_for(size_t(0), runs.size(), [&](size_t r) {
     const uint32_t shift = first_output[r];
     for (uint32_t k = start[r * kRunPositions]; k < start[std::min(nv, (r + 1) * kRunPositions)]; ++k)

@@ -144,6 +144,10 @@ TEST(Prefault, KeepsContentsAndLeavesReservedStorageUsable) {
   EXPECT_GE(v.capacity(), 5'000'000u);
   v.assign(5'000'000, 7u);
   EXPECT_EQ(std::count(v.begin(), v.end(), 7u), 5'000'000);
+  std::vector<uint64_t> w;  // resize_prefaulted: sized and filled with the value
+  resize_prefaulted(w, 3'000'000, uint64_t(9));
+  ASSERT_EQ(w.size(), 3'000'000u);
+  EXPECT_EQ(std::count(w.begin(), w.end(), uint64_t(9)), 3'000'000);
   std::vector<uint8_t> small;  // under kPrefaultMinBytes: a plain reserve
   reserve_prefaulted(small, 100);
   EXPECT_GE(small.capacity(), 100u);
