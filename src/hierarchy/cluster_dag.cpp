@@ -26,19 +26,24 @@ struct Builder {
   const DagOptions& options;
   ClusterDag dag{};
   std::vector<std::vector<uint32_t>> position_ids{};  // by cluster
-  std::vector<uint8_t> open_boundary{};               // by position id (ids of the input mesh)
   uint32_t next_position_id = 0;
   // The input and its level-0 clusters' vertices until their vertex data is copied (beside level 1's
   // grouping, which needs only the clusters' indices, position ids and spheres).
   Mesh input{};
   std::vector<ClusterPart> input_parts{};
-  // Per level, reused (fresh pages cost 4 s/GB to touch): the active clusters' boundary edges, and by
-  // position id the group holding it (UINT32_MAX) and whether clusters of two groups hold it (0), both
-  // reset to those values after each level.
+  // The active clusters' boundary edges, per level, reused (fresh pages cost 4 s/GB to touch).
   std::vector<ClusterEdge> edges{};
-  std::vector<uint32_t> owner{};
-  std::vector<uint8_t> border{};
+  // By position id, one word: kOpenBoundary when it lies on the mesh's open boundary (set at level 1), and
+  // below that bit its claim (claim_base + the group that claimed it first this level, or the level's border
+  // mark claim_base + groups when a second group claimed it). A claim below claim_base is an earlier level's
+  // and counts as none, so nothing is reset between levels. One word read per group vertex: the open
+  // boundary and the borders in two arrays of bytes beside the claims were two cache misses, and resetting
+  // the claims and borders a second random pass over every active position each level.
+  std::vector<uint32_t> claims{};
+  uint32_t claim_base = 1;  // 0, a fresh entry's claim, is below it
 };
+
+constexpr uint32_t kOpenBoundary = 0x80000000u;
 
 // Positions a group simplification creates get ids kNewId | k while groups run in parallel; the ids are made
 // final (next_position_id onwards, in group order) once the level's groups are done, so that ids, and with
@@ -163,15 +168,15 @@ void copy_level0_vertices(Builder& b) {
   b.input_parts = {};
 }
 
-// Marks the positions of edges that no other cluster shares (the mesh's open boundary); `edges` sorted.
+// Marks the positions of edges that no other cluster shares (the mesh's open boundary) in b.claims (sized to
+// every id); `edges` sorted.
 void mark_open_boundary(Builder& b, std::span<const ClusterEdge> edges) {
-  b.open_boundary.assign(b.next_position_id, 0);
   for (size_t i = 0; i < edges.size();) {
     size_t j = i;
     while (j < edges.size() && edges[j].first == edges[i].first) ++j;
     if (j - i == 1) {
-      b.open_boundary[uint32_t(edges[i].first >> 32)] = 1;
-      b.open_boundary[uint32_t(edges[i].first)] = 1;
+      b.claims[uint32_t(edges[i].first >> 32)] |= kOpenBoundary;
+      b.claims[uint32_t(edges[i].first)] |= kOpenBoundary;
     }
     i = j;
   }
@@ -193,10 +198,12 @@ struct GroupResult {
 };
 
 // Merges, simplifies with the border locked and re-splits one group (formula of error_g in the header); once
-// accepted, flags the locked positions of its input clusters.
-GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
-                           const std::vector<uint8_t>& border, uint32_t level) {
+// accepted, flags the locked positions of its input clusters. `border_mark`: the level's claim of positions
+// held by several groups (Builder::claims).
+GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members, uint32_t border_mark,
+                           uint32_t level) {
   const DagOptions& o = b.options;
+  const uint32_t open_lock = o.lock_open_boundary ? kOpenBoundary : 0;
   GroupResult out;
   Mesh merged;
   std::vector<uint32_t> merged_ids;
@@ -231,8 +238,8 @@ GroupResult simplify_group(Builder& b, const std::vector<uint32_t>& members,
     }
     for (uint32_t id : b.position_ids[c]) {
       merged_ids.push_back(id);
-      so.locked.push_back(border[id] ||
-                          (o.lock_open_boundary && id < b.open_boundary.size() && b.open_boundary[id]));
+      const uint32_t claim = b.claims[id];
+      so.locked.push_back((claim & ~kOpenBoundary) == border_mark || (claim & open_lock) != 0);
     }
   }
   floor_radii(so.vertex_error);
@@ -399,6 +406,14 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
     // the level-0 clusters' vertex data is copied (level 1) and the groups whose inputs became final are
     // handed over.
     std::vector<std::vector<uint32_t>> groups;
+    std::vector<uint32_t>& claims = b.claims;
+    if (claims.size() < b.next_position_id) {
+      if (claims.capacity() < b.next_position_id) {  // ids grow by about half the active positions a level
+        claims.reserve(b.next_position_id * 3 / 2);
+        prefault(claims.data(), claims.capacity() * sizeof(uint32_t));  // filled on this thread below
+      }
+      claims.resize(b.next_position_id, 0);
+    }
     tbb::parallel_invoke(
         [&] {
           sort_edges(edges, b.next_position_id);
@@ -414,43 +429,34 @@ ClusterDag build_cluster_dag(Mesh mesh, const DagOptions& options) {
     for (auto& g : groups)
       for (uint32_t& i : g) i = active[i];  // active position -> cluster id
 
-    // Group borders: positions used by clusters of more than one group.
-    std::vector<uint32_t>& owner = b.owner;
-    std::vector<uint8_t>& border = b.border;
-    if (owner.size() < b.next_position_id) {
-      if (owner.capacity() < b.next_position_id) {  // ids grow by about half the active positions a level
-        owner.reserve(b.next_position_id * 3 / 2), border.reserve(b.next_position_id * 3 / 2);
-        prefault(owner.data(), owner.capacity() * sizeof(uint32_t));  // filled on this thread below
-      }
-      owner.resize(b.next_position_id, UINT32_MAX), border.resize(b.next_position_id, 0);
-    }
-    // Groups on every core (these scattered reads of every active position, on one core, left the other
-    // idle): the first group to claim a position owns it, and a claim by any other marks it a border, so
-    // the borders do not depend on the order of the claims.
+    // Group borders: positions used by clusters of more than one group. Groups on every core (these
+    // scattered reads of every active position, on one core, left the other idle): the first group to claim
+    // a position owns it, and a claim by any other marks it a border, so the borders do not depend on the
+    // order of the claims.
+    const uint32_t base = b.claim_base, border_mark = base + uint32_t(groups.size());
+    if (uint64_t(border_mark) >= kOpenBoundary) throw Error("cluster DAG: more than 2^31 group claims");
     tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
+      const uint32_t mine = base + uint32_t(g);
       for (uint32_t c : groups[g])
         for (uint32_t id : b.position_ids[c]) {
-          std::atomic_ref<uint32_t> own(owner[id]);
-          uint32_t claimed = own.load(std::memory_order_relaxed);
-          if (claimed == UINT32_MAX &&
-              own.compare_exchange_strong(claimed, uint32_t(g), std::memory_order_relaxed))
-            continue;
-          if (claimed != g) std::atomic_ref<uint8_t>(border[id]).store(1, std::memory_order_relaxed);
+          std::atomic_ref<uint32_t> claim(claims[id]);
+          uint32_t seen = claim.load(std::memory_order_relaxed);
+          while (
+              (seen & ~kOpenBoundary) < base &&
+              !claim.compare_exchange_weak(seen, (seen & kOpenBoundary) | mine, std::memory_order_relaxed)) {
+          }
+          const uint32_t owner = seen & ~kOpenBoundary;  // before this claim
+          if (owner >= base && owner != mine && owner != border_mark)
+            claim.store((seen & kOpenBoundary) | border_mark, std::memory_order_relaxed);
         }
     });
+    b.claim_base = border_mark + 1;
 
     std::vector<GroupResult> results(groups.size());
     tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
       // A group of one cluster at a level with several groups cannot change its (locked) border: skip it.
       if (groups[g].size() > 1 || groups.size() == 1)
-        results[g] = simplify_group(b, groups[g], border, level);
-    });
-    tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
-      for (uint32_t c : groups[g])
-        for (uint32_t id : b.position_ids[c]) {
-          std::atomic_ref<uint32_t>(owner[id]).store(UINT32_MAX, std::memory_order_relaxed);
-          std::atomic_ref<uint8_t>(border[id]).store(0, std::memory_order_relaxed);
-        }
+        results[g] = simplify_group(b, groups[g], border_mark, level);
     });
 
     std::vector<uint32_t> next, completed_groups;
