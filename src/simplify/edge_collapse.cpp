@@ -330,6 +330,12 @@ class Simplifier {
   size_t alive_triangles_ = 0, welded_triangles_ = 0;  // welded_: before the first collapse
   std::vector<uint32_t> offsets_, faces_;              // vertex -> faces (CSR), rebuilt each pass
   UninitializedVector<Slot> slots_;
+  // On a small mesh (small_), beside each slot: where its candidate's collapse puts the kept end (Plan::x),
+  // as `place` found it with the cost. The candidate's ends are untouched when it is tried (plan_listed), so
+  // `place` would find the same again: the try reads it instead (a bake's DAG groups, elephant_1m
+  // callgrind: the tries' place 367.8 M instructions, see try_collapse). 24 bytes per corner, so a large
+  // mesh (elephant_1m 0.1: 205 MB) places again.
+  UninitializedVector<glm::dvec3> placed_;
   // Uninitialized: the first pass's resizes (elephant_1m 0.1: 894,508 candidates, 7 MB each) were a serial
   // zero fill and the arrays' first touch, 16-25 ms of CPU each with the other core idle (temporary timers,
   // load 6); now their pages are first touched by the parallel writes of gather_candidates and
@@ -529,18 +535,20 @@ class Simplifier {
 
   // Drops dead faces; their corners' cached candidates move with them.
   void compact_faces() {
-    const bool cached = slots_.size() == indices_.size();
+    const bool cached = slots_.size() == indices_.size(), placed = cached && small_;
     size_t w = 0;
     for (size_t f = 0; f < indices_.size(); f += 3)
       if (indices_[f] != kNone) {
         for (size_t k = 0; k < 3; ++k) {
           indices_[w + k] = indices_[f + k];
           if (cached) slots_[w + k] = slots_[f + k];
+          if (placed) placed_[w + k] = placed_[f + k];
         }
         w += 3;
       }
     indices_.resize(w);
     if (cached) slots_.resize(w);
+    if (placed) placed_.resize(w);
   }
 
   // Vertex -> faces (offsets_, faces_), each vertex's faces in increasing order, as one loop over the
@@ -989,8 +997,8 @@ class Simplifier {
       r.eliminate(sums, ww);
     }
     const glm::dvec3 pa = glm::dvec3(pos_[p.a]) - o, pb = glm::dvec3(pos_[p.b]) - o;
-    const uint8_t ka = kind_[p.a], kb = kind_[p.b];
-    p.move = !opt_.half_edge && ka == kb && ka != kLocked;
+    const uint8_t ka = kind_[p.a];
+    p.move = moves(p);
     // Q(x), kept from the choice of x where it was evaluated there (the same call on the same point).
     double q_x;
     if (!p.move) {
@@ -1039,18 +1047,24 @@ class Simplifier {
     }
   }
 
-  // The cheaper allowed direction of edge (i, j), as a candidate; cost = +inf when neither is allowed.
-  Candidate evaluate(uint32_t i, uint32_t j) const {
+  // Whether a planned collapse moves b to an optimal x (else x = b): both ends of one kind that may move.
+  bool moves(const Plan& p) const {
+    return !opt_.half_edge && kind_[p.a] == kind_[p.b] && kind_[p.a] != kLocked;
+  }
+
+  // The cheaper allowed direction of edge (i, j), as a candidate, and its placement in `x`; cost = +inf
+  // when neither is allowed.
+  Candidate evaluate(uint32_t i, uint32_t j, glm::dvec3& x) const {
     Candidate best{std::numeric_limits<float>::infinity(), kNone, kNone};
     Plan p;
     if (can_remove(i, j, p)) {
       place(p);
-      best = {float(p.cost), i, j};
+      best = {float(p.cost), i, j}, x = p.x;
       if (p.move) return best;  // symmetric: the other direction is the same collapse
     }
     if (can_remove(j, i, p)) {
       place(p);
-      if (float(p.cost) < best.cost) best = {float(p.cost), j, i};
+      if (float(p.cost) < best.cost) best = {float(p.cost), j, i}, x = p.x;
     }
     return best;
   }
@@ -1074,6 +1088,7 @@ class Simplifier {
   size_t run_pass(size_t target) {
     const bool all = slots_.size() != indices_.size();
     if (all) slots_.clear(), slots_.resize(indices_.size());  // every slot is written below
+    if (all && small_) placed_.clear(), placed_.resize(indices_.size());
     const uint32_t faces = uint32_t(indices_.size() / 3);
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, faces, 2048), [&](const auto& r) {
       for (uint32_t f = r.begin(); f < r.end(); ++f) {
@@ -1085,8 +1100,10 @@ class Simplifier {
           if (i > j && (kind_[i] == kManifold || has_edge(j, i))) {
             slot = Slot::none();
           } else {
-            const Candidate c = evaluate(i, j);
+            glm::dvec3 x(0.0);
+            const Candidate c = evaluate(i, j, x);
             slot = Slot::make(c.cost, c.a == j);
+            if (small_) placed_[3 * size_t(f) + k] = x;
           }
         }
       }
@@ -1577,7 +1594,10 @@ class Simplifier {
     for (uint32_t c : s.apex)
       if (!has(s.na, c) && !has(s.nb, c)) return rejected_slot(p, s);
 
-    place(p);
+    if (small_)
+      p.x = placed_[p.slot], p.move = moves(p);  // as placed with the cost (placed_)
+    else
+      place(p);
     const glm::vec3 x(p.x);  // as stored: the bounds use the rounded position
     const double da = glm::length(glm::dvec3(pos_[p.a]) - glm::dvec3(x));
     const double db = glm::length(glm::dvec3(pos_[p.b]) - glm::dvec3(x));
