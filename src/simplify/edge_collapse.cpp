@@ -535,20 +535,18 @@ class Simplifier {
 
   // Drops dead faces; their corners' cached candidates move with them.
   void compact_faces() {
-    const bool cached = slots_.size() == indices_.size(), placed = cached && small_;
-    size_t w = 0;
-    for (size_t f = 0; f < indices_.size(); f += 3)
-      if (indices_[f] != kNone) {
-        for (size_t k = 0; k < 3; ++k) {
-          indices_[w + k] = indices_[f + k];
-          if (cached) slots_[w + k] = slots_[f + k];
-          if (placed) placed_[w + k] = placed_[f + k];
-        }
-        w += 3;
-      }
-    indices_.resize(w);
-    if (cached) slots_.resize(w);
-    if (placed) placed_.resize(w);
+    auto keep_alive = [&](auto& values) {  // values per corner: those of the alive faces
+      size_t w = 0;
+      for (size_t f = 0; f < indices_.size(); f += 3)
+        if (indices_[f] != kNone)
+          values[w] = values[f], values[w + 1] = values[f + 1], values[w + 2] = values[f + 2], w += 3;
+      values.resize(w);
+    };
+    if (slots_.size() == indices_.size()) {
+      keep_alive(slots_);
+      if (small_) keep_alive(placed_);
+    }
+    keep_alive(indices_);  // last: the others read from it which faces are alive
   }
 
   // Vertex -> faces (offsets_, faces_), each vertex's faces in increasing order, as one loop over the

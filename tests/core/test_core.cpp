@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "core/image.hpp"
 #include "core/prefault.hpp"
+#include "core/representatives.hpp"
 #include "core/scene.hpp"
 #include "support/run.hpp"
 #include "support/shapes.hpp"
@@ -151,4 +152,22 @@ TEST(Prefault, KeepsContentsAndLeavesReservedStorageUsable) {
   std::vector<uint8_t> small;  // under kPrefaultMinBytes: a plain reserve
   reserve_prefaulted(small, 100);
   EXPECT_GE(small.capacity(), 100u);
+}
+
+TEST(Representatives, SmallestEqualItemInOneBucketAndInMany) {
+  // Items equal when their values agree; a hash that collides across classes too (its low 32 bits), so the
+  // equality decides. 500 items are one bucket (resolved in input order, without the sort), 50,000 many.
+  for (const size_t n : {size_t(0), size_t(1), size_t(500), size_t(1023), size_t(50'000)}) {
+    std::vector<uint32_t> value(n);
+    for (size_t i = 0; i < n; ++i) value[i] = uint32_t((i * 2654435761u) % 97);
+    const std::vector<uint32_t> rep = representatives(
+        n, [&](size_t i) { return uint64_t(value[i] % 13) * 0x9E3779B97F4A7C15ull; },
+        [&](uint32_t a, uint32_t b) { return value[a] == value[b]; });
+    ASSERT_EQ(rep.size(), n);
+    std::vector<uint32_t> first(97, UINT32_MAX);
+    for (size_t i = 0; i < n; ++i) {
+      if (first[value[i]] == UINT32_MAX) first[value[i]] = uint32_t(i);
+      ASSERT_EQ(rep[i], first[value[i]]) << "n " << n << ", item " << i;
+    }
+  }
 }
