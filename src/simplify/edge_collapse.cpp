@@ -534,21 +534,24 @@ class Simplifier {
     rename(wedge_), rename(pid_), rename(weld_remap_);
   }
 
-  // Drops dead faces; their corners' cached candidates (and placements) move with them, each array in a loop
-  // of its own (one loop moving all three: a refined_elephant bake +1.4 M instructions, callgrind).
+  // Drops dead faces; their corners' cached candidates (and placements) move with them, in one loop without
+  // a test per array (a loop per array: elephant_1m bake +130 M instructions, callgrind).
   void compact_faces() {
-    auto keep_alive = [&](auto& values) {  // values per corner: those of the alive faces
+    auto keep_alive = [&](auto&... values) {  // arrays per corner (indices_ last): the alive faces' entries
       size_t w = 0;
       for (size_t f = 0; f < indices_.size(); f += 3)
-        if (indices_[f] != kNone)
-          values[w] = values[f], values[w + 1] = values[f + 1], values[w + 2] = values[f + 2], w += 3;
-      values.resize(w);
+        if (indices_[f] != kNone) {
+          ((values[w] = values[f], values[w + 1] = values[f + 1], values[w + 2] = values[f + 2]), ...);
+          w += 3;
+        }
+      (values.resize(w), ...);
     };
-    if (slots_.size() == indices_.size()) {
-      keep_alive(slots_);
-      if (small_) keep_alive(placed_);
-    }
-    keep_alive(indices_);  // last: the others read from it which faces are alive
+    if (slots_.size() != indices_.size())
+      keep_alive(indices_);
+    else if (small_)
+      keep_alive(placed_, slots_, indices_);
+    else
+      keep_alive(slots_, indices_);
   }
 
   // Vertex -> faces (offsets_, faces_), each vertex's faces in increasing order, as one loop over the
