@@ -334,7 +334,7 @@ class Simplifier {
   // as `place` found it with the cost. The candidate's ends are untouched when it is tried (plan_listed), so
   // `place` would find the same again: the try reads it instead (a bake's DAG groups; elephant_1m bake,
   // callgrind: place_with 3,532.7 -> 3,125.2 M instructions, the stores and copies (run_pass,
-  // compact_faces) about +190 M). 24 bytes per corner, so a large mesh (elephant_1m 0.1: 205 MB) places
+  // compact_faces) about +110 M). 24 bytes per corner, so a large mesh (elephant_1m 0.1: 205 MB) places
   // again.
   UninitializedVector<glm::dvec3> placed_;
   // Uninitialized: the first pass's resizes (elephant_1m 0.1: 894,508 candidates, 7 MB each) were a serial
