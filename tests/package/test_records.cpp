@@ -171,15 +171,19 @@ DecodedNode reference_cluster(const DecodedNode& record, uint32_t cluster) {
   return out;
 }
 
-void expect_same_cluster(const DecodedNode& d, const DecodedNode& expected, uint32_t c) {
-  EXPECT_EQ(d.mesh.indices, expected.mesh.indices) << c;
-  EXPECT_EQ(d.mesh.positions, expected.mesh.positions) << c;
-  EXPECT_EQ(d.mesh.normals, expected.mesh.normals) << c;
-  EXPECT_EQ(d.mesh.uvs, expected.mesh.uvs) << c;
-  EXPECT_EQ(d.mesh.colors, expected.mesh.colors) << c;
-  EXPECT_EQ(d.vertex_data, expected.vertex_data) << c;
-  EXPECT_EQ(d.index_end, expected.index_end) << c;
-  EXPECT_EQ(d.mesh.material, expected.mesh.material) << c;
+// Every field of `d` equals `expected`'s (`what` names the node in a failure).
+void expect_same_node(const DecodedNode& d, const DecodedNode& expected, uint32_t what) {
+  EXPECT_EQ(d.mesh.indices, expected.mesh.indices) << what;
+  EXPECT_EQ(d.mesh.positions, expected.mesh.positions) << what;
+  EXPECT_EQ(d.mesh.normals, expected.mesh.normals) << what;
+  EXPECT_EQ(d.mesh.uvs, expected.mesh.uvs) << what;
+  EXPECT_EQ(d.mesh.colors, expected.mesh.colors) << what;
+  EXPECT_EQ(d.mesh.material, expected.mesh.material) << what;
+  EXPECT_EQ(d.vertex_data, expected.vertex_data) << what;
+  EXPECT_EQ(d.extra, expected.extra) << what;
+  EXPECT_EQ(d.cluster_triangles, expected.cluster_triangles) << what;
+  EXPECT_EQ(d.first_vertex, expected.first_vertex) << what;
+  EXPECT_EQ(d.index_end, expected.index_end) << what;
 }
 
 // extract_cluster numbers a cluster's vertices in order of first use and keeps its triangles' order, on
@@ -192,7 +196,7 @@ TEST(Records, ExtractionNumbersVerticesInFirstUseOrder) {
   DecodedNode into;
   for (uint32_t c = 0; c < record_clusters(decoded); ++c) {
     extract_cluster(decoded, c, "record", into);
-    expect_same_cluster(into, reference_cluster(decoded, c), c);
+    expect_same_node(into, reference_cluster(decoded, c), c);
   }
   std::mt19937 rng(11);
   for (int trial = 0; trial < 40; ++trial) {
@@ -218,7 +222,7 @@ TEST(Records, ExtractionNumbersVerticesInFirstUseOrder) {
     std::shuffle(order.begin(), order.end(), rng);
     for (uint32_t c : order) {
       extract_cluster(record, c, "random", into);
-      expect_same_cluster(into, reference_cluster(record, c), c);
+      expect_same_node(into, reference_cluster(record, c), c);
     }
   }
 }
@@ -389,17 +393,7 @@ TEST(Records, DecodingIntoOneNodeReusesItsBuffers) {
     reader.decode_node(id, reader.read_page(reader.node(id).page), into);
     const DecodedNode d = alone.load_node(id);
     in_records += reader.node(id).cluster > 0;
-    EXPECT_EQ(into.mesh.indices, d.mesh.indices) << id;
-    EXPECT_EQ(into.mesh.positions, d.mesh.positions) << id;
-    EXPECT_EQ(into.mesh.normals, d.mesh.normals) << id;
-    EXPECT_EQ(into.mesh.uvs, d.mesh.uvs) << id;
-    EXPECT_EQ(into.mesh.colors, d.mesh.colors) << id;
-    EXPECT_EQ(into.mesh.material, d.mesh.material) << id;
-    EXPECT_EQ(into.vertex_data, d.vertex_data) << id;
-    EXPECT_EQ(into.extra, d.extra) << id;
-    EXPECT_EQ(into.cluster_triangles, d.cluster_triangles) << id;
-    EXPECT_EQ(into.first_vertex, d.first_vertex) << id;
-    EXPECT_EQ(into.index_end, d.index_end) << id;
+    expect_same_node(into, d, id);
     EXPECT_EQ(into.mesh.indices.data(), indices) << id;
     EXPECT_EQ(into.mesh.positions.data(), positions) << id;
   }
