@@ -40,8 +40,8 @@ void resize_for_overwrite(std::vector<T>& v, size_t n, const T* junk) {
 // 149.8 M). With `wide` (every entry of `order` below in's last vertex), a vertex a 16-byte load and store
 // each: lanes 0-2 are its x y z, lane 3 the next vertex's x, stored into the next place (the arrays' spare
 // entry for the last, dropped after), which the next vertex overwrites: ~11 instructions a vertex with the
-// reset (`bench decode --runs 1` under callgrind, elephant_1m: 17.6 M for 1.59 M vertices). Cost:
-// O(order.size()).
+// reset (`bench decode --runs 1` under callgrind, elephant_1m: 17.6 M for 1.59 M vertices); two vertices a
+// step, ~9 (motorBike: extract_cluster 21.12 -> 20.42 M, with its callees). Cost: O(order.size()).
 void gather_positions_normals(const Mesh& in, std::span<const uint32_t> order, bool wide, uint32_t* map,
                               Mesh& m) {
   const size_t n = order.size() + (wide ? 1 : 0);  // wide: n <= in's vertices, as `order` leaves one out
@@ -55,6 +55,7 @@ void gather_positions_normals(const Mesh& in, std::span<const uint32_t> order, b
   const glm::vec3 *p = in.positions.data(), *q = in.normals.data();
   glm::vec3 *to_p = m.positions.data(), *to_q = m.normals.data();
   if (wide) {
+#pragma GCC unroll 2
     for (size_t k = 0; k < order.size(); ++k) {
       const uint32_t v = order[k];
       std::memcpy(to_p + k, p + v, 16);
@@ -173,27 +174,45 @@ void extract_cluster(const DecodedNode& record, uint32_t cluster, const std::str
   uint32_t* const map = compact.data();
   uint32_t* const first_use = used.data();
   size_t n = 0;
-  // Without a branch (which mispredicted at about every first use, a fifth of the corners): first_use[n] is
-  // written every time and kept only when v is new. A triangle a step, the count in 64 bits (no zero
-  // extension before it indexes): ~15 -> ~12.5 instructions a corner; the loop by pointer, one counter a
-  // triangle fewer (`bench decode --runs 1` under callgrind, decode_node: refined_elephant 44.32 -> 44.18 M,
-  // elephant_1m 668.4 -> 666.0 M). first_use written before the look-up: GCC 12 then keeps no copy of v, 11
-  // -> 10 instructions a corner (elephant_1m: extract_cluster 113.5 -> 106.4 M). Tried: the number as
-  // min(seen, n) and n += (seen > n) (a compare, cmov and adc), as few instructions, but n's chain through
-  // the compare and the adc is two cycles a corner where n += seen >> 31 is one: the extraction alone took
-  // 1.3-1.8 % longer than this form (two runs of 12 interleaved pairs, 20 passes over elephant_1m's records
-  // each, thread CPU time).
+  const uint32_t V = uint32_t(in.positions.size());
+  // The last corner of each triangle without a branch (which mispredicted at about every first use, a
+  // fifth of the corners): first_use[n] is written every time and kept only when v is new. A triangle a
+  // step, the count in 64 bits (no zero extension before it indexes): ~15 -> ~12.5 instructions a corner; the
+  // loop by pointer, one counter a triangle fewer (`bench decode --runs 1` under callgrind, decode_node:
+  // refined_elephant 44.32 -> 44.18 M, elephant_1m 668.4 -> 666.0 M). first_use written before the look-up:
+  // GCC 12 then keeps no copy of v, 11 -> 10 instructions a corner (elephant_1m: extract_cluster 113.5 ->
+  // 106.4 M). A new vertex told by a compare with V (GCC 12: cmp, cmov, sbb; seen >> 31 took a copy and a
+  // shift for the compare): 10 -> 9 (motorBike: extract_cluster 23.66 -> 21.12 M, with its callees).
+  // Tried: the number as min(seen, n) and n += (seen > n) (a compare, cmov and adc), as few instructions, but
+  // n's chain through the compare and the adc is two cycles a corner where this one's is one: the extraction
+  // alone took 1.3-1.8 % longer (two runs of 12 interleaved pairs, 20 passes over elephant_1m's records
+  // each, thread CPU time). A byte a vertex marking its first use, so that the compare does not wait on the
+  // map's store of n: 1.22x the time (motorBike and refined_elephant, the same kind of pairs).
   auto renumber = [&](uint32_t v) {
     first_use[n] = v;
-    const size_t seen = map[v];
-    const size_t fresh = seen >> 31;  // 1 for UINT32_MAX (not used yet): cluster vertices are below 2^31
-    const uint32_t c = uint32_t(fresh ? n : seen);
+    const uint32_t seen = map[v];
+    const bool fresh = seen >= V;  // UINT32_MAX (not used yet): cluster vertices are below V
+    const uint32_t c = fresh ? uint32_t(n) : seen;
     map[v] = c, n += fresh;
     return c;
   };
+  // The first two corners looked up first: in a decoded record a triangle rarely meets a vertex new to its
+  // cluster there (the traversal's kVertex triangle is (b, a, c) with c new: 5 % of the triangles at corner
+  // 0 and 5 % at corner 1, 60 % at corner 2, on motorBike, refined_elephant and elephant_1m), so one branch
+  // a triangle, taken by 7-8 % of them, leaves both as they are, without the stores of a first use, and only
+  // the last corner is renumbered. Two triangles a step. `bench decode --runs 1` under callgrind,
+  // extract_cluster with its callees: motorBike 20.42 -> 17.94 M instructions (~9.7 -> ~8.1 a corner),
+  // refined_elephant 5.74 -> 5.05 M; the extraction alone 0.92x, 0.82x and 0.86x the time (motorBike,
+  // refined_elephant, elephant_1m: medians of 31-101 interleaved pairs over every record's clusters, thread
+  // CPU time).
   const uint32_t* f = from;
-  for (uint32_t *t = m.indices.data(), *const end = t + 3 * count; t != end; t += 3, f += 3)
-    t[0] = renumber(f[0]), t[1] = renumber(f[1]), t[2] = renumber(f[2]);
+#pragma GCC unroll 2
+  for (uint32_t *t = m.indices.data(), *const end = t + 3 * count; t != end; t += 3, f += 3) {
+    uint32_t c0 = map[f[0]], c1 = map[f[1]];
+    if (int32_t(c0 | c1) < 0) [[unlikely]]  // either UINT32_MAX: new to the cluster
+      c0 = renumber(f[0]), c1 = renumber(f[1]);
+    t[0] = c0, t[1] = c1, t[2] = renumber(f[2]);
+  }
   // Whether the cluster leaves the record's last vertex out: its others are followed by 4 bytes of their
   // arrays (gather_positions_normals' wide form).
   const bool wide = !in.positions.empty() && map[in.positions.size() - 1] == UINT32_MAX;

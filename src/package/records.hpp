@@ -52,8 +52,9 @@ DecodedNode extract_cluster(const DecodedNode& record, uint32_t cluster, const s
 // cost three allocations and frees (indices, positions, normals) and a copy of each gathered array
 // (`bench decode --runs 1` under callgrind, whole program: refined_elephant 89.63 -> 88.76 M instructions,
 // elephant_1m 1,072.7 -> 1,056.3 M). out's arrays are resized without value-initialisation and the indices
-// renumbered straight from the record's: ~10 instructions a corner and ~11 a vertex (extract_cluster under
-// the same callgrind runs: refined_elephant 8.50 -> 6.66 M, elephant_1m 136.1 -> 106.4 M).
+// renumbered straight from the record's: ~8 instructions a corner and ~9 a vertex (extract_cluster under
+// the same callgrind runs: refined_elephant 8.50 -> 6.66 -> 5.05 M, elephant_1m 136.1 -> 106.4 -> 80.4 M,
+// motorBike 23.66 -> 17.94 M; records.cpp tells the steps).
 void extract_cluster(const DecodedNode& record, uint32_t cluster, const std::string& where, DecodedNode& out);
 
 }  // namespace lodstream::package

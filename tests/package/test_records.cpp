@@ -8,6 +8,7 @@
 #include <array>
 #include <cstring>
 #include <map>
+#include <numeric>
 #include <random>
 
 #include "core/error.hpp"
@@ -143,6 +144,86 @@ TEST(Records, ExtractingIntoOneNodeMatchesExtractingAlone) {
       EXPECT_EQ(into.mesh.vertex_count(), r.clusters[c].vertex_count()) << c;
     }
     std::reverse(order.begin(), order.end());
+  }
+}
+
+// Cluster `cluster` of `record` as records.hpp defines it, computed the plain way: its triangles in order,
+// its vertices numbered in order of first use by them, each attribute copied.
+DecodedNode reference_cluster(const DecodedNode& record, uint32_t cluster) {
+  size_t first = 0;
+  for (uint32_t c = 0; c < cluster; ++c) first += record.cluster_triangles[c];
+  const Mesh& in = record.mesh;
+  DecodedNode out;
+  out.mesh.material = in.material;
+  std::map<uint32_t, uint32_t> number;
+  for (size_t i = 3 * first; i < 3 * (first + record.cluster_triangles[cluster]); ++i) {
+    const uint32_t v = in.indices[i];
+    const auto [it, added] = number.emplace(v, uint32_t(number.size()));
+    out.mesh.indices.push_back(it->second);
+    if (!added) continue;
+    out.mesh.positions.push_back(in.positions[v]);
+    if (in.has_normals()) out.mesh.normals.push_back(in.normals[v]);
+    if (in.has_uvs()) out.mesh.uvs.push_back(in.uvs[v]);
+    if (in.has_colors()) out.mesh.colors.push_back(in.colors[v]);
+    if (!record.vertex_data.empty()) out.vertex_data.push_back(record.vertex_data[v]);
+  }
+  out.index_end = uint32_t(number.size());
+  return out;
+}
+
+// Every field of `d` equals `expected`'s (`what` names the node in a failure).
+void expect_same_node(const DecodedNode& d, const DecodedNode& expected, uint32_t what) {
+  EXPECT_EQ(d.mesh.indices, expected.mesh.indices) << what;
+  EXPECT_EQ(d.mesh.positions, expected.mesh.positions) << what;
+  EXPECT_EQ(d.mesh.normals, expected.mesh.normals) << what;
+  EXPECT_EQ(d.mesh.uvs, expected.mesh.uvs) << what;
+  EXPECT_EQ(d.mesh.colors, expected.mesh.colors) << what;
+  EXPECT_EQ(d.mesh.material, expected.mesh.material) << what;
+  EXPECT_EQ(d.vertex_data, expected.vertex_data) << what;
+  EXPECT_EQ(d.extra, expected.extra) << what;
+  EXPECT_EQ(d.cluster_triangles, expected.cluster_triangles) << what;
+  EXPECT_EQ(d.first_vertex, expected.first_vertex) << what;
+  EXPECT_EQ(d.index_end, expected.index_end) << what;
+}
+
+// extract_cluster numbers a cluster's vertices in order of first use and keeps its triangles' order, on
+// decoded records (most triangles meet at most their last corner first) and on records of random triangles
+// (any corner first met, corners repeated within a triangle, clusters leaving the last vertex out or not,
+// with and without normals and the other attributes), extracted into one node in a mixed order.
+TEST(Records, ExtractionNumbersVerticesInFirstUseOrder) {
+  const Record r = sphere_record(0);
+  const DecodedNode decoded = TraversalCodec().decode(r.bytes, r.grid, "record");
+  DecodedNode into;
+  for (uint32_t c = 0; c < record_clusters(decoded); ++c) {
+    extract_cluster(decoded, c, "record", into);
+    expect_same_node(into, reference_cluster(decoded, c), c);
+  }
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 40; ++trial) {
+    const uint32_t V = 1 + rng() % 40, C = 2 + rng() % 6;
+    DecodedNode record;
+    record.mesh.material = trial % 3;
+    for (uint32_t v = 0; v < V; ++v) {
+      record.mesh.positions.push_back({float(v), float(trial), 1.0f});
+      if (trial % 4 != 1) record.mesh.normals.push_back({0.0f, float(v), 0.5f});
+      if (trial % 2 == 0) record.mesh.uvs.push_back({float(v), 0.25f});
+      if (trial % 5 == 0) record.mesh.colors.push_back({float(v), 0.0f, 1.0f, 1.0f});
+      if (trial % 3 == 0) record.vertex_data.push_back(7 * v);
+    }
+    // Small clusters drawing from a part of the pool: some use the last vertex, some do not.
+    const uint32_t reach = trial % 2 ? V : std::max(1u, V - 1);
+    for (uint32_t c = 0; c < C; ++c) {
+      const uint32_t triangles = 1 + rng() % 12;
+      record.cluster_triangles.push_back(triangles);
+      for (uint32_t k = 0; k < 3 * triangles; ++k) record.mesh.indices.push_back(rng() % reach);
+    }
+    std::vector<uint32_t> order(C);
+    std::iota(order.begin(), order.end(), 0u);
+    std::shuffle(order.begin(), order.end(), rng);
+    for (uint32_t c : order) {
+      extract_cluster(record, c, "random", into);
+      expect_same_node(into, reference_cluster(record, c), c);
+    }
   }
 }
 
@@ -312,17 +393,7 @@ TEST(Records, DecodingIntoOneNodeReusesItsBuffers) {
     reader.decode_node(id, reader.read_page(reader.node(id).page), into);
     const DecodedNode d = alone.load_node(id);
     in_records += reader.node(id).cluster > 0;
-    EXPECT_EQ(into.mesh.indices, d.mesh.indices) << id;
-    EXPECT_EQ(into.mesh.positions, d.mesh.positions) << id;
-    EXPECT_EQ(into.mesh.normals, d.mesh.normals) << id;
-    EXPECT_EQ(into.mesh.uvs, d.mesh.uvs) << id;
-    EXPECT_EQ(into.mesh.colors, d.mesh.colors) << id;
-    EXPECT_EQ(into.mesh.material, d.mesh.material) << id;
-    EXPECT_EQ(into.vertex_data, d.vertex_data) << id;
-    EXPECT_EQ(into.extra, d.extra) << id;
-    EXPECT_EQ(into.cluster_triangles, d.cluster_triangles) << id;
-    EXPECT_EQ(into.first_vertex, d.first_vertex) << id;
-    EXPECT_EQ(into.index_end, d.index_end) << id;
+    expect_same_node(into, d, id);
     EXPECT_EQ(into.mesh.indices.data(), indices) << id;
     EXPECT_EQ(into.mesh.positions.data(), positions) << id;
   }
