@@ -149,7 +149,11 @@ constexpr uint32_t kKinds = 6, kScale = 1u << kTraversalScaleBits;
 // By a vertex's triangle count t (a byte): 16 x 8 min(t, 7) and 16 x min(t, 7), the offsets of a gate's
 // row of class_starts() from its level's and previous class's first row, for the gate's first and
 // second vertex (two loads where a min took four instructions with its constant: refined_elephant's
-// decode_traversal 19.90 -> 19.27 M instructions, format 12).
+// decode_traversal 19.90 -> 19.27 M instructions, format 12). The min by a compare and a conditional move
+// again, 2 cycles where a load takes 4-5 on the way to the class (main 18b25c4, decode_traversal over every
+// record, paired thread-CPU times new / old): motorBike 69.17 -> 72.34 M instructions, 0.986 (15 pairs)
+// then 1.002 (30), elephant_1m 0.976 then 0.992, refined_elephant 0.925 then 0.984; `bench/decode-pairs` on
+// motorBike 0.990 (M triangles/s new / old): within the noise.
 struct GateOffsets {
   uint16_t first[256], second[256];
 };
@@ -251,7 +255,10 @@ const RankTable& rank_table() {
 // Cost: 28 instructions on x86-64, two loads of the row, no branch. There one asm block: GCC 12 took ~37
 // for the same steps from intrinsics (copies of x and `at` around renormalize's asm, the class index
 // sign-extended and moved): `bench decode --runs 1` under callgrind, decode_traversal, refined_elephant
-// 27.95 -> 25.40 M instructions, elephant_1m 370.9 -> 367.0 M.
+// 27.95 -> 25.40 M instructions, elephant_1m 370.9 -> 367.0 M. The read by a branch (`at` then waits on no
+// step) was slower, presumably mispredicted (no counters on this VM; main 18b25c4, decode_traversal over
+// every record, paired thread-CPU times new / old): motorBike 69.17 -> 65.34 M instructions, 1.060;
+// elephant_1m 286.1 -> 270.4 M, 1.070; refined_elephant 1.024.
 inline __attribute__((always_inline)) uint32_t decode_class(uint32_t& x, const uint16_t* starts,
                                                             const uint8_t*& at) {
   // (AddressSanitizer sees no access in an asm block: its builds take the C++ form, whose reads it checks.)
@@ -549,6 +556,16 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
   // Two states, each step on the one the step before did not take (x, then y: the loop below): a gate's
   // state is not the previous gate's, whose decode only picks its context's row, so that the steps of
   // consecutive gates overlap in the CPU.
+  // GCC 12 keeps x, y and `in` on the stack in the gate loop (a load and a store each a gate): register
+  // pressure, not the calls (with the kSplit's varint call taken out they stay; -fira-region=one,
+  // -fira-algorithm=priority, -fsched-pressure change nothing). On the AMD EPYC of main 18b25c4 the round
+  // trip costs no measurable time (decode_traversal over every record, paired thread-CPU times new / old,
+  // motorBike and elephant_1m): `in` in a register (a and b as size_t, the counts' base hidden from CSE in
+  // emit) 0.998 and 1.006, motorBike 69.17 -> 69.42 M instructions; one scratch register fewer in
+  // decode_class and kSplit [[unlikely]] (the spills unchanged) 0.994 and 1.005. Both states in one 64-bit
+  // register (each step on the low half, then shrd $32: the other state continues, no swap after a rank)
+  // were slower, 1.169 (motorBike) and 1.128 (refined_elephant), 70.54 M: each step then waits on the one
+  // before it, the two states no longer overlap.
   thread_local std::vector<uint8_t> stream;
   static constexpr uint8_t kNoStream[1] = {};
   uint32_t x = 0, y = 0;
