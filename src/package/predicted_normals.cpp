@@ -13,6 +13,7 @@
 
 #include "package/byte_planes.hpp"
 #include "package/octahedral.hpp"
+#include "package/scratch.hpp"
 #include "package/widest_build.hpp"
 
 namespace lodstream::package {
@@ -146,8 +147,11 @@ __attribute__((target_clones("avx2", "default"))) void predicted_normals(
     std::memcpy(&r, &positions[v], sizeof r);
     return r;
   };
+  // Zeros: the entries sum held before cleared, the rest value-initialised by the resize, not both
+  // (motorBike's `bench decode --runs 1` under callgrind: memset here 5.37 -> 4.16 M instructions).
+  const size_t held = std::min(sum.size(), (size_t(V) + 3) & ~size_t(3));
   sum.resize((size_t(V) + 3) & ~size_t(3));
-  std::memset(sum.data(), 0, sum.size() * sizeof(NormalSum));
+  std::memset(sum.data(), 0, held * sizeof(NormalSum));
   // With all_inside, first_vertex is 0 (the caller's condition below): a constant, so no subtraction.
   auto accumulate = [&](auto all_inside) {
     const uint32_t base = all_inside ? 0 : first_vertex;
@@ -314,7 +318,8 @@ template <class F, class I>
   constexpr size_t L = sizeof(F) / sizeof(float);
   const size_t lanes = (size_t(V) + 3) & ~size_t(3);
   thread_local std::vector<int32_t> residual;
-  residual.resize(2 * size_t(V) + 4), normals.resize(lanes);
+  grow_scratch(residual, 2 * size_t(V) + 4);
+  normals.resize(lanes);
   glm::vec3* const out = normals.data();
   read_planes(planes, V, 2, width, residual.data());
   const float inv_scale = 1.0f / frame_scale(bits);

@@ -8,6 +8,7 @@
 #include "package/coarse_positions.hpp"
 #include "package/predictive_node.hpp"
 #include "package/quantized_node.hpp"
+#include "package/scratch.hpp"
 #include "package/vertex_attributes.hpp"
 
 namespace lodstream::package {
@@ -91,12 +92,12 @@ void parallelogram_form(uint32_t V, uint32_t& o1, uint32_t& o2, uint32_t& o) {
   if (o2 == kNone) o2 = o = o1;
 }
 
-// The predictors (predictive_node.hpp) of every vertex by for_each_prediction's rule into `predictors`
-// (3V entries); returns the largest index. O(T + V).
+// The predictors (predictive_node.hpp) of every vertex by for_each_prediction's rule into the first 3V
+// entries of `predictors` (grow_scratch: it may hold more); returns the largest index. O(T + V).
 uint32_t predictors_of(std::span<const uint32_t> indices, uint32_t first_vertex, uint32_t V,
                        std::vector<uint32_t>& predictors) {
   thread_local std::vector<uint32_t> first;
-  predictors.resize(3 * size_t(V));
+  grow_scratch(predictors, 3 * size_t(V));
   return for_each_prediction(
       indices, first_vertex, V, first, [&](uint32_t v, uint32_t o1, uint32_t o2, uint32_t o) {
         parallelogram_form(V, o1, o2, o);
@@ -144,15 +145,23 @@ std::vector<uint8_t> PredictiveCodec::encode(const NodeGeometry& g, const Positi
 
 DecodedNode PredictiveCodec::decode(std::span<const uint8_t> bytes, const PositionGrid& grid,
                                     const std::string& where) const {
+  DecodedNode out;
+  decode_into(bytes, grid, where, out);
+  return out;
+}
+
+void PredictiveCodec::decode_into(std::span<const uint8_t> bytes, const PositionGrid& grid,
+                                  const std::string& where, DecodedNode& out) const {
   const PredictiveNode p = parse(bytes, where);
   const uint32_t V = p.vertices;
   const size_t T = p.triangles;
-  DecodedNode out;
   out.first_vertex = p.first_vertex;
   out.index_end = p.index_end;
   out.extra.assign(p.tail.begin(), p.tail.end());
+  out.cluster_triangles.clear();
   Mesh& m = out.mesh;
-  m.indices.resize(3 * T);
+  m.material = 0;
+  m.indices.resize(3 * T);  // zero-fills only beyond the size it had
   if (meshopt_decodeIndexBuffer(m.indices.data(), m.indices.size(), sizeof(uint32_t), p.connectivity.data(),
                                 p.connectivity.size()) != 0)
     throw Error(where + ": corrupted index stream");
@@ -161,7 +170,6 @@ DecodedNode PredictiveCodec::decode(std::span<const uint8_t> bytes, const Positi
   if (T > 0 && max_index >= p.index_end)
     throw Error(where + ": index " + std::to_string(max_index) + " out of range");
   decode_predicted_vertices(p, predictors, nullptr, grid, out, where);
-  return out;
 }
 
 NodeSizeBreakdown PredictiveCodec::layout(std::span<const uint8_t> bytes, size_t node_size,

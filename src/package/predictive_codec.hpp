@@ -36,6 +36,8 @@ class PredictiveCodec final : public NodeCodec {
   std::vector<uint8_t> encode(const NodeGeometry& geometry, const PositionGrid& grid) const override;
   DecodedNode decode(std::span<const uint8_t> bytes, const PositionGrid& grid,
                      const std::string& where) const override;
+  void decode_into(std::span<const uint8_t> bytes, const PositionGrid& grid, const std::string& where,
+                   DecodedNode& out) const override;
   NodeSizeBreakdown layout(std::span<const uint8_t> bytes, size_t node_size,
                            const std::string& where) const override;
 };

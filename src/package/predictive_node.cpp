@@ -9,6 +9,7 @@
 #include "package/bytes.hpp"
 #include "package/derived_normals.hpp"
 #include "package/predicted_normals.hpp"
+#include "package/scratch.hpp"
 #include "package/vertex_attributes.hpp"
 #include "package/widest_build.hpp"
 
@@ -347,11 +348,11 @@ namespace {
   // planes first (one vectorized pass). The arithmetic wraps (unsigned), so hostile residuals cannot
   // overflow; the results are range-checked after it (out_of_range).
   thread_local std::vector<int64_t> c;
-  c.resize(3 * (size_t(V) + 1));
+  grow_scratch(c, 3 * (size_t(V) + 1));
   uint64_t* cu = reinterpret_cast<uint64_t*>(c.data());
   for (int a = 0; a < 3; ++a) cu[3 * size_t(V) + a] = uint64_t(p.cmin[a]);
   thread_local std::vector<int64_t> residual;
-  residual.resize(3 * size_t(V));
+  grow_scratch(residual, 3 * size_t(V));
   read_planes(p.position_planes.data(), V, 3, p.position_bytes, residual.data());
   const bool plane = p.flags & kPlanePrediction;
   if (p.damping == 4)

@@ -5,6 +5,7 @@
 #include "package/predictive_codec.hpp"
 #include "package/predictive_node.hpp"
 #include "package/quantized_node.hpp"
+#include "package/scratch.hpp"
 #include "package/traversal_connectivity.hpp"
 #include "package/vertex_attributes.hpp"
 
@@ -69,20 +70,19 @@ DecodedNode TraversalCodec::decode(std::span<const uint8_t> bytes, const Positio
 void TraversalCodec::decode_into(std::span<const uint8_t> bytes, const PositionGrid& grid,
                                  const std::string& where, DecodedNode& out) const {
   if (!bytes.empty() && bytes[0] == kOrderedFormat) {
-    out = ordered_codec().decode(bytes, grid, where);
+    ordered_codec().decode_into(bytes, grid, where, out);
     return;
   }
   const PredictiveNode p = PredictiveNode::parse(bytes, kFormat, kAllFlags, where);
   const uint32_t V = p.vertices;
-  // What the node may not hold cleared (capacity kept); the rest overwritten (the normals by
-  // decode_predicted_vertices, which clears them for a node without: resized from the last record's count,
+  // What the node may not hold cleared (capacity kept); the rest overwritten (the attributes by
+  // decode_predicted_vertices, which clears those the node lacks: resized from the last record's count,
   // they are zero-filled only where they grow).
-  out.mesh.uvs.clear(), out.mesh.colors.clear(), out.mesh.material = 0;
-  out.vertex_data.clear(), out.extra.clear();
+  out.mesh.material = 0, out.extra.clear();
   out.first_vertex = 0, out.index_end = V;
   out.mesh.indices.resize(3 * size_t(p.triangles));  // zero-fills only beyond the size it had
   thread_local std::vector<uint32_t> predictors;
-  predictors.resize(3 * (size_t(V) + 1));
+  grow_scratch(predictors, 3 * (size_t(V) + 1));
   thread_local Parallelograms extra;
   Parallelograms* const multi = p.flags & kMultiParallelogram ? &extra : nullptr;
   decode_traversal(p.connectivity, p.tail, p.triangles, V, out.mesh.indices.data(), predictors.data(), where,

@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "package/bytes.hpp"
+#include "package/scratch.hpp"
 
 namespace lodstream::package {
 
@@ -52,6 +53,8 @@ void get_attributes(const uint8_t* records, size_t stride, size_t V, const Attri
       const uint8_t* r = records + v * stride + l.uv;
       m.uvs[v] = uv_min + glm::vec2(load_raw<uint16_t>(r), load_raw<uint16_t>(r + 2)) * scale;
     }
+  } else {
+    m.uvs.clear();
   }
   if (flags & kHasColors) {
     m.colors.resize(V);
@@ -59,10 +62,14 @@ void get_attributes(const uint8_t* records, size_t stride, size_t V, const Attri
       const uint8_t* r = records + v * stride + l.color;
       m.colors[v] = glm::vec4(r[0], r[1], r[2], r[3]) * (1.0f / 255.0f);
     }
+  } else {
+    m.colors.clear();
   }
   if (flags & kHasVertexData) {
     out.vertex_data.resize(V);
     for (size_t v = 0; v < V; ++v) out.vertex_data[v] = load_raw<uint32_t>(records + v * stride + l.data);
+  } else {
+    out.vertex_data.clear();
   }
 }
 
@@ -83,10 +90,13 @@ void decode_attribute_stream(std::span<const uint8_t> stream, uint32_t flags, si
   const AttributeLayout layout = attribute_layout(flags, 0);
   if (layout.end == 0) {
     if (!stream.empty()) throw Error(where + ": attribute stream without attributes");
+    get_attributes(nullptr, 0, V, layout, flags, uv_min, uv_extent, out);  // clears them
     return;
   }
   const size_t stride = (layout.end + 3) & ~size_t(3);
-  std::vector<uint8_t> records(V * stride);
+  // Kept across nodes (meshopt overwrites the V records): no allocation and zero-fill a node.
+  thread_local std::vector<uint8_t> records;
+  grow_scratch(records, V * stride);
   if (meshopt_decodeVertexBuffer(records.data(), V, stride, stream.data(), stream.size()) != 0)
     throw Error(where + ": corrupted attribute stream");
   get_attributes(records.data(), stride, V, layout, flags, uv_min, uv_extent, out);

@@ -28,8 +28,8 @@ AttributeLayout attribute_layout(uint32_t flags, size_t at);
 // Writes caller vertex `old`'s attributes into `record`. Cost: O(1).
 void put_attributes(uint8_t* record, const AttributeLayout& layout, uint32_t flags,
                     const NodeGeometry& geometry, const QuantizedNode& node, uint32_t old);
-// Reads the attributes of V records (`stride` bytes apart) into out.mesh.uvs / colors and out.vertex_data.
-// Cost: O(V).
+// Reads the attributes of V records (`stride` bytes apart) into out.mesh.uvs / colors and out.vertex_data,
+// and clears those that `flags` lacks (out's buffers may hold a previous node's). Cost: O(V).
 void get_attributes(const uint8_t* records, size_t stride, size_t vertices, const AttributeLayout& layout,
                     uint32_t flags, glm::vec2 uv_min, glm::vec2 uv_extent, DecodedNode& out);
 
@@ -38,8 +38,8 @@ void get_attributes(const uint8_t* records, size_t stride, size_t vertices, cons
 // meshopt_encodeVertexBuffer; empty without such attributes. Cost: O(V).
 std::vector<uint8_t> encode_attribute_stream(uint32_t flags, const NodeGeometry& geometry,
                                              const QuantizedNode& node);
-// Decodes such a stream of V records into out (throws lodstream::Error starting with `where` on a corrupted
-// stream, or a non-empty one without attributes). Cost: O(V).
+// Decodes such a stream of V records into out as get_attributes does (throws lodstream::Error starting with
+// `where` on a corrupted stream, or a non-empty one without attributes). Cost: O(V).
 void decode_attribute_stream(std::span<const uint8_t> stream, uint32_t flags, size_t vertices,
                              glm::vec2 uv_min, glm::vec2 uv_extent, DecodedNode& out,
                              const std::string& where);

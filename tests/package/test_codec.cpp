@@ -308,6 +308,21 @@ TEST_P(NodeCodecTest, AttributesAndLockedVerticesRoundTrip) {
   EXPECT_EQ(got, expected);
 }
 
+// Every field of two decoded nodes equal.
+void expect_same_node(const DecodedNode& a, const DecodedNode& b) {
+  EXPECT_EQ(a.mesh.positions, b.mesh.positions);
+  EXPECT_EQ(a.mesh.normals, b.mesh.normals);
+  EXPECT_EQ(a.mesh.uvs, b.mesh.uvs);
+  EXPECT_EQ(a.mesh.colors, b.mesh.colors);
+  EXPECT_EQ(a.mesh.indices, b.mesh.indices);
+  EXPECT_EQ(a.mesh.material, b.mesh.material);
+  EXPECT_EQ(a.first_vertex, b.first_vertex);
+  EXPECT_EQ(a.index_end, b.index_end);
+  EXPECT_EQ(a.vertex_data, b.vertex_data);
+  EXPECT_EQ(a.extra, b.extra);
+  EXPECT_EQ(a.cluster_triangles, b.cluster_triangles);
+}
+
 TEST_P(NodeCodecTest, DecodeIntoAReusedNodeEqualsAFreshDecode) {
   // decode_into overwrites every field of a node that held another decode: one with more vertices and
   // triangles and every attribute, then one smaller and without attributes (normals included), then the first
@@ -331,25 +346,45 @@ TEST_P(NodeCodecTest, DecodeIntoAReusedNodeEqualsAFreshDecode) {
   g = NodeGeometry{};
   g.mesh = &small;
   const std::vector<uint8_t> small_bytes = codec.encode(g, pg);
-  auto expect_same = [](const DecodedNode& a, const DecodedNode& b) {
-    EXPECT_EQ(a.mesh.positions, b.mesh.positions);
-    EXPECT_EQ(a.mesh.normals, b.mesh.normals);
-    EXPECT_EQ(a.mesh.uvs, b.mesh.uvs);
-    EXPECT_EQ(a.mesh.colors, b.mesh.colors);
-    EXPECT_EQ(a.mesh.indices, b.mesh.indices);
-    EXPECT_EQ(a.mesh.material, b.mesh.material);
-    EXPECT_EQ(a.first_vertex, b.first_vertex);
-    EXPECT_EQ(a.index_end, b.index_end);
-    EXPECT_EQ(a.vertex_data, b.vertex_data);
-    EXPECT_EQ(a.extra, b.extra);
-    EXPECT_EQ(a.cluster_triangles, b.cluster_triangles);
-  };
   DecodedNode reused;
   for (const std::vector<uint8_t>* bytes : {&big_bytes, &small_bytes, &big_bytes}) {
     codec.decode_into(*bytes, pg, "reused", reused);
-    expect_same(reused, codec.decode(*bytes, pg, "fresh"));
+    expect_same_node(reused, codec.decode(*bytes, pg, "fresh"));
   }
   EXPECT_FALSE(reused.mesh.colors.empty());  // the last decode was the node with attributes
+}
+
+TEST(TraversalCodec, DecodeIntoAlternatingRecordsAndOrderedNodesEqualsFreshDecodes) {
+  // Codec 3 decodes a node whose order is significant as codec 2 (its ordered format) into the same reused
+  // node as its records: a record of two clusters with every attribute, then a progressive step with extra
+  // bytes and no attributes, and again, each decode equal to a fresh one.
+  Mesh big = uv_sphere(1.0f, 9, 14);
+  big.colors.assign(big.vertex_count(), glm::vec4(0.5f, 0.25f, 1.0f, 1.0f));
+  std::vector<uint32_t> id(big.vertex_count());
+  for (size_t v = 0; v < id.size(); ++v) id[v] = uint32_t(5 * v);
+  const uint32_t T = uint32_t(big.triangle_count());
+  const std::vector<uint32_t> clusters = {T / 3, T - T / 3};
+  Mesh step = grid(4);
+  step.normals.clear();
+  const std::vector<uint8_t> extra = {9, 8, 7};
+  Bounds both = big.bounds();
+  both.add(step.bounds());
+  const PositionGrid pg = PositionGrid::for_bounds(both, 14);
+  const TraversalCodec codec;
+  NodeGeometry g;
+  g.mesh = &big, g.vertex_data = id, g.cluster_triangles = clusters;
+  const std::vector<uint8_t> record = codec.encode(g, pg);
+  g = NodeGeometry{};
+  g.mesh = &step, g.preserve_order = true, g.extra = extra;
+  const std::vector<uint8_t> ordered = codec.encode(g, pg);
+  ASSERT_NE(record[0], ordered[0]);  // the format byte: a traversal, then codec 2's bytes
+  DecodedNode reused;
+  for (const std::vector<uint8_t>* bytes : {&record, &ordered, &record, &ordered}) {
+    codec.decode_into(*bytes, pg, "reused", reused);
+    expect_same_node(reused, codec.decode(*bytes, pg, "fresh"));
+  }
+  EXPECT_EQ(reused.extra, extra);
+  EXPECT_TRUE(reused.cluster_triangles.empty() && reused.mesh.colors.empty() && reused.vertex_data.empty());
 }
 
 TEST(PredictiveCodec, SmoothMeshTakesFewerBytesThanCodecOneAfterZstd) {
