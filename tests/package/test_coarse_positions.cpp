@@ -1,5 +1,6 @@
 // Decoding coarse coordinates to positions (package/coarse_positions.hpp): the four-vertex step gives the
-// scalar formula's bits, and coordinates beyond 32 bits fall back to the formula.
+// scalar formula's bits, with and without a position shift and locked vertices, and coordinates beyond 32
+// bits fall back to the formula.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -55,6 +56,41 @@ TEST(CoarsePositions, CoordinatesBeyondThirtyTwoBitsDecodeAsTheFormula) {
       EXPECT_EQ(decoded(c, grid), by_formula(c, grid)) << far << " at " << at;
     }
   }
+}
+
+TEST(CoarsePositions, ShiftedNodesWithLockedVerticesDecodeAsTheFormula) {
+  // Shifts k up to the format's 24 (z's low bits in one window with x's and y's up to k = 19, in a second
+  // above), every share of locked vertices, vertex counts around the four-vertex steps, coordinates that
+  // fit the 32-bit conversion and some that do not: each vertex decodes to origin + float(q) * step, q the
+  // finest-grid coordinate of a locked vertex (its low bits from the locked stream) and c * 2^k of a free
+  // one.
+  std::mt19937 rng(11);
+  PositionGrid grid;
+  grid.origin = {-2.5f, 0.75f, 40.0f}, grid.step = 3.1e-5f;
+  for (uint32_t k : {1u, 3u, 8u, 19u, 20u, 24u})
+    for (double share : {0.0, 0.3, 0.8, 1.0})
+      for (size_t V : {1, 4, 7, 8, 13, 64, 101})
+        for (bool beyond : {false, true}) {
+          const int64_t reach = (int64_t(1) << 31) >> k;  // c * 2^k within [-2^31, 2^31)
+          std::uniform_int_distribution<int64_t> coarse(-reach, reach - 1), low(0, (int64_t(1) << k) - 1);
+          std::bernoulli_distribution locks(share);
+          QuantizedNode n;
+          n.c.resize(3 * V), n.q.resize(3 * V), n.locked.resize(V);
+          for (size_t v = 0; v < V; ++v) {
+            n.locked[v] = locks(rng);
+            for (int a = 0; a < 3; ++a) {
+              const int64_t c = coarse(rng);
+              n.c[3 * v + a] = c;
+              n.q[3 * v + a] = c * (int64_t(1) << k) + (n.locked[v] ? low(rng) : 0);
+            }
+          }
+          if (beyond) n.c[3 * (V - 1)] = int64_t(1) << 32, n.q[3 * (V - 1)] = n.c[3 * (V - 1)] << k;
+          const std::vector<uint8_t> stream = encode_locked_stream(n, k);
+          std::vector<glm::vec3> p(V);
+          decode_positions(n.c, LockedStream::parse(stream, V, k, "test"), grid, p.data());
+          EXPECT_EQ(p, by_formula(n.q, grid)) << "k " << k << ", locked share " << share << ", " << V
+                                              << " vertices" << (beyond ? ", one beyond 32 bits" : "");
+        }
 }
 
 }  // namespace
