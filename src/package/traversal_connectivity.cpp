@@ -566,6 +566,16 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
   // register (each step on the low half, then shrd $32: the other state continues, no swap after a rank)
   // were slower, 1.169 (motorBike) and 1.128 (refined_elephant), 70.54 M: each step then waits on the one
   // before it, the two states no longer overlap.
+  // More states gain nothing: two already keep the chain off the critical path (main 780dbcf, a format 15
+  // tried, packages baked by each binary, paired thread-CPU times new / old of `bench decode --runs 9`,
+  // decoded nodes and 1 px renders identical). Each gate's steps on state g mod N (a rank on its class's
+  // state; two so 0.985 against main): four against two 0.999 and 0.988 on motorBike, 0.981 elephant_1m,
+  // 0.997 refined_elephant; three against two 0.997 (motorBike). Step i on state i mod 4, the four rotated
+  // after a rank: 0.971 against main on motorBike, 0.966 refined_elephant, decode_traversal 69.45 -> 74.63 M
+  // instructions (callgrind). Four states cost +0.12-0.18 % of the packages (refined_elephant 225,155 ->
+  // 225,453 B). A gate's time goes to its row (the front's a and b, their counts and offsets, the row's
+  // loads) and the class search before the kind's branch resolves (perf annotate of motorBike's decode): the
+  // front's chain, not the states'.
   thread_local std::vector<uint8_t> stream;
   static constexpr uint8_t kNoStream[1] = {};
   uint32_t x = 0, y = 0;
