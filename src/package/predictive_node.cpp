@@ -148,23 +148,43 @@ template <uint32_t j>
           : predict_positions<j, false, false>(residual, V, o, extra, c);
 }
 
-// predict_positions<j, true, false> (the plane prediction, one parallelogram a vertex) in the AVX-512 build's
-// lanes, to the bit: a vertex's coordinates, edges u = x - z, w = y - z, parallelogram and normal n = u x w
-// in the lanes of one register each (64-bit products: VPMULLQ), the offsets of all three candidate axes at
-// once (lane a: axis a dominant, the same doubles and operations as PlaneGate::offset) and the dominant axis
-// as an index into tables (which rotation of the components, which lane's offset) from one compare of |n|'s
-// lanes, where the scalar kernel branched on it (the axis changes at 19 % of motorBike's plane-predicted
-// vertices). P is damped_parallelogram's, as x + w for j = 4 and from ((4 + j)(u + w) + 8z + 4) / 8 otherwise
-// (equal modulo 2^64 before the shift). Measured (rdtsc around the prediction, each node's fastest of 15 runs
-// summed, interleaved runs): motorBike's 301,608 vertices of plane-predicted nodes 22.2 -> 13.2 TSC ticks a
-// vertex, 12.4 with the negation and the rounding below (9.4 -> 8.8 where nothing depends on the vertices
-// just written: the rest is the chain from one vertex to the next). Coordinates are read and written 3 lanes
-// at a time (masked: nothing past entry V of c).
-template <uint32_t j>
-__attribute__((target("arch=x86-64-v4"))) inline void predict_plane_positions_avx512(const int64_t* residual,
-                                                                                     uint32_t V,
-                                                                                     const uint32_t* o,
-                                                                                     uint64_t* c) {
+// The AVX-512 plane kernel's triangle (below): corners x, z and edges u = x - z, w = y - z of predictors t,
+// one register each (3 lanes).
+struct LaneTriangle {
+  __m256i x, z, u, w;
+};
+__attribute__((target("arch=x86-64-v4"))) inline LaneTriangle lane_triangle(const uint64_t* c,
+                                                                            const uint32_t* t) {
+  const __m256i x = _mm256_maskz_loadu_epi64(7, c + 3 * size_t(t[0]));
+  const __m256i y = _mm256_maskz_loadu_epi64(7, c + 3 * size_t(t[1]));
+  const __m256i z = _mm256_maskz_loadu_epi64(7, c + 3 * size_t(t[2]));
+  return LaneTriangle{x, z, _mm256_sub_epi64(x, z), _mm256_sub_epi64(y, z)};
+}
+// Its normal u x w (add_normal's), wrapping.
+__attribute__((target("arch=x86-64-v4"))) inline __m256i lane_normal(const LaneTriangle& t) {
+  return _mm256_sub_epi64(_mm256_mullo_epi64(_mm256_permute4x64_epi64(t.u, _MM_SHUFFLE(3, 0, 2, 1)),
+                                             _mm256_permute4x64_epi64(t.w, _MM_SHUFFLE(3, 1, 0, 2))),
+                          _mm256_mullo_epi64(_mm256_permute4x64_epi64(t.u, _MM_SHUFFLE(3, 1, 0, 2)),
+                                             _mm256_permute4x64_epi64(t.w, _MM_SHUFFLE(3, 0, 2, 1))));
+}
+
+// predict_positions<j, true, multi> (the plane prediction) in the AVX-512 build's lanes, to the bit: a
+// vertex's coordinates, edges u = x - z, w = y - z, parallelogram and normal n = u x w in the lanes of one
+// register each (64-bit products: VPMULLQ), the offsets of all three candidate axes at once (lane a: axis a
+// dominant, the same doubles and operations as PlaneGate::offset) and the dominant axis as an index into
+// tables (which rotation of the components, which lane's offset) from one compare of |n|'s lanes, where the
+// scalar kernel branched on it (the axis changes at 19 % of motorBike's plane-predicted vertices). P is
+// damped_parallelogram's, as x + w for j = 4 and from ((4 + j)(u + w) + 8z + 4) / 8 otherwise, and
+// averaged_parallelogram's from ((4 + j)(u + w + u' + w') + 8(z + z') + 8) / 16 (equal modulo 2^64 before
+// the shift). Measured (rdtsc around the prediction, each node's fastest of 15 runs summed, interleaved
+// runs): motorBike's 301,608 vertices of plane-predicted nodes 22.2 -> 13.2 TSC ticks a vertex, 12.4 with the
+// negation and the rounding below (9.4 -> 8.8 where nothing depends on the vertices just written: the rest is
+// the chain from one vertex to the next); with the multi-parallelogram prediction, refined_elephant's 16,274
+// vertices 33.8 -> 18.9, motorBike's 6,687 32.5 -> 21.6. Coordinates are read and written 3 lanes at a time
+// (masked: nothing past entry V of c).
+template <uint32_t j, bool multi>
+__attribute__((target("arch=x86-64-v4"))) inline void predict_plane_positions_avx512(
+    const int64_t* residual, uint32_t V, const uint32_t* o, const Parallelograms* extra, uint64_t* c) {
   // By the compare's bits k (bit 0: |n0| >= |n1|, bit 1: |n1| >= |n2|, bit 2: |n0| >= |n2|), whose dominant
   // axis d is k & 1 ? (k & 4 ? 0 : 2) : (k & 2 ? 1 : 2) (PlaneGate::set's): for each axis a, the component
   // (a - d) mod 3 it takes (the lifted one, 0, at a = d), and the lane d as a mask.
@@ -174,24 +194,30 @@ __attribute__((target("arch=x86-64-v4"))) inline void predict_plane_positions_av
   static const uint8_t kDominant[8] = {4, 4, 2, 4, 4, 1, 2, 1};
   const __m256d sign = _mm256_set1_pd(-0.0), half = _mm256_set1_pd(0.5);
   const long long* r = reinterpret_cast<const long long*>(residual);
+  const uint8_t* const found = multi ? extra->found.data() : nullptr;
+  const uint32_t* const corners = multi ? extra->corners.data() : nullptr;
+  const __m256i weight = _mm256_set1_epi64x(4 + j);
   for (uint32_t v = 0; v < V; ++v, o += 3, ++r) {
-    const __m256i x = _mm256_maskz_loadu_epi64(7, c + 3 * size_t(o[0]));
-    const __m256i y = _mm256_maskz_loadu_epi64(7, c + 3 * size_t(o[1]));
-    const __m256i z = _mm256_maskz_loadu_epi64(7, c + 3 * size_t(o[2]));
-    const __m256i u = _mm256_sub_epi64(x, z), w = _mm256_sub_epi64(y, z);
-    __m256i p;
-    if constexpr (j == 4) {
-      p = _mm256_add_epi64(x, w);
-    } else {
-      const __m256i s = _mm256_mullo_epi64(_mm256_set1_epi64x(4 + j), _mm256_add_epi64(u, w));
-      p = _mm256_srai_epi64(
-          _mm256_add_epi64(_mm256_add_epi64(s, _mm256_slli_epi64(z, 3)), _mm256_set1_epi64x(4)), 3);
+    const LaneTriangle g = lane_triangle(c, o);
+    const __m256i s = _mm256_add_epi64(g.u, g.w);
+    __m256i p = j == 4 ? _mm256_add_epi64(g.x, g.w)
+                       : _mm256_srai_epi64(_mm256_add_epi64(_mm256_add_epi64(_mm256_mullo_epi64(weight, s),
+                                                                             _mm256_slli_epi64(g.z, 3)),
+                                                            _mm256_set1_epi64x(4)),
+                                           3);
+    __m256i n = lane_normal(g);
+    if constexpr (multi) {
+      // Both triangles where v has a second parallelogram (averaged_parallelogram, the normals summed), the
+      // lanes chosen by a mask rather than a branch; elsewhere the second is the gate again, loaded but
+      // unused (corners holds stale entries there).
+      const __mmask8 more = found[v] ? 7 : 0;
+      const LaneTriangle h = lane_triangle(c, found[v] ? corners + 3 * size_t(v) : o);
+      const __m256i both =
+          _mm256_add_epi64(_mm256_mullo_epi64(weight, _mm256_add_epi64(s, _mm256_add_epi64(h.u, h.w))),
+                           _mm256_slli_epi64(_mm256_add_epi64(g.z, h.z), 3));
+      p = _mm256_mask_mov_epi64(p, more, _mm256_srai_epi64(_mm256_add_epi64(both, _mm256_set1_epi64x(8)), 4));
+      n = _mm256_mask_add_epi64(n, more, n, lane_normal(h));
     }
-    const __m256i yzx = _mm256_permute4x64_epi64(u, _MM_SHUFFLE(3, 0, 2, 1)),
-                  zxy = _mm256_permute4x64_epi64(u, _MM_SHUFFLE(3, 1, 0, 2));
-    const __m256i n =
-        _mm256_sub_epi64(_mm256_mullo_epi64(yzx, _mm256_permute4x64_epi64(w, _MM_SHUFFLE(3, 1, 0, 2))),
-                         _mm256_mullo_epi64(zxy, _mm256_permute4x64_epi64(w, _MM_SHUFFLE(3, 0, 2, 1))));
     const __m256d along = _mm256_cvtepi64_pd(n), size = _mm256_andnot_pd(sign, along);
     const __m256d first = _mm256_permute4x64_pd(along, _MM_SHUFFLE(3, 0, 2, 1)),
                   second = _mm256_permute4x64_pd(along, _MM_SHUFFLE(3, 1, 0, 2));
@@ -217,15 +243,23 @@ __attribute__((target("arch=x86-64-v4"))) inline void predict_plane_positions_av
   }
 }
 
-// predict_plane_positions_avx512 with the damping j = 4, 3 or 2.
+// predict_plane_positions_avx512 with the damping j = 4, 3 or 2, and the multi-parallelogram prediction where
+// `extra` is not null.
+template <uint32_t j>
 __attribute__((target("arch=x86-64-v4"))) inline void predict_plane_positions_avx512(
-    uint32_t j, const int64_t* residual, uint32_t V, const uint32_t* o, uint64_t* c) {
+    const int64_t* residual, uint32_t V, const uint32_t* o, const Parallelograms* extra, uint64_t* c) {
+  extra ? predict_plane_positions_avx512<j, true>(residual, V, o, extra, c)
+        : predict_plane_positions_avx512<j, false>(residual, V, o, extra, c);
+}
+__attribute__((target("arch=x86-64-v4"))) inline void predict_plane_positions_avx512(
+    uint32_t j, const int64_t* residual, uint32_t V, const uint32_t* o, const Parallelograms* extra,
+    uint64_t* c) {
   if (j == 4)
-    predict_plane_positions_avx512<4>(residual, V, o, c);
+    predict_plane_positions_avx512<4>(residual, V, o, extra, c);
   else if (j == 3)
-    predict_plane_positions_avx512<3>(residual, V, o, c);
+    predict_plane_positions_avx512<3>(residual, V, o, extra, c);
   else
-    predict_plane_positions_avx512<2>(residual, V, o, c);
+    predict_plane_positions_avx512<2>(residual, V, o, extra, c);
 }
 
 // Whether any of c[0 .. n) lies outside [-kMaxCoarse, kMaxCoarse): their shifted values OR-ed, one pass that
@@ -438,8 +472,8 @@ template <bool avx512 = false>
   grow_scratch(residual, 3 * size_t(V));
   read_planes(p.position_planes.data(), V, 3, p.position_bytes, residual.data());
   const bool plane = p.flags & kPlanePrediction;
-  if (avx512 && plane && !extra)
-    predict_plane_positions_avx512(p.damping, residual.data(), V, predictors.data(), cu);
+  if (avx512 && plane)
+    predict_plane_positions_avx512(p.damping, residual.data(), V, predictors.data(), extra, cu);
   else if (p.damping == 4)
     predict_positions<4>(plane, residual.data(), V, predictors.data(), extra, cu);
   else if (p.damping == 3)
