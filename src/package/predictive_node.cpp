@@ -233,10 +233,13 @@ __attribute__((target("arch=x86-64-v4"))) inline void predict_plane_positions_av
     const __m256d sum = _mm256_add_pd(_mm256_mul_pd(first, minus_ra), _mm256_mul_pd(second, minus_rb));
     const __m256d t = _mm256_add_pd(_mm256_div_pd(sum, along), half);
     // floor(t) in lane d alone, 0 where n = 0 (then every lane of `along` is), converted rounding down in one
-    // instruction (embedded rounding takes 512-bit registers).
+    // instruction (embedded rounding takes 512-bit registers; the low half taken by a shuffle, where GCC 12's
+    // _mm512_castsi512_si256 warns of its undefined upper lanes).
     const __mmask8 lane = _mm256_cmp_pd_mask(along, _mm256_setzero_pd(), _CMP_NEQ_UQ) & kDominant[k];
-    const __m256i offset = _mm512_castsi512_si256(_mm512_maskz_cvt_roundpd_epi64(
-        lane, _mm512_castpd256_pd512(t), _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC));
+    using Int64x8 = long long __attribute__((vector_size(64)));
+    const Int64x8 all = Int64x8(_mm512_maskz_cvt_roundpd_epi64(lane, _mm512_castpd256_pd512(t),
+                                                               _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC));
+    const __m256i offset = __m256i(__builtin_shufflevector(all, all, 0, 1, 2, 3));
     const __m256i components =
         _mm256_permutexvar_epi64(_mm256_load_si256(reinterpret_cast<const __m256i*>(kComponent[k])), q);
     _mm256_mask_storeu_epi64(c + 3 * size_t(v), 7, _mm256_add_epi64(_mm256_add_epi64(p, components), offset));
@@ -500,7 +503,9 @@ template <bool avx512 = false>
 // The AVX-512 (x86-64-v4) build: 10.8 TSC ticks a vertex from the residual planes to the range-checked coarse
 // coordinates, where the AVX2 build takes 11.6 (rdtsc around them, each node's fastest of 15 runs summed over
 // elephant_1m's 1.31 M vertices, median of 10 interleaved pairs: 15.2 -> 14.1 M ticks, 0.925x); read_planes
-// and out_of_range take 16 lanes a step. Without contraction (CMakeLists.txt's -ffp-contract=off: x86-64-v4
+// and out_of_range take 16 lanes a step. With predict_plane_positions_avx512 (5 interleaved runs each, the
+// same harness): elephant_1m 10.5 -> 6.8 ticks a vertex, motorBike 22.0 -> 13.1, refined_elephant 18.3 ->
+// 11.8. Without contraction (CMakeLists.txt's -ffp-contract=off: x86-64-v4
 // includes FMA), so the plane prediction's doubles give the same bits as the other builds.
 __attribute__((target("arch=x86-64-v4"))) void decode_vertices_avx512(
     const PredictiveNode& p, std::span<const uint32_t> predictors, const Parallelograms* extra,
