@@ -149,15 +149,17 @@ template <uint32_t j>
 }
 
 // The AVX-512 plane kernel's triangle (below): corners x, z and edges u = x - z, w = y - z of predictors t,
-// one register each (3 lanes).
+// one register each (lanes 0-2; lane 3 holds whatever follows a corner in c, which nothing reads: the kernel
+// masks it out of every result). Plain 4-lane loads, where masked 3-lane ones took 12.4 TSC ticks a
+// plane-predicted vertex rather than 11.6 (motorBike, measured as predict_plane_positions_avx512 says).
 struct LaneTriangle {
   __m256i x, z, u, w;
 };
 __attribute__((target("arch=x86-64-v4"))) inline LaneTriangle lane_triangle(const uint64_t* c,
                                                                             const uint32_t* t) {
-  const __m256i x = _mm256_maskz_loadu_epi64(7, c + 3 * size_t(t[0]));
-  const __m256i y = _mm256_maskz_loadu_epi64(7, c + 3 * size_t(t[1]));
-  const __m256i z = _mm256_maskz_loadu_epi64(7, c + 3 * size_t(t[2]));
+  const __m256i x = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + 3 * size_t(t[0])));
+  const __m256i y = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + 3 * size_t(t[1])));
+  const __m256i z = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + 3 * size_t(t[2])));
   return LaneTriangle{x, z, _mm256_sub_epi64(x, z), _mm256_sub_epi64(y, z)};
 }
 // Its normal u x w (add_normal's), wrapping.
@@ -180,8 +182,8 @@ __attribute__((target("arch=x86-64-v4"))) inline __m256i lane_normal(const LaneT
 // runs): motorBike's 301,608 vertices of plane-predicted nodes 22.2 -> 13.2 TSC ticks a vertex, 12.4 with the
 // negation and the rounding below (9.4 -> 8.8 where nothing depends on the vertices just written: the rest is
 // the chain from one vertex to the next); with the multi-parallelogram prediction, refined_elephant's 16,274
-// vertices 33.8 -> 18.9, motorBike's 6,687 32.5 -> 21.6. Coordinates are read and written 3 lanes at a time
-// (masked: nothing past entry V of c).
+// vertices 33.8 -> 18.9, motorBike's 6,687 32.5 -> 21.6. Coordinates are read 4 lanes at a time (c holds one
+// entry past cmin's coordinates for the last read) and written 3 (masked: cmin's stay).
 template <uint32_t j, bool multi>
 __attribute__((target("arch=x86-64-v4"))) inline void predict_plane_positions_avx512(
     const int64_t* residual, uint32_t V, const uint32_t* o, const Parallelograms* extra, uint64_t* c) {
@@ -466,9 +468,10 @@ template <bool avx512 = false>
   const LockedStream locked = LockedStream::parse(p.locked_stream, V, p.shift, where);
   // c[v] = P + residual (the damped parallelogram), with entry V holding cmin, the residuals read from their
   // planes first (one vectorized pass). The arithmetic wraps (unsigned), so hostile residuals cannot
-  // overflow; the results are range-checked after it (out_of_range).
+  // overflow; the results are range-checked after it (out_of_range). One entry more, which the AVX-512
+  // build's 4-lane reads of cmin's 3 coordinates take (lane_triangle).
   thread_local std::vector<int64_t> c;
-  grow_scratch(c, 3 * (size_t(V) + 1));
+  grow_scratch(c, 3 * (size_t(V) + 1) + 1);
   uint64_t* cu = reinterpret_cast<uint64_t*>(c.data());
   for (int a = 0; a < 3; ++a) cu[3 * size_t(V) + a] = uint64_t(p.cmin[a]);
   thread_local std::vector<int64_t> residual;
@@ -504,8 +507,8 @@ template <bool avx512 = false>
 // coordinates, where the AVX2 build takes 11.6 (rdtsc around them, each node's fastest of 15 runs summed over
 // elephant_1m's 1.31 M vertices, median of 10 interleaved pairs: 15.2 -> 14.1 M ticks, 0.925x); read_planes
 // and out_of_range take 16 lanes a step. With predict_plane_positions_avx512 (5 interleaved runs each, the
-// same harness): elephant_1m 10.5 -> 6.8 ticks a vertex, motorBike 22.0 -> 13.1, refined_elephant 18.3 ->
-// 11.8. Without contraction (CMakeLists.txt's -ffp-contract=off: x86-64-v4
+// same harness): elephant_1m 10.5 -> 6.7 ticks a vertex, motorBike 22.0 -> 12.3, refined_elephant 18.3 ->
+// 11.3. Without contraction (CMakeLists.txt's -ffp-contract=off: x86-64-v4
 // includes FMA), so the plane prediction's doubles give the same bits as the other builds.
 __attribute__((target("arch=x86-64-v4"))) void decode_vertices_avx512(
     const PredictiveNode& p, std::span<const uint32_t> predictors, const Parallelograms* extra,
