@@ -1,5 +1,6 @@
 #include "package/predictive_node.hpp"
 
+#include <immintrin.h>
 #include <algorithm>
 #include <cmath>
 #include <iterator>
@@ -145,6 +146,125 @@ template <uint32_t j>
   else
     plane ? predict_positions<j, true, false>(residual, V, o, extra, c)
           : predict_positions<j, false, false>(residual, V, o, extra, c);
+}
+
+// The AVX-512 plane kernel's triangle (below): corners x, z and edges u = x - z, w = y - z of predictors t,
+// one register each (lanes 0-2; lane 3 holds whatever follows a corner in c, which nothing reads: the kernel
+// masks it out of every result). Plain 4-lane loads, where masked 3-lane ones took 12.4 TSC ticks a
+// plane-predicted vertex rather than 11.6 (motorBike, measured as predict_plane_positions_avx512 says).
+struct LaneTriangle {
+  __m256i x, z, u, w;
+};
+__attribute__((target("arch=x86-64-v4"))) inline LaneTriangle lane_triangle(const uint64_t* c,
+                                                                            const uint32_t* t) {
+  const __m256i x = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + 3 * size_t(t[0])));
+  const __m256i y = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + 3 * size_t(t[1])));
+  const __m256i z = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + 3 * size_t(t[2])));
+  return LaneTriangle{x, z, _mm256_sub_epi64(x, z), _mm256_sub_epi64(y, z)};
+}
+// Its normal u x w (add_normal's), wrapping.
+__attribute__((target("arch=x86-64-v4"))) inline __m256i lane_normal(const LaneTriangle& t) {
+  return _mm256_sub_epi64(_mm256_mullo_epi64(_mm256_permute4x64_epi64(t.u, _MM_SHUFFLE(3, 0, 2, 1)),
+                                             _mm256_permute4x64_epi64(t.w, _MM_SHUFFLE(3, 1, 0, 2))),
+                          _mm256_mullo_epi64(_mm256_permute4x64_epi64(t.u, _MM_SHUFFLE(3, 1, 0, 2)),
+                                             _mm256_permute4x64_epi64(t.w, _MM_SHUFFLE(3, 0, 2, 1))));
+}
+
+// predict_positions<j, true, multi> (the plane prediction) in the AVX-512 build's lanes, to the bit: a
+// vertex's coordinates, edges u = x - z, w = y - z, parallelogram and normal n = u x w in the lanes of one
+// register each (64-bit products: VPMULLQ), the offsets of all three candidate axes at once (lane a: axis a
+// dominant, the same doubles and operations as PlaneGate::offset) and the dominant axis as an index into
+// tables (which rotation of the components, which lane's offset) from one compare of |n|'s lanes, where the
+// scalar kernel branched on it (the axis changes at 19 % of motorBike's plane-predicted vertices). P is
+// damped_parallelogram's, as x + w for j = 4 and from ((4 + j)(u + w) + 8z + 4) / 8 otherwise, and
+// averaged_parallelogram's from ((4 + j)(u + w + u' + w') + 8(z + z') + 8) / 16 (equal modulo 2^64 before
+// the shift). Measured (rdtsc around the prediction, each node's fastest of 15 runs summed, interleaved
+// runs): motorBike's 301,608 vertices of plane-predicted nodes 22.2 -> 13.2 TSC ticks a vertex, 12.4 with the
+// negation and the rounding below (9.4 -> 8.8 where nothing depends on the vertices just written: the rest is
+// the chain from one vertex to the next); with the multi-parallelogram prediction, refined_elephant's 16,274
+// vertices 33.8 -> 18.9, motorBike's 6,687 32.5 -> 21.6. Coordinates are read 4 lanes at a time (c holds one
+// entry past cmin's coordinates for the last read) and written 3 (masked: cmin's stay).
+template <uint32_t j, bool multi>
+__attribute__((target("arch=x86-64-v4"))) inline void predict_plane_positions_avx512(
+    const int64_t* residual, uint32_t V, const uint32_t* o, const Parallelograms* extra, uint64_t* c) {
+  // By the compare's bits k (bit 0: |n0| >= |n1|, bit 1: |n1| >= |n2|, bit 2: |n0| >= |n2|), whose dominant
+  // axis d is k & 1 ? (k & 4 ? 0 : 2) : (k & 2 ? 1 : 2) (PlaneGate::set's): for each axis a, the component
+  // (a - d) mod 3 it takes (the lifted one, 0, at a = d), and the lane d as a mask.
+  alignas(32) static const int64_t kComponent[8][4] = {{1, 2, 0, 3}, {1, 2, 0, 3}, {2, 0, 1, 3},
+                                                       {1, 2, 0, 3}, {1, 2, 0, 3}, {0, 1, 2, 3},
+                                                       {2, 0, 1, 3}, {0, 1, 2, 3}};
+  static const uint8_t kDominant[8] = {4, 4, 2, 4, 4, 1, 2, 1};
+  const __m256d sign = _mm256_set1_pd(-0.0), half = _mm256_set1_pd(0.5);
+  const long long* r = reinterpret_cast<const long long*>(residual);
+  const uint8_t* const found = multi ? extra->found.data() : nullptr;
+  const uint32_t* const corners = multi ? extra->corners.data() : nullptr;
+  const __m256i weight = _mm256_set1_epi64x(4 + j);
+  for (uint32_t v = 0; v < V; ++v, o += 3, ++r) {
+    const LaneTriangle g = lane_triangle(c, o);
+    const __m256i s = _mm256_add_epi64(g.u, g.w);
+    __m256i p = j == 4 ? _mm256_add_epi64(g.x, g.w)
+                       : _mm256_srai_epi64(_mm256_add_epi64(_mm256_add_epi64(_mm256_mullo_epi64(weight, s),
+                                                                             _mm256_slli_epi64(g.z, 3)),
+                                                            _mm256_set1_epi64x(4)),
+                                           3);
+    __m256i n = lane_normal(g);
+    if constexpr (multi) {
+      // Both triangles where v has a second parallelogram (averaged_parallelogram, the normals summed), the
+      // lanes chosen by a mask rather than a branch; elsewhere the second is the gate again, loaded but
+      // unused (corners holds stale entries there).
+      const __mmask8 more = found[v] ? 7 : 0;
+      const LaneTriangle h = lane_triangle(c, found[v] ? corners + 3 * size_t(v) : o);
+      const __m256i both =
+          _mm256_add_epi64(_mm256_mullo_epi64(weight, _mm256_add_epi64(s, _mm256_add_epi64(h.u, h.w))),
+                           _mm256_slli_epi64(_mm256_add_epi64(g.z, h.z), 3));
+      p = _mm256_mask_mov_epi64(p, more, _mm256_srai_epi64(_mm256_add_epi64(both, _mm256_set1_epi64x(8)), 4));
+      n = _mm256_mask_add_epi64(n, more, n, lane_normal(h));
+    }
+    const __m256d along = _mm256_cvtepi64_pd(n), size = _mm256_andnot_pd(sign, along);
+    const __m256d first = _mm256_permute4x64_pd(along, _MM_SHUFFLE(3, 0, 2, 1)),
+                  second = _mm256_permute4x64_pd(along, _MM_SHUFFLE(3, 1, 0, 2));
+    const uint32_t k = _mm256_cmp_pd_mask(_mm256_permute4x64_pd(size, _MM_SHUFFLE(3, 0, 1, 0)),
+                                          _mm256_permute4x64_pd(size, _MM_SHUFFLE(3, 2, 2, 1)), _CMP_GE_OQ) &
+                       7;
+    const __m256i q = _mm256_set_epi64x(0, r[2 * size_t(V)], r[V], r[0]);
+    // -ra and -rb: first (-ra) + second (-rb) is -(first ra + second rb) to the bit, the negation off the
+    // chain from one vertex to the next.
+    const __m256d minus = _mm256_xor_pd(_mm256_cvtepi64_pd(q), sign);
+    const __m256d minus_ra = _mm256_permute4x64_pd(minus, _MM_SHUFFLE(1, 1, 1, 1)),
+                  minus_rb = _mm256_permute4x64_pd(minus, _MM_SHUFFLE(2, 2, 2, 2));
+    const __m256d sum = _mm256_add_pd(_mm256_mul_pd(first, minus_ra), _mm256_mul_pd(second, minus_rb));
+    const __m256d t = _mm256_add_pd(_mm256_div_pd(sum, along), half);
+    // floor(t) in lane d alone, 0 where n = 0 (then every lane of `along` is), converted rounding down in one
+    // instruction (embedded rounding takes 512-bit registers; the low half taken by a shuffle, where GCC 12's
+    // _mm512_castsi512_si256 warns of its undefined upper lanes).
+    const __mmask8 lane = _mm256_cmp_pd_mask(along, _mm256_setzero_pd(), _CMP_NEQ_UQ) & kDominant[k];
+    using Int64x8 = long long __attribute__((vector_size(64)));
+    const Int64x8 all = Int64x8(_mm512_maskz_cvt_roundpd_epi64(lane, _mm512_castpd256_pd512(t),
+                                                               _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC));
+    const __m256i offset = __m256i(__builtin_shufflevector(all, all, 0, 1, 2, 3));
+    const __m256i components =
+        _mm256_permutexvar_epi64(_mm256_load_si256(reinterpret_cast<const __m256i*>(kComponent[k])), q);
+    _mm256_mask_storeu_epi64(c + 3 * size_t(v), 7, _mm256_add_epi64(_mm256_add_epi64(p, components), offset));
+  }
+}
+
+// predict_plane_positions_avx512 with the damping j = 4, 3 or 2, and the multi-parallelogram prediction where
+// `extra` is not null.
+template <uint32_t j>
+__attribute__((target("arch=x86-64-v4"))) inline void predict_plane_positions_avx512(
+    const int64_t* residual, uint32_t V, const uint32_t* o, const Parallelograms* extra, uint64_t* c) {
+  extra ? predict_plane_positions_avx512<j, true>(residual, V, o, extra, c)
+        : predict_plane_positions_avx512<j, false>(residual, V, o, extra, c);
+}
+__attribute__((target("arch=x86-64-v4"))) inline void predict_plane_positions_avx512(
+    uint32_t j, const int64_t* residual, uint32_t V, const uint32_t* o, const Parallelograms* extra,
+    uint64_t* c) {
+  if (j == 4)
+    predict_plane_positions_avx512<4>(residual, V, o, extra, c);
+  else if (j == 3)
+    predict_plane_positions_avx512<3>(residual, V, o, extra, c);
+  else
+    predict_plane_positions_avx512<2>(residual, V, o, extra, c);
 }
 
 // Whether any of c[0 .. n) lies outside [-kMaxCoarse, kMaxCoarse): their shifted values OR-ed, one pass that
@@ -336,7 +456,9 @@ std::vector<uint8_t> write_predictive_node(const NodeHeader& header, const Predi
 
 namespace {
 
-// decode_predicted_vertices' body, forced inline into each of its builds below.
+// decode_predicted_vertices' body, forced inline into each of its builds below; `avx512` for the AVX-512
+// build's (predict_plane_positions_avx512).
+template <bool avx512 = false>
 [[gnu::always_inline]] inline void decode_vertices(const PredictiveNode& p,
                                                    std::span<const uint32_t> predictors,
                                                    const Parallelograms* extra, const PositionGrid& grid,
@@ -346,16 +468,19 @@ namespace {
   const LockedStream locked = LockedStream::parse(p.locked_stream, V, p.shift, where);
   // c[v] = P + residual (the damped parallelogram), with entry V holding cmin, the residuals read from their
   // planes first (one vectorized pass). The arithmetic wraps (unsigned), so hostile residuals cannot
-  // overflow; the results are range-checked after it (out_of_range).
+  // overflow; the results are range-checked after it (out_of_range). One entry more, which the AVX-512
+  // build's 4-lane reads of cmin's 3 coordinates take (lane_triangle).
   thread_local std::vector<int64_t> c;
-  grow_scratch(c, 3 * (size_t(V) + 1));
+  grow_scratch(c, 3 * (size_t(V) + 1) + 1);
   uint64_t* cu = reinterpret_cast<uint64_t*>(c.data());
   for (int a = 0; a < 3; ++a) cu[3 * size_t(V) + a] = uint64_t(p.cmin[a]);
   thread_local std::vector<int64_t> residual;
   grow_scratch(residual, 3 * size_t(V));
   read_planes(p.position_planes.data(), V, 3, p.position_bytes, residual.data());
   const bool plane = p.flags & kPlanePrediction;
-  if (p.damping == 4)
+  if (avx512 && plane)
+    predict_plane_positions_avx512(p.damping, residual.data(), V, predictors.data(), extra, cu);
+  else if (p.damping == 4)
     predict_positions<4>(plane, residual.data(), V, predictors.data(), extra, cu);
   else if (p.damping == 3)
     predict_positions<3>(plane, residual.data(), V, predictors.data(), extra, cu);
@@ -381,12 +506,14 @@ namespace {
 // The AVX-512 (x86-64-v4) build: 10.8 TSC ticks a vertex from the residual planes to the range-checked coarse
 // coordinates, where the AVX2 build takes 11.6 (rdtsc around them, each node's fastest of 15 runs summed over
 // elephant_1m's 1.31 M vertices, median of 10 interleaved pairs: 15.2 -> 14.1 M ticks, 0.925x); read_planes
-// and out_of_range take 16 lanes a step. Without contraction (CMakeLists.txt's -ffp-contract=off: x86-64-v4
+// and out_of_range take 16 lanes a step. With predict_plane_positions_avx512 (5 interleaved runs each, the
+// same harness): elephant_1m 10.5 -> 6.7 ticks a vertex, motorBike 22.0 -> 12.3, refined_elephant 18.3 ->
+// 11.3. Without contraction (CMakeLists.txt's -ffp-contract=off: x86-64-v4
 // includes FMA), so the plane prediction's doubles give the same bits as the other builds.
 __attribute__((target("arch=x86-64-v4"))) void decode_vertices_avx512(
     const PredictiveNode& p, std::span<const uint32_t> predictors, const Parallelograms* extra,
     const PositionGrid& grid, DecodedNode& out, const std::string& where) {
-  decode_vertices(p, predictors, extra, grid, out, where);
+  decode_vertices<true>(p, predictors, extra, grid, out, where);
 }
 
 // An AVX2 build, as predicted_normals (no FMA: the same bits): VEX's 3-operand forms and wider byte-plane

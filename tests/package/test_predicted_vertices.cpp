@@ -86,5 +86,44 @@ TEST(PredictedVertices, TheWidestBuildDecodesTheBaselineBits) {
   EXPECT_GT(refused, 100u);
 }
 
+TEST(PredictedVertices, TheWidestBuildDecodesTiedAndFlatPlanesAsTheBaseline) {
+  // The plane prediction where the dominant axis is a tie or n = 0 (the AVX-512 build takes it from a table
+  // indexed by the compares of |n|'s components, the baseline by selects): residuals in {-1, 0, 1} around
+  // predictors among a few vertices, so that gates are small, often axis-aligned or degenerate triangles.
+  std::mt19937 rng(11);
+  const PositionGrid grid{glm::vec3(0.0f), 0.01f};
+  size_t ties = 0, flat = 0;
+  for (uint32_t V : {5u, 64u, 1000u})
+    for (uint32_t damping = 2; damping <= 4; ++damping) {
+      std::vector<uint8_t> planes(3 * size_t(V));
+      for (uint8_t& b : planes) b = uint8_t(rng() % 3);  // zigzag: 0, -1, 1
+      std::vector<uint32_t> predictors(3 * size_t(V));
+      for (uint32_t v = 0; v < V; ++v)
+        for (int k = 0; k < 3; ++k) predictors[3 * v + k] = v < 4 ? V : uint32_t(rng() % 4);
+      PredictiveNode p;
+      p.vertices = V, p.index_end = V, p.position_bytes = 1, p.damping = damping, p.flags = kPlanePrediction;
+      p.position_planes = planes;
+      DecodedNode widest, baseline;
+      decode_predicted_vertices(p, predictors, nullptr, grid, widest, "node");
+      decode_predicted_vertices_baseline(p, predictors, nullptr, grid, baseline, "node");
+      ASSERT_EQ(widest.mesh.positions.size(), V);
+      for (uint32_t v = 0; v < V; ++v) {
+        for (int a = 0; a < 3; ++a)
+          ASSERT_EQ(std::bit_cast<uint32_t>(widest.mesh.positions[v][a]),
+                    std::bit_cast<uint32_t>(baseline.mesh.positions[v][a]))
+              << V << " vertices, damping " << damping << ": vertex " << v;
+        // The gate's normal from the decoded positions' coarse coordinates (small integers).
+        const uint32_t* o = &predictors[3 * v];
+        if (o[0] == V) continue;
+        auto coarse = [&](uint32_t i) { return glm::round(glm::dvec3(baseline.mesh.positions[i]) / 0.01); };
+        const glm::dvec3 m = glm::abs(glm::cross(coarse(o[0]) - coarse(o[2]), coarse(o[1]) - coarse(o[2])));
+        flat += m == glm::dvec3(0.0);
+        ties += m != glm::dvec3(0.0) && (m.x == m.y || m.y == m.z || m.x == m.z);
+      }
+    }
+  EXPECT_GT(ties, 100u);
+  EXPECT_GT(flat, 100u);
+}
+
 }  // namespace
 }  // namespace lodstream::test
