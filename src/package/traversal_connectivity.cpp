@@ -701,6 +701,17 @@ void decode_symbols(std::span<const uint8_t> symbols, std::span<const uint8_t> r
       // row (about 18 cycles of latency a gate by the instruction tables) is gone. Paired timings of
       // decode_traversal over every record of elephant_1m, new / old: 0.95 (edges linked by address) -> 0.89
       // (and this), for 1.3 M instructions more.
+      // The rest of the row's chain (a and b, their counts, kGateOffsets, the row) made shorter gained
+      // nothing (main c761699, decoded nodes and 1 px renders identical; `bench/decode-pairs` on motorBike,
+      // 12-16 pairs; decode_symbols<false> under callgrind, 63.7 M instructions before): the next edge's
+      // offsets loaded before the kind's branch and used after a kVertex (42 % of the gates; the gate's own
+      // two increments moved before the branch, undone by a kBoundary) 1.001, refined_elephant 1.007,
+      // elephant_1m 1.010, 78.3 M; after a kBoundary (22 %) 0.991, 74.1 M; its counts kept exact in emit by
+      // compares 0.969, 87.9 M; the increments moved alone 0.996, 66.6 M. One load where kGateOffsets took
+      // two (a byte min(count, 7) beside each count, both from a table by the count) 1.000, 67.7 M, with the
+      // increments moved 0.990, 72.6 M; that byte by a compare in emit 0.987, 68.4 M. Yet the chain counts:
+      // two imul by 1 on the row's address 0.967 (0.972 again), on a value nothing waits for 0.990, on the
+      // state 0.991.
       uint32_t kind = symbol_class;
       size_t tag = 0;
       // Untagged: the gate's cluster (below C, checked when its triangle was decoded), else the code's - 1.
