@@ -143,7 +143,12 @@ Renderer::~Renderer() {
   for (GLuint program : programs_) glDeleteProgram(program);
 }
 
-MeshHandle Renderer::upload_mesh(const Mesh& mesh) {
+MeshHandle Renderer::upload_mesh(const Mesh& mesh, std::span<const uint32_t> range_triangles) {
+  uint64_t ranged = 0;
+  for (uint32_t t : range_triangles) ranged += t;
+  if (!range_triangles.empty() && ranged != mesh.triangle_count())
+    throw Error("renderer: a mesh's ranges hold " + std::to_string(ranged) + " triangles, the mesh " +
+                std::to_string(mesh.triangle_count()));
   Mesh with_normals;
   if (!mesh.has_normals()) {
     with_normals.positions = mesh.positions;
@@ -165,10 +170,16 @@ MeshHandle Renderer::upload_mesh(const Mesh& mesh) {
   }
 
   GpuMesh gpu;
-  gpu.index_count = uint32_t(mesh.indices.size());
   gpu.has_uvs = uvs;
   gpu.has_colors = colors;
-  gpu.bounds = mesh.bounds();
+  if (range_triangles.empty()) gpu.ranges.push_back({0, uint32_t(mesh.indices.size()), mesh.bounds()});
+  for (uint32_t first = 0; uint32_t t : range_triangles) {
+    GpuRange r{3 * first, 3 * t, {}};
+    for (uint32_t i = r.first_index; i < r.first_index + r.index_count; ++i)
+      r.bounds.add(mesh.positions[mesh.indices[i]]);
+    gpu.ranges.push_back(r);
+    first += t;
+  }
   glCreateBuffers(1, &gpu.vertex_buffer);
   glCreateBuffers(1, &gpu.index_buffer);
   // Zero-sized buffer storage is an error; an empty mesh keeps one dummy byte and draws nothing.
@@ -177,8 +188,9 @@ MeshHandle Renderer::upload_mesh(const Mesh& mesh) {
   std::vector<uint32_t> reordered;
   if (options_.optimize_vertex_cache && !mesh.indices.empty()) {
     reordered.resize(mesh.indices.size());
-    meshopt_optimizeVertexCache(reordered.data(), mesh.indices.data(), mesh.indices.size(),
-                                mesh.positions.size());
+    for (const GpuRange& r : gpu.ranges)
+      meshopt_optimizeVertexCache(reordered.data() + r.first_index, mesh.indices.data() + r.first_index,
+                                  r.index_count, mesh.positions.size());
   }
   const std::vector<uint32_t>& indices = reordered.empty() ? mesh.indices : reordered;
   glNamedBufferStorage(gpu.index_buffer, std::max<GLsizeiptr>(1, indices.size() * sizeof(uint32_t)),
@@ -199,6 +211,15 @@ MeshHandle Renderer::upload_mesh(const Mesh& mesh) {
   meshes_.push_back(gpu);
   check_gl("mesh upload");
   return MeshHandle(meshes_.size());
+}
+
+const Renderer::GpuRange& Renderer::range_of(const DrawItem& item) const {
+  const GpuMesh& gpu = meshes_.at(item.mesh - 1);
+  if (!gpu.vertex_array) throw Error("renderer: drawing a released mesh");
+  if (item.range >= gpu.ranges.size())
+    throw Error("renderer: drawing range " + std::to_string(item.range) + " of a mesh of " +
+                std::to_string(gpu.ranges.size()));
+  return gpu.ranges[item.range];
 }
 
 void Renderer::release_mesh(MeshHandle mesh) {
@@ -282,7 +303,7 @@ double Renderer::draw(const Camera& camera, std::span<const DrawItem> items) {
   ensure_frame(camera.width, camera.height);
   world_boxes_.clear();
   for (const DrawItem& item : items)
-    world_boxes_.push_back(transform_bounds(meshes_.at(item.mesh - 1).bounds, item.transform));
+    world_boxes_.push_back(transform_bounds(range_of(item).bounds, item.transform));
   const DepthRange range = depth_range(camera, world_boxes_);
   const glm::mat4 view = camera.view();
   const glm::mat4 view_projection =
@@ -304,9 +325,9 @@ double Renderer::draw(const Camera& camera, std::span<const DrawItem> items) {
   if (!range.empty()) {
     GLuint current = 0;
     for (const DrawItem& item : items) {
-      const GpuMesh& gpu = meshes_.at(item.mesh - 1);
-      if (!gpu.vertex_array) throw Error("renderer: drawing a released mesh");
-      if (gpu.index_count == 0) continue;
+      const GpuMesh& gpu = meshes_[item.mesh - 1];
+      const GpuRange& r = range_of(item);
+      if (r.index_count == 0) continue;
       const glm::mat4 mvp = view_projection * item.transform;
       const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(view * item.transform)));
       GLuint texture = item.material.texture ? textures_.at(item.material.texture - 1) : 0;
@@ -319,7 +340,8 @@ double Renderer::draw(const Camera& camera, std::span<const DrawItem> items) {
       glProgramUniform4fv(program, kBaseColor, 1, &item.material.base_color[0]);
       if (textured) glBindTextureUnit(0, texture);
       glBindVertexArray(gpu.vertex_array);
-      glDrawElements(GL_TRIANGLES, GLsizei(gpu.index_count), GL_UNSIGNED_INT, nullptr);
+      glDrawElements(GL_TRIANGLES, GLsizei(r.index_count), GL_UNSIGNED_INT,
+                     reinterpret_cast<const void*>(uintptr_t(r.first_index) * sizeof(uint32_t)));
     }
     glBindVertexArray(0);
   }
