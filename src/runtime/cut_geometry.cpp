@@ -136,7 +136,8 @@ size_t CutGeometry::update(const schedule::Cut& cut, const PageSource& pages) {
   for (const schedule::DrawnNode& d : cut.drawn) {
     if (d.refined) continue;  // drawn as part of its object's prefix, below
     const package::NodeRecord& n = reader_->node(d.node);
-    CutItem item{d.object, d.node};
+    CutItem item;
+    item.object = d.object, item.node = d.node;
     item.transform = d.object == package::kNone ? glm::mat4(1.0f) : objects[d.object].transform;
     item.material = n.material < materials_.size() ? n.material : 0;
     if (n.kind == package::NodeKind::progressive_step) {

@@ -381,7 +381,7 @@ TEST(Records, TheReaderGivesEachClusterAsARangeOfItsRecord) {
   write_test_package(file, TraversalCodec::kId);
   PackageReader reader = PackageReader::open(file), alone = PackageReader::open(file);
   DecodedNode record;
-  size_t in_records = 0;
+  size_t in_records = 0, refused = 0;
   for (uint32_t id = 0; id < reader.node_count(); ++id) {
     const std::vector<uint8_t> page = reader.read_page(reader.node(id).page);
     reader.decode_record(id, page, record);
@@ -394,12 +394,20 @@ TEST(Records, TheReaderGivesEachClusterAsARangeOfItsRecord) {
       ASSERT_EQ(record.mesh.normals[v], d.mesh.normals[d.mesh.indices[k]]) << id;
     }
     in_records += reader.node(id).cluster > 0;
-    // Another record's node: its cluster or its triangle count differs from what this record holds.
-    if (id > 0 && reader.node(id - 1).offset != reader.node(id).offset &&
-        reader.node(id - 1).triangles != range.triangles)
-      EXPECT_THROW(reader.cluster_of(id - 1, record), Error) << id;
+    // Another record's node is refused unless this record has a cluster of its index and triangle count.
+    if (reader.node(id).cluster > 0) continue;
+    for (uint32_t other = 0; other < reader.node_count(); ++other) {
+      const NodeRecord& n = reader.node(other);
+      if (n.page == reader.node(id).page && n.offset == reader.node(id).offset) continue;
+      const bool fits = n.cluster < record_clusters(record) &&
+                        cluster_range(record, n.cluster, "record").triangles == n.triangles;
+      if (fits) continue;
+      EXPECT_THROW(reader.cluster_of(other, record), Error) << id << " " << other;
+      ++refused;
+    }
   }
   EXPECT_GT(in_records, 4u);
+  EXPECT_GT(refused, 2u);
 }
 
 // Decoding every node into one DecodedNode (the bench's and a recycling client's path) gives each node as
