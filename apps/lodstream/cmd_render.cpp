@@ -160,8 +160,13 @@ int run_render(const RenderOptions& opt) {
                           {"platform", context->platform()},
                           {"msaa", opt.msaa},
                           {"output", opt.output}};
+    // held_triangles: the decoded records' (every cluster of a record that the cut draws any of), decoded and
+    // uploaded whole.
     if (package)
-      out.update({{"nodes", cut.nodes}, {"pixel_error", tau}, {"pixel_error_max", cut.pixel_error_max}});
+      out.update({{"nodes", cut.nodes},
+                  {"pixel_error", tau},
+                  {"pixel_error_max", cut.pixel_error_max},
+                  {"held_triangles", cut.geometry->held_triangles()}});
     print_json(out);
   } else {
     std::printf("%s: %zu triangles, %dx%d, draw %.1f ms (median of %d), load %.2f s, %s\n",
