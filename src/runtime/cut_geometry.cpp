@@ -143,7 +143,8 @@ size_t CutGeometry::update(const schedule::Cut& cut, const PageSource& pages) {
     if (n.kind == package::NodeKind::progressive_step) {
       item.mesh = &prefix(d.node);
       item.triangles = {0, uint32_t(item.mesh->triangle_count())};
-      item.mesh_key = uint64_t(1) << 63 | d.node;  // above every record's: pages are below 2^31
+      // Above every record's key: pages number fewer than 2^31 (their ranges fill a root index of <= 64 MiB).
+      item.mesh_key = uint64_t(1) << 63 | d.node;
     } else {
       const package::DecodedNode& record = records_.at(record_key(n)).node;
       item.mesh = &record.mesh;
