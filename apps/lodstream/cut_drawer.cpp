@@ -24,6 +24,7 @@ const std::vector<render::DrawItem>& CutDrawer::items(const runtime::CutGeometry
   for (const runtime::CutItem& item : geometry.items()) {
     Uploaded& u = meshes_[item.mesh_key];
     if (!u.mesh) u.mesh = renderer_.upload_mesh(*item.mesh, item.range_triangles);
+    renderer_.prepare_range(u.mesh, item.range, *item.mesh);  // once per range
     u.last_drawn = frame_;
     items_.push_back({u.mesh, item.transform, materials_.at(item.material), item.range});
   }

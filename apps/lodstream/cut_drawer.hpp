@@ -24,8 +24,9 @@ class CutDrawer {
   CutDrawer(const CutDrawer&) = delete;
   CutDrawer& operator=(const CutDrawer&) = delete;
 
-  // The draw items of `geometry`'s current cut (after its update()), uploading the meshes new to the GPU and
-  // releasing those undrawn for keep_frames calls. Cost: the new meshes' upload (renderer.hpp).
+  // The draw items of `geometry`'s current cut (after its update()), uploading the meshes new to the GPU
+  // (preparing their drawn ranges, and those newly drawn of meshes already there) and releasing those
+  // undrawn for keep_frames calls. Cost: the new meshes' upload and new ranges' preparation (renderer.hpp).
   const std::vector<render::DrawItem>& items(const runtime::CutGeometry& geometry);
   // Warnings of the materials' upload (an unreadable texture file).
   const std::vector<std::string>& warnings() const { return textures_.warnings; }

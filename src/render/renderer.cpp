@@ -145,6 +145,25 @@ Renderer::~Renderer() {
   for (GLuint program : programs_) glDeleteProgram(program);
 }
 
+namespace {
+
+// `indices` (triangles) reordered for the vertex cache into `out`, shifted down by their lowest first so that
+// the reordering's tables span their vertices, not the whole mesh's (a package record's ranges, its clusters,
+// each use a band of its vertices): under callgrind, `render` of motorBike's package at 1 px (near camera,
+// every range of the drawn records reordered), meshopt_optimizeVertexCache 438.0 -> 337.3 M instructions.
+// The order comes out the same whatever the vertices' numbers (meshoptimizer 0.18 breaks ties by cache
+// position and triangle order only; tests/render: a range draws as the range alone).
+void reorder_for_vertex_cache(std::span<const uint32_t> indices, uint32_t* out) {
+  uint32_t lowest = UINT32_MAX, end = 0;
+  for (uint32_t v : indices) lowest = std::min(lowest, v), end = std::max(end, v + 1);
+  std::vector<uint32_t> shifted(indices.size());
+  for (size_t i = 0; i < indices.size(); ++i) shifted[i] = indices[i] - lowest;
+  meshopt_optimizeVertexCache(out, shifted.data(), indices.size(), end - lowest);
+  for (size_t i = 0; i < indices.size(); ++i) out[i] += lowest;
+}
+
+}  // namespace
+
 MeshHandle Renderer::upload_mesh(const Mesh& mesh, std::span<const uint32_t> range_triangles) {
   uint64_t ranged = 0;
   for (uint32_t t : range_triangles) ranged += t;
@@ -174,22 +193,16 @@ MeshHandle Renderer::upload_mesh(const Mesh& mesh, std::span<const uint32_t> ran
   GpuMesh gpu;
   gpu.has_uvs = uvs;
   gpu.has_colors = colors;
-  // Per range, its lowest index and one past its highest (the vertices that the reordering's tables span).
-  std::vector<std::pair<uint32_t, uint32_t>> spans;
-  if (range_triangles.empty()) {
-    gpu.ranges.push_back({0, uint32_t(mesh.indices.size()), mesh.bounds()});
-    spans.push_back({0, uint32_t(mesh.positions.size())});
-  }
+  // With ranges, each is reordered when first prepared (prepare_range), so that ranges never drawn cost no
+  // reordering: a package record's clusters that the cut does not draw (`render` of elephant_1m's package at
+  // 1 px, near camera: records of 1,059,288 triangles hold the 519,762 drawn).
+  const bool later = !range_triangles.empty() && options_.optimize_vertex_cache;
+  if (range_triangles.empty()) gpu.ranges.push_back({0, uint32_t(mesh.indices.size()), mesh.bounds(), true});
   for (uint32_t first = 0; uint32_t t : range_triangles) {
-    GpuRange r{3 * first, 3 * t, {}};
-    uint32_t lowest = UINT32_MAX, end = 0;
-    for (uint32_t i = r.first_index; i < r.first_index + r.index_count; ++i) {
-      const uint32_t v = mesh.indices[i];
-      r.bounds.add(mesh.positions[v]);
-      lowest = std::min(lowest, v), end = std::max(end, v + 1);
-    }
+    GpuRange r{3 * first, 3 * t, {}, !later};
+    for (uint32_t i = r.first_index; i < r.first_index + r.index_count; ++i)
+      r.bounds.add(mesh.positions[mesh.indices[i]]);
     gpu.ranges.push_back(r);
-    spans.push_back({std::min(lowest, end), end});
     first += t;
   }
   glCreateBuffers(1, &gpu.vertex_buffer);
@@ -198,30 +211,13 @@ MeshHandle Renderer::upload_mesh(const Mesh& mesh, std::span<const uint32_t> ran
   glNamedBufferStorage(gpu.vertex_buffer, std::max<GLsizeiptr>(1, vertices.size() * sizeof(float)),
                        vertices.empty() ? nullptr : vertices.data(), 0);
   std::vector<uint32_t> reordered;
-  if (options_.optimize_vertex_cache && !mesh.indices.empty()) {
-    // Each range reordered on its own, its indices shifted down by its lowest: the reordering's tables then
-    // span the range's vertices, not the mesh's (a package record's ranges, its clusters, each use a band of
-    // its vertices). Measured under callgrind, `render` of motorBike's package at 1 px (near camera, records
-    // of 284,398 triangles holding the 229,468 drawn), meshopt_optimizeVertexCache: 438.0 -> 337.3 M
-    // instructions (260.3 M over the drawn clusters copied out of their records, main 780dbcf). The order
-    // comes out the same whatever the vertices' numbers (meshoptimizer 0.18 breaks ties by cache position and
-    // triangle order only; tests/render: a range draws as the range alone).
+  if (options_.optimize_vertex_cache && range_triangles.empty() && !mesh.indices.empty()) {
     reordered.resize(mesh.indices.size());
-    std::vector<uint32_t> shifted;
-    for (size_t k = 0; k < gpu.ranges.size(); ++k) {
-      const GpuRange& r = gpu.ranges[k];
-      const auto [lowest, end] = spans[k];
-      const uint32_t* in = mesh.indices.data() + r.first_index;
-      shifted.resize(r.index_count);
-      for (uint32_t i = 0; i < r.index_count; ++i) shifted[i] = in[i] - lowest;
-      uint32_t* out = reordered.data() + r.first_index;
-      meshopt_optimizeVertexCache(out, shifted.data(), r.index_count, end - lowest);
-      for (uint32_t i = 0; i < r.index_count; ++i) out[i] += lowest;
-    }
+    reorder_for_vertex_cache(mesh.indices, reordered.data());
   }
   const std::vector<uint32_t>& indices = reordered.empty() ? mesh.indices : reordered;
   glNamedBufferStorage(gpu.index_buffer, std::max<GLsizeiptr>(1, indices.size() * sizeof(uint32_t)),
-                       indices.empty() ? nullptr : indices.data(), 0);
+                       indices.empty() ? nullptr : indices.data(), later ? GL_DYNAMIC_STORAGE_BIT : 0);
   glCreateVertexArrays(1, &gpu.vertex_array);
   const GLuint vao = gpu.vertex_array;
   glVertexArrayVertexBuffer(vao, 0, gpu.vertex_buffer, 0, GLsizei(floats * sizeof(float)));
@@ -240,13 +236,30 @@ MeshHandle Renderer::upload_mesh(const Mesh& mesh, std::span<const uint32_t> ran
   return MeshHandle(meshes_.size());
 }
 
-const Renderer::GpuRange& Renderer::range_of(const DrawItem& item) const {
-  const GpuMesh& gpu = meshes_.at(item.mesh - 1);
+void Renderer::prepare_range(MeshHandle mesh, uint32_t range, const Mesh& source) {
+  GpuRange& r = range_of({mesh, glm::mat4(1.0f), {}, range}, false);
+  if (r.ready) return;
+  if (size_t(r.first_index) + r.index_count > source.indices.size())
+    throw Error("renderer: preparing range " + std::to_string(range) +
+                " from a mesh it was not uploaded from");
+  std::vector<uint32_t> reordered(r.index_count);
+  reorder_for_vertex_cache(std::span(source.indices).subspan(r.first_index, r.index_count), reordered.data());
+  glNamedBufferSubData(meshes_[mesh - 1].index_buffer, GLintptr(r.first_index) * GLintptr(sizeof(uint32_t)),
+                       GLsizeiptr(r.index_count) * GLsizeiptr(sizeof(uint32_t)), reordered.data());
+  r.ready = true;
+  check_gl("range preparation");
+}
+
+Renderer::GpuRange& Renderer::range_of(const DrawItem& item, bool drawn) {
+  GpuMesh& gpu = meshes_.at(item.mesh - 1);
   if (!gpu.vertex_array) throw Error("renderer: drawing a released mesh");
   if (item.range >= gpu.ranges.size())
     throw Error("renderer: drawing range " + std::to_string(item.range) + " of a mesh of " +
                 std::to_string(gpu.ranges.size()));
-  return gpu.ranges[item.range];
+  GpuRange& r = gpu.ranges[item.range];
+  if (drawn && !r.ready)
+    throw Error("renderer: drawing range " + std::to_string(item.range) + " before prepare_range");
+  return r;
 }
 
 void Renderer::release_mesh(MeshHandle mesh) {

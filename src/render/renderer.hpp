@@ -72,10 +72,16 @@ class Renderer {
   // their own (the reordering does not depend on how vertices are numbered) and its bounds (for the depth
   // range) those of the vertices it uses (of all the mesh's vertices when there is one range). Smooth normals
   // are computed when the mesh has none (over the whole mesh); triangles are reordered when
-  // options.optimize_vertex_cache. Cost: O(V + T) on the CPU, about 7 ms per million triangles of upload
-  // with llvmpipe plus the reordering. Throws lodstream::Error when the ranges do not add up to the mesh's
-  // triangles or GL runs out of memory.
+  // options.optimize_vertex_cache: at upload for a mesh of one range, else each range by prepare_range,
+  // before it is drawn. Cost: O(V + T) on the CPU, about 7 ms per million triangles of upload with llvmpipe
+  // plus the reordering. Throws lodstream::Error when the ranges do not add up to the mesh's triangles or GL
+  // runs out of memory.
   MeshHandle upload_mesh(const Mesh& mesh, std::span<const uint32_t> range_triangles = {});
+  // Makes range `range` of `mesh` ready to draw: reorders its triangles, from `source` (the mesh uploaded),
+  // unless done already (a mesh of one range, or without options.optimize_vertex_cache, is ready at upload).
+  // Drawing a range not ready is a lodstream::Error. Cost: the range's reordering, about 0.1 s per million
+  // triangles, once.
+  void prepare_range(MeshHandle mesh, uint32_t range, const Mesh& source);
   // Frees a mesh's buffers; its handle must not be drawn again.
   void release_mesh(MeshHandle mesh);
 
@@ -100,7 +106,8 @@ class Renderer {
  private:
   struct GpuRange {
     uint32_t first_index = 0, index_count = 0;
-    Bounds bounds;  // object space
+    Bounds bounds;      // object space
+    bool ready = true;  // reordered (prepare_range)
   };
   struct GpuMesh {
     uint32_t vertex_array = 0, vertex_buffer = 0, index_buffer = 0;  // 0 once released
@@ -108,8 +115,9 @@ class Renderer {
     bool has_uvs = false;
     bool has_colors = false;
   };
-  // Item `item`'s range; throws lodstream::Error for a released mesh or a range it does not have.
-  const GpuRange& range_of(const DrawItem& item) const;
+  // Item `item`'s range; throws lodstream::Error for a released mesh, a range it does not have, or (`drawn`)
+  // a range not ready.
+  GpuRange& range_of(const DrawItem& item, bool drawn = true);
   void ensure_frame(int width, int height);
   void release_frame();
 

@@ -278,7 +278,8 @@ TEST(Renderer, MultisamplingSmoothsEdgesOnly) {
 // A mesh uploaded once with triangle ranges draws each range as the range's triangles uploaded alone, their
 // vertices compacted in first-use order (what extracting a cluster from its record gives), to the pixel:
 // the reordering for the vertex cache and the depth range (from the drawn ranges' bounds) come out the same.
-// The vertices are numbered backwards, so the record's numbering is not the ranges' first-use order.
+// The vertices are numbered backwards, so the record's numbering is not the ranges' first-use order. A range
+// is reordered when first prepared; drawing it before is an error.
 TEST(Renderer, ARangeOfAMeshDrawsAsTheRangeAlone) {
   Mesh record = test::sphere(1.0f, 24, 48);
   const uint32_t V = uint32_t(record.positions.size());
@@ -305,10 +306,13 @@ TEST(Renderer, ARangeOfAMeshDrawsAsTheRangeAlone) {
   Renderer renderer(test::headless_context());
   const MeshHandle whole = renderer.upload_mesh(record, ranges);
   const Camera c = test::camera_at({0.3f, 0.5f, 2.5f}, {0, 0, 0}, 160, 120, 60.0f);
-  // Every range, and the last two alone (the depth range then comes from their bounds only).
-  for (uint32_t from : {0u, 1u}) {
+  DrawItem unprepared{whole, glm::mat4(1.0f), {}, 2};  // a range is reordered before it is drawn
+  EXPECT_THROW(render_once(renderer, c, std::span(&unprepared, 1)), Error);
+  // The last two ranges alone (the depth range then comes from their bounds only), then every range.
+  for (uint32_t from : {1u, 0u}) {
     std::vector<DrawItem> ranged, separate;
     for (uint32_t r = from; r < ranges.size(); ++r) {
+      renderer.prepare_range(whole, r, record);
       ranged.push_back({whole, glm::mat4(1.0f), {}, r});
       separate.push_back({renderer.upload_mesh(alone[r]), glm::mat4(1.0f), {}});
     }
