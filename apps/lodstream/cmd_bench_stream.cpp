@@ -22,12 +22,12 @@
 #include "child_process.hpp"
 #include "core/error.hpp"
 #include "core/image.hpp"
+#include "cut_drawer.hpp"
 #include "measure/image_metrics.hpp"
 #include "package/reader.hpp"
 #include "real_stream.hpp"
 #include "render/context.hpp"
 #include "render/renderer.hpp"
-#include "render/scene_upload.hpp"
 #include "runtime/cut_geometry.hpp"
 #include "scene_bounds.hpp"
 #include "schedule/path_gen.hpp"
@@ -115,19 +115,18 @@ class FrameRenderer {
         renderer_(*context_),
         reader_(&reader),
         facts_(&facts),
-        geometry_(reader, package_dir, UINT64_MAX) {}
+        geometry_(reader, package_dir, UINT64_MAX),
+        drawer_(renderer_, geometry_.materials(), 0) {}
 
   Image draw(const Camera& camera, const std::vector<schedule::DrawnNode>& drawn) {
     schedule::Cut cut;
     cut.drawn = drawn;
     geometry_.update(cut, runtime::pages_from_reader(*reader_));
-    const render::SceneUpload upload = render::upload_scene(renderer_, geometry_.scene());
-    for (const std::string& w : upload.warnings)
+    const std::vector<render::DrawItem>& items = drawer_.items(geometry_);
+    for (const std::string& w : drawer_.warnings())
       if (warned_.insert(w).second) std::fprintf(stderr, "lodstream: warning: %s\n", w.c_str());
-    renderer_.draw(camera, upload.items);
-    Image image = renderer_.read_pixels();
-    render::release_scene(renderer_, upload);
-    return image;
+    renderer_.draw(camera, items);
+    return renderer_.read_pixels();
   }
   // The full-resolution frame at path time `t` (`camera`: the path's pose then), drawn once per t (the
   // simulated policies share their frame times; real runs' frames each have their own).
@@ -144,6 +143,7 @@ class FrameRenderer {
   package::PackageReader* reader_;
   const PackageFacts* facts_;
   runtime::CutGeometry geometry_;
+  CutDrawer drawer_;  // meshes a frame does not draw released after it
   std::map<double, Image> references_;
   std::set<std::string> warned_;
 };

@@ -13,6 +13,7 @@
 #include "core/camera.hpp"
 #include "core/error.hpp"
 #include "core/image.hpp"
+#include "cut_drawer.hpp"
 #include "io/import.hpp"
 #include "render/context.hpp"
 #include "render/renderer.hpp"
@@ -70,24 +71,28 @@ bool is_package(const std::filesystem::path& file) {
   return lower_extension(file) == ".lods";
 }
 
-// A package's cut for `camera` at `tau` pixels, every node available.
+// A package's cut for `camera` at `tau` pixels, every node available, its records decoded.
 struct PackageCut {
-  Scene scene;
+  std::unique_ptr<package::PackageReader> reader;  // held where `geometry` points
+  std::unique_ptr<runtime::CutGeometry> geometry;
   size_t nodes = 0;
   double pixel_error_max = 0.0;
 };
 
 PackageCut package_cut(const std::string& file, const Camera& camera, double tau) {
-  package::PackageReader reader = package::PackageReader::open(file);
+  PackageCut out;
+  out.reader = std::make_unique<package::PackageReader>(package::PackageReader::open(file));
+  package::PackageReader& reader = *out.reader;
   runtime::ReaderNodes nodes(reader);
   const schedule::Cut cut = schedule::select_cut(reader.scene(), nodes, schedule::View::of(camera), {tau});
-  runtime::CutGeometry geometry(reader, std::filesystem::path(file).parent_path());
-  geometry.update(cut, runtime::pages_from_reader(reader));
-  for (const std::string& warning : geometry.warnings())
+  out.geometry = std::make_unique<runtime::CutGeometry>(reader, std::filesystem::path(file).parent_path());
+  out.geometry->update(cut, runtime::pages_from_reader(reader));
+  for (const std::string& warning : out.geometry->warnings())
     std::fprintf(stderr, "lodstream: warning: %s\n", warning.c_str());
-  const runtime::FrameQuality q =
-      runtime::frame_quality(reader.scene(), nodes, cut, schedule::View::of(camera), tau);
-  return {geometry.scene(), cut.drawn.size(), q.pixel_error_max};
+  out.nodes = cut.drawn.size();
+  out.pixel_error_max =
+      runtime::frame_quality(reader.scene(), nodes, cut, schedule::View::of(camera), tau).pixel_error_max;
+  return out;
 }
 
 int run_render(const RenderOptions& opt) {
@@ -104,14 +109,28 @@ int run_render(const RenderOptions& opt) {
   if (!(tau > 0.0) || !std::isfinite(tau))
     throw Error("--pixel-error must be a positive number of pixels, got " + std::to_string(tau));
   PackageCut cut;
-  if (package) cut = package_cut(opt.model, camera, tau);
-  const Scene scene = package ? std::move(cut.scene) : import_model(opt.model);
+  Scene scene;
+  if (package)
+    cut = package_cut(opt.model, camera, tau);
+  else
+    scene = import_model(opt.model);
   const double load_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
 
   auto context = render::create_headless_context();
   render::Renderer renderer(*context, {opt.msaa});
   const auto upload_start = std::chrono::steady_clock::now();
-  const render::SceneUpload upload = render::upload_scene(renderer, scene);
+  // A package's cut as a client draws it (each decoded record uploaded once, its clusters drawn as ranges);
+  // a model as one scene.
+  std::optional<CutDrawer> drawer;
+  render::SceneUpload upload;
+  if (package) {
+    drawer.emplace(renderer, cut.geometry->materials());
+    upload.items = drawer->items(*cut.geometry);
+    upload.triangles = cut.geometry->triangles();
+    upload.warnings = drawer->warnings();
+  } else {
+    upload = render::upload_scene(renderer, scene);
+  }
   const double upload_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - upload_start).count();
   for (const std::string& warning : upload.warnings)
@@ -141,8 +160,13 @@ int run_render(const RenderOptions& opt) {
                           {"platform", context->platform()},
                           {"msaa", opt.msaa},
                           {"output", opt.output}};
+    // held_triangles: the decoded records' (every cluster of a record that the cut draws any of), decoded and
+    // uploaded whole.
     if (package)
-      out.update({{"nodes", cut.nodes}, {"pixel_error", tau}, {"pixel_error_max", cut.pixel_error_max}});
+      out.update({{"nodes", cut.nodes},
+                  {"pixel_error", tau},
+                  {"pixel_error_max", cut.pixel_error_max},
+                  {"held_triangles", cut.geometry->held_triangles()}});
     print_json(out);
   } else {
     std::printf("%s: %zu triangles, %dx%d, draw %.1f ms (median of %d), load %.2f s, %s\n",

@@ -22,10 +22,11 @@ const std::vector<render::DrawItem>& CutDrawer::items(const runtime::CutGeometry
   }
   items_.clear();
   for (const runtime::CutItem& item : geometry.items()) {
-    Uploaded& u = meshes_[item.node];
-    if (!u.mesh) u.mesh = renderer_.upload_mesh(*item.mesh);
+    Uploaded& u = meshes_[item.mesh_key];
+    if (!u.mesh) u.mesh = renderer_.upload_mesh(*item.mesh, item.range_triangles);
+    renderer_.prepare_range(u.mesh, item.range, *item.mesh);  // once per range
     u.last_drawn = frame_;
-    items_.push_back({u.mesh, item.transform, materials_.at(item.mesh->material)});
+    items_.push_back({u.mesh, item.transform, materials_.at(item.material), item.range});
   }
   for (auto it = meshes_.begin(); it != meshes_.end();) {
     if (frame_ - it->second.last_drawn > keep_frames_) {

@@ -5,7 +5,6 @@
 
 #include "core/error.hpp"
 #include "package/page_parts.hpp"
-#include "package/records.hpp"
 
 namespace lodstream::package {
 
@@ -196,41 +195,62 @@ DecodedNode PackageReader::decode_node(uint32_t id, std::span<const uint8_t> pag
   return decoded;
 }
 
+// The error context, built in a buffer kept across calls (a string built anew took three allocations a node),
+// the numbers by to_chars (std::to_string's strings took ~5 M of elephant_1m's 19,860 nodes), and only where
+// it may be read: for a record decoded from its bytes and for an error, not for the other clusters of the
+// last record (refined_elephant's `bench decode --runs 1` under callgrind: decode_node 46.57 -> 46.29 M
+// instructions, ~220 a node).
+const std::string& PackageReader::node_context(uint32_t id, const NodeRecord& n) {
+  std::string& what = node_context_;
+  char digits[2][10];
+  const size_t id_digits = size_t(std::to_chars(digits[0], digits[0] + 10, id).ptr - digits[0]);
+  const size_t page_digits = size_t(std::to_chars(digits[1], digits[1] + 10, n.page).ptr - digits[1]);
+  what.assign(source_->name()).append(": node ").append(digits[0], id_digits);
+  what.append(" (page ").append(digits[1], page_digits).append(")");
+  return what;
+}
+
+void PackageReader::decode_record(uint32_t id, const NodeRecord& n, std::span<const uint8_t> page,
+                                  DecodedNode& record) {
+  if (n.encoding != NodeEncoding::codec)
+    throw Error(node_context(id, n) + ": holds raw bytes, not codec geometry");
+  const std::span<const uint8_t> bytes = record_bytes(id, n, page);
+  const Representation& rep = root_.scene.representations[n.representation];
+  codec_->decode_into(bytes, rep.grid, node_context(id, n), record);
+}
+
+void PackageReader::decode_record(uint32_t id, std::span<const uint8_t> page, DecodedNode& record) {
+  decode_record(id, node(id), page, record);
+}
+
+ClusterRange PackageReader::cluster_of(uint32_t id, const DecodedNode& record) {
+  return cluster_of(id, node(id), record);
+}
+
+ClusterRange PackageReader::cluster_of(uint32_t id, const NodeRecord& n, const DecodedNode& record) {
+  // cluster_range reads its context only to refuse a cluster the record does not hold.
+  const bool held = n.cluster < record_clusters(record);
+  const ClusterRange range = cluster_range(record, n.cluster, held ? node_context_ : node_context(id, n));
+  if (range.triangles != n.triangles) {
+    throw Error(node_context(id, n) + ": record says " + std::to_string(n.triangles) +
+                " triangles, its bytes hold " + std::to_string(range.triangles));
+  }
+  return range;
+}
+
 void PackageReader::decode_node(uint32_t id, std::span<const uint8_t> page, DecodedNode& decoded) {
   const NodeRecord& n = node(id);
-  // The error context, built in a buffer kept across calls (a string built anew took three allocations a
-  // node), the numbers by to_chars (std::to_string's strings took ~5 M of elephant_1m's 19,860 nodes), and
-  // only where it may be read: for a record decoded from its bytes and for an error, not for the other
-  // clusters of the last record (refined_elephant's `bench decode --runs 1` under callgrind: decode_node
-  // 46.57 -> 46.29 M instructions, ~220 a node).
-  auto context = [&]() -> const std::string& {
-    std::string& what = node_context_;
-    char digits[2][10];
-    const size_t id_digits = size_t(std::to_chars(digits[0], digits[0] + 10, id).ptr - digits[0]);
-    const size_t page_digits = size_t(std::to_chars(digits[1], digits[1] + 10, n.page).ptr - digits[1]);
-    what.assign(source_->name()).append(": node ").append(digits[0], id_digits);
-    what.append(" (page ").append(digits[1], page_digits).append(")");
-    return what;
-  };
-  if (n.encoding != NodeEncoding::codec) throw Error(context() + ": holds raw bytes, not codec geometry");
-  std::span<const uint8_t> bytes = record_bytes(id, n, page);
-  const Representation& rep = root_.scene.representations[n.representation];
   // The last record decoded is kept (in buffers reused by the next: no allocation or clearing per record),
   // so that a record's clusters, usually decoded one after another (consecutive ids of one page group),
   // decode it once.
   LastRecord& last = last_record_;
   if (!(last.valid && last.page == n.page && last.offset == n.offset && last.size == n.size)) {
     last.valid = false;  // until decoded: a corrupted record leaves none
-    codec_->decode_into(bytes, rep.grid, context(), last.decoded);
+    decode_record(id, n, page, last.decoded);
     last.valid = true, last.page = n.page, last.offset = n.offset, last.size = n.size;
   }
-  // extract_cluster reads its context only to refuse a cluster the record does not hold.
-  const bool held = n.cluster < record_clusters(last.decoded);
-  extract_cluster(last.decoded, n.cluster, held ? node_context_ : context(), decoded);
-  if (decoded.mesh.triangle_count() != n.triangles) {
-    throw Error(context() + ": record says " + std::to_string(n.triangles) + " triangles, its bytes hold " +
-                std::to_string(decoded.mesh.triangle_count()));
-  }
+  cluster_of(id, n, last.decoded);                                   // checks the cluster against n
+  extract_cluster(last.decoded, n.cluster, node_context_, decoded);  // so this one does not throw
   decoded.mesh.material = n.material;
 }
 

@@ -18,6 +18,7 @@
 #include "package/format.hpp"
 #include "package/index.hpp"
 #include "package/index_page_map.hpp"
+#include "package/records.hpp"
 
 namespace lodstream::package {
 
@@ -69,6 +70,16 @@ class PackageReader {
   // The same into `out`, every field of which it overwrites, reusing out's buffers (extract_cluster's):
   // a caller that decodes many nodes into one DecodedNode, or recycles those it drops, allocates once.
   void decode_node(uint32_t id, std::span<const uint8_t> page, DecodedNode& out);
+  // Decodes the record that holds codec node `id` (records.hpp: all its clusters over one vertex pool) from
+  // its decompressed page into `record`, every field of which it overwrites, reusing its buffers: what a
+  // client keeps and draws the clusters of (cluster_of), with no cluster copied out. Two nodes share a record
+  // when their NodeRecords have the same page and offset. Cost: the record's decoding; decode_node's last
+  // record is left as it is.
+  void decode_record(uint32_t id, std::span<const uint8_t> page, DecodedNode& record);
+  // Node `id`'s triangles in `record`, its record decoded (decode_record of any of its nodes), checked
+  // against the node's NodeRecord: a cluster the record holds, with the triangles the NodeRecord says. Cost:
+  // O(the record's clusters).
+  ClusterRange cluster_of(uint32_t id, const DecodedNode& record);
   // read_page + decode_node.
   DecodedNode load_node(uint32_t id);
   // Blob `blob` (an embedded texture file), read and checked.
@@ -90,6 +101,12 @@ class PackageReader {
   // node_bytes for node `id`, whose record `n` the caller has (one look-up of the record, not two).
   std::span<const uint8_t> record_bytes(uint32_t id, const NodeRecord& n,
                                         std::span<const uint8_t> page) const;
+  // decode_node's error context ("FILE: node N (page P)") in node_context_.
+  const std::string& node_context(uint32_t id, const NodeRecord& n);
+  // Decodes codec node `id`'s record (`n`) into `record`.
+  void decode_record(uint32_t id, const NodeRecord& n, std::span<const uint8_t> page, DecodedNode& record);
+  // cluster_of for node `id`, whose NodeRecord `n` the caller has.
+  ClusterRange cluster_of(uint32_t id, const NodeRecord& n, const DecodedNode& record);
   std::string where(const std::string& what) const { return source_->name() + ": " + what; }
 
   std::shared_ptr<const ByteSource> source_;

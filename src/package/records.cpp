@@ -139,20 +139,26 @@ DecodedNode extract_cluster(const DecodedNode& record, uint32_t cluster, const s
   return out;
 }
 
-void extract_cluster(const DecodedNode& record, uint32_t cluster, const std::string& where,
-                     DecodedNode& out) {
+ClusterRange cluster_range(const DecodedNode& record, uint32_t cluster, const std::string& where) {
   const uint32_t clusters = record_clusters(record);
   if (cluster >= clusters) {
     throw Error(where + ": cluster " + std::to_string(cluster) + " out of range (its record holds " +
                 std::to_string(clusters) + ")");
   }
-  if (clusters == 1) {
+  if (clusters == 1) return {0, uint32_t(record.mesh.triangle_count())};
+  uint32_t first = 0;  // the codec checked that the counts add up to the record's triangles
+  for (uint32_t c = 0; c < cluster; ++c) first += record.cluster_triangles[c];
+  return {first, record.cluster_triangles[cluster]};
+}
+
+void extract_cluster(const DecodedNode& record, uint32_t cluster, const std::string& where,
+                     DecodedNode& out) {
+  const ClusterRange range = cluster_range(record, cluster, where);
+  if (record_clusters(record) == 1) {
     out = record;  // copy-assigned: out's buffers reused
     return;
   }
-  size_t first = 0;  // the cluster's first triangle
-  for (uint32_t c = 0; c < cluster; ++c) first += record.cluster_triangles[c];
-  const size_t count = record.cluster_triangles[cluster];
+  const size_t first = range.first_triangle, count = range.triangles;
   const Mesh& in = record.mesh;
   // record vertex -> cluster vertex (UINT32_MAX = not used yet); reset after use, so that each call costs
   // O(the cluster), not O(the record).

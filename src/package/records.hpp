@@ -11,9 +11,11 @@
 // copies.
 //
 // weld_record builds a record from clusters; extract_cluster gives one cluster back from a decoded record,
-// what the reader returns for a cluster's node id, so that a record is invisible above the package: the
-// cluster's triangles with its vertices compacted (numbered in first-use order), the same DecodedNode as a
-// node of one cluster. A vertex that several clusters share decodes once, so it is bit-identical in each.
+// what the reader's decode_node returns for a cluster's node id (tests, `inspect`): the cluster's triangles
+// with its vertices compacted (numbered in first-use order), the same DecodedNode as a node of one cluster.
+// A client copies nothing: it keeps the decoded record and draws each cluster as a view, its ClusterRange of
+// the record's triangles (PackageReader::decode_record and cluster_of, runtime/cut_geometry.hpp). A vertex
+// that several clusters share decodes once, so it is bit-identical in each.
 #pragma once
 
 #include <cstdint>
@@ -42,6 +44,17 @@ RecordMesh weld_record(std::span<const Mesh* const> clusters,
 inline uint32_t record_clusters(const DecodedNode& record) {
   return record.cluster_triangles.empty() ? 1u : uint32_t(record.cluster_triangles.size());
 }
+
+// A cluster as a view into its decoded record: its triangles are the record's mesh.indices triangles
+// [first_triangle, first_triangle + triangles), indices in the record's numbering (its vertices the record's
+// pool). What a client draws without extracting the cluster (runtime/cut_geometry.hpp).
+struct ClusterRange {
+  uint32_t first_triangle = 0, triangles = 0;
+};
+
+// Cluster `cluster`'s range in `record` (a node of one cluster: all its triangles). Throws lodstream::Error
+// starting with `where` when the record has no such cluster. Cost: O(cluster), no copy.
+ClusterRange cluster_range(const DecodedNode& record, uint32_t cluster, const std::string& where);
 
 // Cluster `cluster` of `record`; of a node of one cluster (progressive steps included), the node itself (a
 // copy). Throws lodstream::Error starting with `where` when the record has no such cluster. Cost: O(the

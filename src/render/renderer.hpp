@@ -41,6 +41,7 @@ struct DrawItem {
   MeshHandle mesh = 0;
   glm::mat4 transform{1.0f};  // object to world
   DrawMaterial material;
+  uint32_t range = 0;  // which of the mesh's triangle ranges is drawn (upload_mesh)
 };
 
 struct RendererOptions {
@@ -64,11 +65,23 @@ class Renderer {
   Renderer& operator=(const Renderer&) = delete;
 
   // Uploads a mesh (one vertex buffer with interleaved position, normal and, where present, UV and colour,
-  // and one 32-bit index buffer). Smooth normals are computed when the mesh has none; triangles are reordered
-  // when options.optimize_vertex_cache. Cost: O(V + T) on the CPU, about 7 ms per million triangles of upload
-  // with llvmpipe plus the reordering. Throws lodstream::Error when GL runs out
-  // of memory.
-  MeshHandle upload_mesh(const Mesh& mesh);
+  // and one 32-bit index buffer) whose triangles are consecutive ranges of `range_triangles[k]` triangles
+  // each (empty: one range, all of them), each drawn on its own (DrawItem::range): a package's decoded record
+  // uploaded once, its clusters drawn as ranges (runtime/cut_geometry.hpp). A range is drawn as the same
+  // triangles uploaded alone with their vertices compacted would be, to the pixel: its triangles reordered on
+  // their own (the reordering does not depend on how vertices are numbered) and its bounds (for the depth
+  // range) those of the vertices it uses (of all the mesh's vertices when there is one range). Smooth normals
+  // are computed when the mesh has none (over the whole mesh); triangles are reordered when
+  // options.optimize_vertex_cache: at upload for a mesh of one range, else each range by prepare_range,
+  // before it is drawn. Cost: O(V + T) on the CPU, about 7 ms per million triangles of upload with llvmpipe
+  // plus the reordering. Throws lodstream::Error when the ranges do not add up to the mesh's triangles or GL
+  // runs out of memory.
+  MeshHandle upload_mesh(const Mesh& mesh, std::span<const uint32_t> range_triangles = {});
+  // Makes range `range` of `mesh` ready to draw: reorders its triangles, from `source` (the mesh uploaded),
+  // unless done already (a mesh of one range, or without options.optimize_vertex_cache, is ready at upload).
+  // Drawing a range not ready is a lodstream::Error. Cost: the range's reordering, about 0.1 s per million
+  // triangles, once.
+  void prepare_range(MeshHandle mesh, uint32_t range, const Mesh& source);
   // Frees a mesh's buffers; its handle must not be drawn again.
   void release_mesh(MeshHandle mesh);
 
@@ -91,13 +104,20 @@ class Renderer {
   void present(int width, int height) const;
 
  private:
+  struct GpuRange {
+    uint32_t first_index = 0, index_count = 0;
+    Bounds bounds;      // object space
+    bool ready = true;  // reordered (prepare_range)
+  };
   struct GpuMesh {
     uint32_t vertex_array = 0, vertex_buffer = 0, index_buffer = 0;  // 0 once released
-    uint32_t index_count = 0;
+    std::vector<GpuRange> ranges;
     bool has_uvs = false;
     bool has_colors = false;
-    Bounds bounds;  // object space
   };
+  // Item `item`'s range; throws lodstream::Error for a released mesh, a range it does not have, or (`drawn`)
+  // a range not ready.
+  GpuRange& range_of(const DrawItem& item, bool drawn = true);
   void ensure_frame(int width, int height);
   void release_frame();
 

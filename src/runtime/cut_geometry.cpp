@@ -101,28 +101,32 @@ void CutGeometry::load_textures(const schedule::Cut& cut) {
 size_t CutGeometry::update(const schedule::Cut& cut, const PageSource& pages) {
   ++frame_;
   load_textures(cut);
-  // New nodes grouped by page, so each page is unpacked once.
+  // The nodes of records not held, grouped by page, so each page is unpacked once.
   std::map<uint32_t, std::vector<uint32_t>> missing_by_page;
   for (const schedule::DrawnNode& d : cut.drawn) {
-    auto it = decoded_.find(d.node);
-    if (it != decoded_.end())
+    const package::NodeRecord& n = reader_->node(d.node);
+    auto it = records_.find(record_key(n));
+    if (it != records_.end())
       it->second.last_drawn = frame_;
     else
-      missing_by_page[reader_->node(d.node).page].push_back(d.node);
+      missing_by_page[n.page].push_back(d.node);
   }
   size_t decoded = 0;
-  for (auto& [page, ids] : missing_by_page) {
+  for (const auto& [page, ids] : missing_by_page) {
     const std::vector<uint8_t> bytes = pages(page);
-    // In id order: the clusters of one record are consecutive ids, decoded from one decode of the record
-    // (PackageReader::decode_node keeps the last).
-    std::sort(ids.begin(), ids.end());
     for (uint32_t id : ids) {
-      if (decoded_.count(id)) continue;  // an instanced node listed once per object
-      package::DecodedNode node;         // into an evicted node's buffers where one is spare: no allocation
-      if (!spare_.empty()) node = std::move(spare_.back()), spare_.pop_back();
-      reader_->decode_node(id, bytes, node);
-      if (node.mesh.material >= materials_.size()) node.mesh.material = 0;
-      decoded_.emplace(id, Decoded{std::move(node), frame_});
+      auto [it, inserted] = records_.try_emplace(record_key(reader_->node(id)));
+      if (!inserted) continue;  // another cluster of the record, or an instanced node listed once per object
+      // Into an evicted record's buffers where one is spare: no allocation.
+      if (!spare_.empty()) it->second.node = std::move(spare_.back()), spare_.pop_back();
+      try {
+        reader_->decode_record(id, bytes, it->second.node);
+        reader_->cluster_of(id, it->second.node);  // checked now: a progressive step is not an item below
+      } catch (...) {
+        records_.erase(it);  // a corrupted record leaves none
+        throw;
+      }
+      it->second.last_drawn = frame_;
       ++decoded;
     }
   }
@@ -131,12 +135,26 @@ size_t CutGeometry::update(const schedule::Cut& cut, const PageSource& pages) {
   const auto& objects = reader_->scene().objects;
   for (const schedule::DrawnNode& d : cut.drawn) {
     if (d.refined) continue;  // drawn as part of its object's prefix, below
-    const Mesh& mesh = reader_->node(d.node).kind == package::NodeKind::progressive_step
-                           ? prefix(d.node)
-                           : decoded_.at(d.node).node.mesh;
-    const glm::mat4 transform = d.object == package::kNone ? glm::mat4(1.0f) : objects[d.object].transform;
-    items_.push_back({d.object, d.node, transform, &mesh});  // HLOD proxies are world space
-    triangles_ += mesh.triangle_count();
+    const package::NodeRecord& n = reader_->node(d.node);
+    CutItem item;
+    item.object = d.object, item.node = d.node;
+    item.transform = d.object == package::kNone ? glm::mat4(1.0f) : objects[d.object].transform;
+    item.material = n.material < materials_.size() ? n.material : 0;
+    if (n.kind == package::NodeKind::progressive_step) {
+      item.mesh = &prefix(d.node);
+      item.triangles = {0, uint32_t(item.mesh->triangle_count())};
+      // Above every record's key: pages number fewer than 2^31 (their ranges fill a root index of <= 64 MiB).
+      item.mesh_key = uint64_t(1) << 63 | d.node;
+    } else {
+      const package::DecodedNode& record = records_.at(record_key(n)).node;
+      item.mesh = &record.mesh;
+      item.range_triangles = record.cluster_triangles;
+      item.range = n.cluster;
+      item.triangles = reader_->cluster_of(d.node, record);
+      item.mesh_key = record_key(n);
+    }
+    triangles_ += item.triangles.triangles;
+    items_.push_back(item);
   }
   evict();
   return decoded;
@@ -145,10 +163,11 @@ size_t CutGeometry::update(const schedule::Cut& cut, const PageSource& pages) {
 const Mesh& CutGeometry::prefix(uint32_t last_step) {
   auto it = prefixes_.find(last_step);
   if (it == prefixes_.end()) {
+    // Every step of a drawn prefix is drawn (cut.hpp), each a node of one cluster: its record is the node.
     std::vector<const package::DecodedNode*> steps;  // last first, then reversed
     for (uint32_t id = last_step;;) {
-      steps.push_back(&decoded_.at(id).node);  // every step of a drawn prefix is drawn (cut.hpp)
       const package::NodeRecord& r = reader_->node(id);
+      steps.push_back(&records_.at(record_key(r)).node);
       if (r.parents.empty()) break;
       id = r.parents[0];
     }
@@ -163,37 +182,31 @@ const Mesh& CutGeometry::prefix(uint32_t last_step) {
 }
 
 void CutGeometry::evict() {
-  std::vector<std::tuple<uint64_t, bool, uint32_t>> idle;  // (last drawn, prefix?, node) not drawn now
+  std::vector<std::tuple<uint64_t, bool, uint64_t>> idle;  // (last drawn, prefix?, key) not drawn now
   uint64_t idle_triangles = 0;
-  for (auto* map : {&decoded_, &prefixes_})
-    for (const auto& [id, d] : *map) {
+  for (auto* map : {&records_, &prefixes_})
+    for (const auto& [key, d] : *map) {
       if (d.last_drawn == frame_) continue;
-      idle.push_back({d.last_drawn, map == &prefixes_, id});
+      idle.push_back({d.last_drawn, map == &prefixes_, key});
       idle_triangles += d.node.mesh.triangle_count();
     }
   if (idle_triangles <= budget_) return;
   std::sort(idle.begin(), idle.end());
-  for (const auto& [last, is_prefix, id] : idle) {
+  for (const auto& [last, is_prefix, key] : idle) {
     if (idle_triangles <= budget_) break;
-    auto& map = is_prefix ? prefixes_ : decoded_;
-    auto it = map.find(id);
+    auto& map = is_prefix ? prefixes_ : records_;
+    auto it = map.find(key);
     idle_triangles -= it->second.node.mesh.triangle_count();
-    if (!is_prefix && spare_.size() < kSpareNodes) spare_.push_back(std::move(it->second.node));
+    if (!is_prefix && spare_.size() < kSpareRecords) spare_.push_back(std::move(it->second.node));
     map.erase(it);
   }
 }
 
-Scene CutGeometry::scene() const {
-  Scene scene;
-  scene.materials = materials_;
-  std::unordered_map<uint32_t, uint32_t> mesh_of_node;
-  for (const CutItem& item : items_) {
-    auto [it, inserted] = mesh_of_node.emplace(item.node, uint32_t(scene.meshes.size()));
-    if (inserted) scene.meshes.push_back(*item.mesh);
-    const std::string owner = item.object == package::kNone ? "hlod" : "object" + std::to_string(item.object);
-    scene.objects.push_back({owner + "/node" + std::to_string(item.node), item.transform, it->second});
-  }
-  return scene;
+uint64_t CutGeometry::held_triangles() const {
+  uint64_t triangles = 0;
+  for (const auto* map : {&records_, &prefixes_})
+    for (const auto& [key, d] : *map) triangles += d.node.mesh.triangle_count();
+  return triangles;
 }
 
 }  // namespace lodstream::runtime

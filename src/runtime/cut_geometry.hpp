@@ -1,10 +1,15 @@
-// Cut geometry: the meshes of a cut's drawn nodes (a progressive mesh's drawn steps assembled into one mesh,
-// the item of its last step), decoded from their data pages, placed by their objects'
-// transforms and given the package's materials, as what a renderer draws (a core::Scene, or a list of items
-// for a caller that keeps its own GPU copy per node). Decoded meshes are cached per node, so a frame decodes
-// only the nodes that are new to it: each new node's page is unpacked once per update, then the node decoded.
-// Pure computation (no GL, no clock); the pages come from a PageSource (a local file through the
-// PackageReader, or pages already in the client's PageCache).
+// Cut geometry: the triangles of a cut's drawn nodes (a progressive mesh's drawn steps assembled into one
+// mesh, the item of its last step), decoded from their data pages, placed by their objects' transforms and
+// given the package's materials, as a list of items for a renderer that uploads each mesh once and draws
+// triangle ranges of it (render::Renderer::upload_mesh with ranges). A cluster is a view into its decoded
+// record (package/records.hpp: the record's mesh, one vertex pool, and the cluster's consecutive triangle
+// range), never copied out: decoded records are cached, so a frame decodes only the records new to it, each
+// new record's page unpacked once per update. Copying a cluster out of its record took 6.6 % of motorBike's
+// decode time (perf, `bench decode`, main 780dbcf); without it, `bench decode --runs 1` under callgrind,
+// whole program: motorBike 251.9 -> 234.1 M instructions, refined_elephant 80.64 -> 75.66 M, elephant_1m
+// 942.3 -> 862.8 M. A renderer draws the same pixels either way (render::Renderer::upload_mesh). Pure
+// computation (no GL, no clock); the pages come from a PageSource (a local file through the PackageReader, or
+// pages already in the client's PageCache).
 #pragma once
 
 #include <cstdint>
@@ -13,6 +18,7 @@
 #include <future>
 #include <map>
 #include <memory>
+#include <span>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -62,29 +68,42 @@ class ReaderNodes final : public schedule::NodeSource {
   package::PackageReader* reader_;
 };
 
-// One drawn (object, node): the node's decoded mesh (object space) under the object's transform; an HLOD
-// proxy (object package::kNone) is world space (identity transform).
+// One drawn (object, node): the node's triangles (object space) under the object's transform; an HLOD proxy
+// (object package::kNone) is world space (identity transform). The triangles are range `range` of `mesh`:
+// mesh's triangles are consecutive ranges of `range_triangles[k]` triangles each (one range, all of them,
+// when range_triangles is empty), as Renderer::upload_mesh takes them. For a cluster, mesh is its decoded
+// record's (every cluster of the record over one vertex pool, indices in the record's numbering) and the
+// ranges the record's clusters; for a progressive prefix, its assembled mesh, one range.
 struct CutItem {
   uint32_t object = 0, node = 0;
-  glm::mat4 transform{1.0f};   // object to world
-  const Mesh* mesh = nullptr;  // valid until the next update(); mesh->material indexes materials()
+  glm::mat4 transform{1.0f};                  // object to world
+  const Mesh* mesh = nullptr;                 // valid until the next update()
+  std::span<const uint32_t> range_triangles;  // valid until the next update()
+  uint32_t range = 0;
+  package::ClusterRange triangles;  // range `range`: its first triangle and count
+  uint32_t material = 0;            // indexes materials()
+  // Names mesh's content across updates: two items with the same key draw the same mesh (a caller keeps one
+  // GPU copy per key), however often it is evicted and decoded again (a record's key is its page and offset,
+  // a prefix's its last step).
+  uint64_t mesh_key = 0;
 };
 
 class CutGeometry {
  public:
-  // `reader` must outlive this object. `decoded_triangle_budget`: decoded meshes of nodes that the current
-  // cut does not draw are kept (for a cut that goes back to them) up to this many triangles, least recently
-  // drawn dropped first.
-  // Embedded textures are read from the reader's byte source as `textures` says; one that cannot be read or
-  // decoded is a warning (warnings()), its material drawn in its base colour.
+  // `reader` must outlive this object. `decoded_triangle_budget`: decoded records none of whose clusters the
+  // current cut draws (and assembled prefixes it does not draw) are kept, for a cut that goes back to them,
+  // up to this many triangles (a record's all), least recently drawn dropped first; a record that the cut
+  // draws any cluster of is kept whole. Embedded textures are read from the reader's byte source as
+  // `textures` says; one that cannot be read or decoded is a warning (warnings()), its material drawn in its
+  // base colour.
   explicit CutGeometry(package::PackageReader& reader, const std::filesystem::path& package_dir = {},
                        uint64_t decoded_triangle_budget = 2'000'000,
                        TextureLoading textures = TextureLoading::now);
 
-  // Makes the drawn nodes of `cut` (from select_cut over this reader's scene) ready to draw: decodes those
-  // not cached, reading each of their pages once from `pages`. Returns the number of nodes decoded. Cost:
-  // O(drawn nodes) plus the pages' unpacking and the new nodes' decoding. Throws lodstream::Error (from the
-  // reader or the page source) on a corrupted page or node.
+  // Makes the drawn nodes of `cut` (from select_cut over this reader's scene) ready to draw: decodes their
+  // records not cached, reading each of their pages once from `pages`. Returns the number of records decoded.
+  // Cost: O(drawn nodes) plus the pages' unpacking and the new records' decoding. Throws lodstream::Error
+  // (from the reader or the page source) on a corrupted page or node.
   size_t update(const schedule::Cut& cut, const PageSource& pages);
 
   // The current cut's items, in the cut's (object, node) order.
@@ -97,19 +116,20 @@ class CutGeometry {
   // Changes whenever a texture read in the background is installed into materials() (so a caller that
   // uploaded the materials knows to upload them again).
   uint64_t materials_version() const { return materials_version_; }
-  // A core::Scene of the current cut: one mesh per distinct drawn node (copied: O(triangles drawn)), one
-  // object per item, the package's materials. What render::upload_scene draws.
-  Scene scene() const;
   // Triangles drawn by the current cut (instances counted each time).
   uint64_t triangles() const { return triangles_; }
-  // Decoded meshes held (drawn or kept for later; assembled progressive prefixes not counted).
-  size_t cached_nodes() const { return decoded_.size(); }
+  // Decoded records held (drawn from or kept for later).
+  size_t cached_records() const { return records_.size(); }
+  // Triangles held: the decoded records' (all their clusters, drawn or not) and the assembled prefixes'.
+  uint64_t held_triangles() const;
 
  private:
   struct Decoded {
-    package::DecodedNode node;  // a prefix's assembled mesh: node.mesh alone
-    uint64_t last_drawn = 0;    // update() count of the last cut that drew it
+    package::DecodedNode node;  // a record; a prefix's assembled mesh: node.mesh alone
+    uint64_t last_drawn = 0;    // update() count of the last cut that drew it (any of its clusters)
   };
+  // records_'s key of node `n`'s record (CutItem::mesh_key).
+  static uint64_t record_key(const package::NodeRecord& n) { return uint64_t(n.page) << 32 | n.offset; }
   void evict();
   // The mesh of the progressive prefix that ends with step `last_step` (its steps decoded), assembled once
   // (package/progressive_prefix.hpp) and cached. Throws lodstream::Error on corrupted steps.
@@ -127,11 +147,12 @@ class CutGeometry {
   std::vector<std::string> warnings_;
   uint64_t materials_version_ = 0;
   uint64_t budget_, frame_ = 0, triangles_ = 0;
-  std::unordered_map<uint32_t, Decoded> decoded_;
-  std::unordered_map<uint32_t, Decoded> prefixes_;  // by last step
-  // Evicted nodes, whose buffers the next decodes reuse (PackageReader::decode_node into a DecodedNode), at
-  // most kSpareNodes: a cut change that drops and adds a few hundred clusters then allocates for the rest.
-  static constexpr size_t kSpareNodes = 64;
+  std::unordered_map<uint64_t, Decoded> records_;   // by record_key
+  std::unordered_map<uint64_t, Decoded> prefixes_;  // by last step
+  // Evicted records, whose buffers the next decodes reuse (PackageReader::decode_record into a DecodedNode),
+  // at most kSpareRecords: a cut change that drops and adds a few hundred records then allocates for the
+  // rest.
+  static constexpr size_t kSpareRecords = 64;
   std::vector<package::DecodedNode> spare_;
   std::vector<CutItem> items_;
 };

@@ -35,6 +35,8 @@ TEST(RenderPackage, CutAtOnePixelMatchesTheSourceAndCoarserTargetsDrawLess) {
   EXPECT_LT(b["triangles"].get<int64_t>(), a["triangles"].get<int64_t>());
   EXPECT_LT(b["nodes"].get<int64_t>(), a["nodes"].get<int64_t>());
   EXPECT_LT(a["triangles"].get<int64_t>(), s["triangles"].get<int64_t>());  // a cut, not the finest level
+  // The drawn clusters' records are held whole: at least the drawn triangles (each node drawn once here).
+  EXPECT_GE(a["held_triangles"].get<int64_t>(), a["triangles"].get<int64_t>());
 
   auto m1 = test::run_lodstream({"measure", "--images", px1, source, "--json"}).json();
   auto m8 = test::run_lodstream({"measure", "--images", px8, source, "--json"}).json();

@@ -373,6 +373,43 @@ TEST(Records, TheReaderGivesEachClusterInAnyOrder) {
   }
 }
 
+// A client's path: each record decoded once (decode_record) and its clusters taken as views (cluster_of):
+// the view's triangles are the cluster's own (as decode_node gives it alone), and a node whose NodeRecord
+// disagrees with its record's cluster is refused.
+TEST(Records, TheReaderGivesEachClusterAsARangeOfItsRecord) {
+  const auto file = temp_dir() / "records_views.lods";
+  write_test_package(file, TraversalCodec::kId);
+  PackageReader reader = PackageReader::open(file), alone = PackageReader::open(file);
+  DecodedNode record;
+  size_t in_records = 0, refused = 0;
+  for (uint32_t id = 0; id < reader.node_count(); ++id) {
+    const std::vector<uint8_t> page = reader.read_page(reader.node(id).page);
+    reader.decode_record(id, page, record);
+    const ClusterRange range = reader.cluster_of(id, record);
+    const DecodedNode d = alone.load_node(id);
+    ASSERT_EQ(range.triangles, d.mesh.triangle_count()) << id;
+    for (size_t k = 0; k < 3 * size_t(range.triangles); ++k) {
+      const uint32_t v = record.mesh.indices[3 * size_t(range.first_triangle) + k];
+      ASSERT_EQ(record.mesh.positions[v], d.mesh.positions[d.mesh.indices[k]]) << id;
+      ASSERT_EQ(record.mesh.normals[v], d.mesh.normals[d.mesh.indices[k]]) << id;
+    }
+    in_records += reader.node(id).cluster > 0;
+    // Another record's node is refused unless this record has a cluster of its index and triangle count.
+    if (reader.node(id).cluster > 0) continue;
+    for (uint32_t other = 0; other < reader.node_count(); ++other) {
+      const NodeRecord& n = reader.node(other);
+      if (n.page == reader.node(id).page && n.offset == reader.node(id).offset) continue;
+      const bool fits = n.cluster < record_clusters(record) &&
+                        cluster_range(record, n.cluster, "record").triangles == n.triangles;
+      if (fits) continue;
+      EXPECT_THROW(reader.cluster_of(other, record), Error) << id << " " << other;
+      ++refused;
+    }
+  }
+  EXPECT_GT(in_records, 4u);
+  EXPECT_GT(refused, 2u);
+}
+
 // Decoding every node into one DecodedNode (the bench's and a recycling client's path) gives each node as
 // decoding it alone does, whatever the node held before (fields a node lacks are cleared), and reuses its
 // buffers: after one pass over the nodes, the arrays are never reallocated.

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
@@ -272,4 +273,55 @@ TEST(Renderer, MultisamplingSmoothsEdgesOnly) {
   EXPECT_NEAR(double(test::covered_pixels(ib)), double(test::covered_pixels(ia)),
               0.1 * double(test::covered_pixels(ia)));
   EXPECT_THROW(Renderer(test::headless_context(), {4096}), Error);
+}
+
+// A mesh uploaded once with triangle ranges draws each range as the range's triangles uploaded alone, their
+// vertices compacted in first-use order (what extracting a cluster from its record gives), to the pixel:
+// the reordering for the vertex cache and the depth range (from the drawn ranges' bounds) come out the same.
+// The vertices are numbered backwards, so the record's numbering is not the ranges' first-use order. A range
+// is reordered when first prepared; drawing it before is an error.
+TEST(Renderer, ARangeOfAMeshDrawsAsTheRangeAlone) {
+  Mesh record = test::sphere(1.0f, 24, 48);
+  const uint32_t V = uint32_t(record.positions.size());
+  std::reverse(record.positions.begin(), record.positions.end());
+  std::reverse(record.normals.begin(), record.normals.end());
+  for (uint32_t& v : record.indices) v = V - 1 - v;
+  const uint32_t T = uint32_t(record.triangle_count());
+  const std::vector<uint32_t> ranges = {T / 3, T - T / 3 - T / 5, T / 5};
+  std::vector<Mesh> alone;  // each range compacted
+  for (uint32_t first = 0; uint32_t t : ranges) {
+    Mesh m;
+    std::vector<uint32_t> compact(V, UINT32_MAX);
+    for (size_t k = 3 * size_t(first); k < 3 * size_t(first + t); ++k) {
+      const uint32_t v = record.indices[k];
+      if (compact[v] == UINT32_MAX) {
+        compact[v] = uint32_t(m.positions.size());
+        m.positions.push_back(record.positions[v]), m.normals.push_back(record.normals[v]);
+      }
+      m.indices.push_back(compact[v]);
+    }
+    alone.push_back(std::move(m));
+    first += t;
+  }
+  Renderer renderer(test::headless_context());
+  const MeshHandle whole = renderer.upload_mesh(record, ranges);
+  const Camera c = test::camera_at({0.3f, 0.5f, 2.5f}, {0, 0, 0}, 160, 120, 60.0f);
+  DrawItem unprepared{whole, glm::mat4(1.0f), {}, 2};  // a range is reordered before it is drawn
+  EXPECT_THROW(render_once(renderer, c, std::span(&unprepared, 1)), Error);
+  // The last two ranges alone (the depth range then comes from their bounds only), then every range.
+  for (uint32_t from : {1u, 0u}) {
+    std::vector<DrawItem> ranged, separate;
+    for (uint32_t r = from; r < ranges.size(); ++r) {
+      renderer.prepare_range(whole, r, record);
+      ranged.push_back({whole, glm::mat4(1.0f), {}, r});
+      separate.push_back({renderer.upload_mesh(alone[r]), glm::mat4(1.0f), {}});
+    }
+    const Image a = render_once(renderer, c, ranged), b = render_once(renderer, c, separate);
+    EXPECT_GT(test::covered_pixels(a), 1000u);
+    EXPECT_EQ(a.rgba, b.rgba) << "from range " << from;
+  }
+  DrawItem beyond{whole, glm::mat4(1.0f), {}, uint32_t(ranges.size())};
+  EXPECT_THROW(render_once(renderer, c, std::span(&beyond, 1)), Error);
+  const std::vector<uint32_t> short_ranges = {T / 3};
+  EXPECT_THROW(renderer.upload_mesh(record, short_ranges), Error);
 }

@@ -3,12 +3,14 @@
 #include <fstream>
 #include <glm/gtc/matrix_transform.hpp>
 #include <iterator>
+#include <map>
 #include <set>
 #include <thread>
 
 #include "core/error.hpp"
 #include "core/image.hpp"
 #include "package/reader.hpp"
+#include "package/records.hpp"
 #include "package/writer.hpp"
 #include "runtime/cut_geometry.hpp"
 #include "runtime/package_nodes.hpp"
@@ -44,7 +46,8 @@ struct GeometryPackage {
                                     glm::translate(glm::mat4(1.0f), glm::vec3(20.0f, 0.0f, 0.0f))};
 
   // `blue_texture`: the blue material's texture embedded (a 3 x 2 PNG, blob 0) instead of referenced by path.
-  explicit GeometryPackage(bool blue_texture = false) {
+  // `records`: leaves 2k and 2k + 1 stored as one record (package/records.hpp), welded where they meet.
+  explicit GeometryPackage(bool blue_texture = false, bool records = false) {
     package::PackageScene scene = dag.scene(transforms);
     Material red, blue;
     red.base_color = {1.0f, 0.0f, 0.0f, 1.0f};
@@ -63,14 +66,28 @@ struct GeometryPackage {
       scene.materials[1].texture_blob =
           writer.add_blob(std::vector<uint8_t>(std::istreambuf_iterator<char>(in), {}));
     }
+    std::vector<Mesh> meshes;
     for (uint32_t i = 0; i < dag.records.size(); ++i) {
       const auto [x0, x1] = dag.intervals[i];
-      const Mesh mesh = strip(x0, x1, int(x1 - x0) * int(i % 3 + 1));
-      dag.records[i].triangles = uint32_t(mesh.triangle_count());
+      meshes.push_back(strip(x0, x1, int(x1 - x0) * int(i % 3 + 1)));
+      dag.records[i].triangles = uint32_t(meshes[i].triangle_count());
       dag.records[i].material = i % 2;
+    }
+    const package::PositionGrid& grid = scene.representations[0].grid;
+    for (uint32_t i = 0; i < dag.records.size(); ++i) {
       package::NodeGeometry geometry;
-      geometry.mesh = &mesh;
-      writer.add_node(i, package::default_node_codec().encode(geometry, scene.representations[0].grid));
+      if (records && dag.records[i].level == 0) {
+        const Mesh* pair[2] = {&meshes[i], &meshes[i + 1]};
+        const package::RecordMesh record = package::weld_record(pair, {});
+        geometry.mesh = &record.mesh;
+        geometry.cluster_triangles = record.cluster_triangles;
+        const uint32_t ids[2] = {i, i + 1};
+        writer.add_record(ids, package::default_node_codec().encode(geometry, grid));
+        ++i;
+      } else {
+        geometry.mesh = &meshes[i];
+        writer.add_node(i, package::default_node_codec().encode(geometry, grid));
+      }
       writer.end_group();
     }
     writer.finish(scene, dag.records, 4);
@@ -115,7 +132,8 @@ TEST(CutGeometry, DecodesTheDrawnNodesOnceAndPlacesThemByObject) {
     EXPECT_EQ(item.transform, p.transforms[item.object]);
     ASSERT_NE(item.mesh, nullptr);
     EXPECT_EQ(item.mesh->triangle_count(), p.dag.records[id].triangles);
-    EXPECT_EQ(item.mesh->material, id % 2);
+    EXPECT_EQ(item.triangles.triangles, p.dag.records[id].triangles);
+    EXPECT_EQ(item.material, id % 2);
     const Bounds b = item.mesh->bounds();
     EXPECT_NEAR(b.min.x, p.dag.intervals[id].first, 1e-2);
     EXPECT_NEAR(b.max.x, p.dag.intervals[id].second, 1e-2);
@@ -131,18 +149,60 @@ TEST(CutGeometry, DecodesTheDrawnNodesOnceAndPlacesThemByObject) {
   ASSERT_GT(fresh, 0u);
   EXPECT_EQ(geometry.update(fine, pages_from_reader(reader)), fresh);
 
-  // The scene: one mesh per distinct node, one object per item, materials resolved against the package's
-  // folder.
-  const Scene scene = geometry.scene();
-  EXPECT_EQ(scene.meshes.size(), distinct_nodes(fine).size());
-  EXPECT_EQ(scene.objects.size(), fine.drawn.size());
-  EXPECT_EQ(scene.triangle_count(), geometry.triangles());
-  ASSERT_EQ(scene.materials.size(), 2u);
-  EXPECT_EQ(scene.materials[1].base_color_texture, "/packages/textures/blue.png");
-  EXPECT_EQ(scene.materials[0].base_color, glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
+  // Materials resolved against the package's folder.
+  ASSERT_EQ(geometry.materials().size(), 2u);
+  EXPECT_EQ(geometry.materials()[1].base_color_texture, "/packages/textures/blue.png");
+  EXPECT_EQ(geometry.materials()[0].base_color, glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
 }
 
-// With no room for idle meshes, only the current cut's stay decoded.
+// The triangles of item `item` (its range of its mesh) as corner positions.
+std::vector<glm::vec3> corners(const CutItem& item) {
+  std::vector<glm::vec3> out;
+  const uint32_t* f = item.mesh->indices.data() + 3 * size_t(item.triangles.first_triangle);
+  for (size_t k = 0; k < 3 * size_t(item.triangles.triangles); ++k) out.push_back(item.mesh->positions[f[k]]);
+  return out;
+}
+
+// A record's clusters are drawn as views into the record, decoded once: each item's range holds the
+// cluster's own triangles (as the reader gives the cluster alone), ranges of the record's mesh; a record is
+// kept, whole, while the cut draws any of its clusters, and its triangles are counted as held.
+TEST(CutGeometry, DrawsClustersAsRangesOfTheirDecodedRecord) {
+  GeometryPackage p(false, true);
+  package::PackageReader reader = package::PackageReader::open(p.file),
+                         alone = package::PackageReader::open(p.file);
+  ReaderNodes all(reader);
+  CutGeometry geometry(reader, {}, 0);
+  const Cut fine = select_cut(reader.scene(), all, view_of({-1.0f, 0.5f, 1.0f}, {8.0f, 0.0f, 0.0f}), {0.5});
+  std::map<uint64_t, uint64_t> triangles_of_record;  // by page and offset
+  for (uint32_t id = 0; id < reader.node_count(); ++id)
+    triangles_of_record[uint64_t(reader.node(id).page) << 32 | reader.node(id).offset] +=
+        reader.node(id).triangles;
+  std::set<uint64_t> records;
+  for (uint32_t id : distinct_nodes(fine))
+    records.insert(uint64_t(reader.node(id).page) << 32 | reader.node(id).offset);
+  uint64_t record_triangles = 0;
+  for (uint64_t r : records) record_triangles += triangles_of_record[r];
+  EXPECT_EQ(geometry.update(fine, pages_from_reader(reader)), records.size());
+  EXPECT_EQ(geometry.cached_records(), records.size());
+  size_t in_records = 0;
+  for (const CutItem& item : geometry.items()) {
+    const package::NodeRecord& n = reader.node(item.node);
+    const package::DecodedNode d = alone.load_node(item.node);
+    std::vector<glm::vec3> expected;
+    for (uint32_t v : d.mesh.indices) expected.push_back(d.mesh.positions[v]);
+    EXPECT_EQ(corners(item), expected) << item.node;
+    EXPECT_EQ(item.range, n.cluster);
+    uint32_t first = 0;
+    for (uint32_t c = 0; c < item.range; ++c) first += item.range_triangles[c];
+    EXPECT_EQ(item.triangles.first_triangle, first);
+    in_records += !item.range_triangles.empty();
+  }
+  EXPECT_GT(in_records, 2u);
+  EXPECT_LT(records.size(), distinct_nodes(fine).size());  // some records draw both clusters
+  EXPECT_EQ(geometry.held_triangles(), record_triangles);  // no idle record kept (budget 0)
+}
+
+// With no room for idle records, only the current cut's stay decoded (nodes of one cluster: a record each).
 TEST(CutGeometry, DropsIdleMeshesBeyondTheBudget) {
   GeometryPackage p;
   package::PackageReader reader = package::PackageReader::open(p.file);
@@ -152,9 +212,9 @@ TEST(CutGeometry, DropsIdleMeshesBeyondTheBudget) {
   const Cut coarse =
       select_cut(reader.scene(), all, view_of({8.0f, 2.0f, 60.0f}, {18.0f, 0.0f, 0.0f}), {2.0});
   geometry.update(fine, pages_from_reader(reader));
-  EXPECT_EQ(geometry.cached_nodes(), distinct_nodes(fine).size());
+  EXPECT_EQ(geometry.cached_records(), distinct_nodes(fine).size());
   geometry.update(coarse, pages_from_reader(reader));
-  EXPECT_EQ(geometry.cached_nodes(), distinct_nodes(coarse).size());
+  EXPECT_EQ(geometry.cached_records(), distinct_nodes(coarse).size());
 }
 
 // Nodes decoded into the buffers of evicted ones (fine, coarse, fine again with no room for idle meshes) come
@@ -175,7 +235,7 @@ TEST(CutGeometry, DecodesIntoEvictedNodesBuffersAlike) {
     EXPECT_EQ(a.indices, b.indices) << i;
     EXPECT_EQ(a.positions, b.positions) << i;
     EXPECT_EQ(a.normals, b.normals) << i;
-    EXPECT_EQ(a.material, b.material) << i;
+    EXPECT_EQ(recycling.items()[i].material, fresh.items()[i].material) << i;
   }
 }
 
