@@ -222,11 +222,13 @@ void PackageReader::decode_node(uint32_t id, std::span<const uint8_t> page, Deco
   if (!(last.valid && last.page == n.page && last.offset == n.offset && last.size == n.size)) {
     last.valid = false;  // until decoded: a corrupted record leaves none
     codec_->decode_into(bytes, rep.grid, context(), last.decoded);
+    cluster_firsts(last.decoded, last.firsts);
     last.valid = true, last.page = n.page, last.offset = n.offset, last.size = n.size;
   }
   // extract_cluster reads its context only to refuse a cluster the record does not hold.
   const bool held = n.cluster < record_clusters(last.decoded);
-  extract_cluster(last.decoded, n.cluster, held ? node_context_ : context(), decoded);
+  extract_cluster(last.decoded, n.cluster, held ? last.firsts[n.cluster] : 0,
+                  held ? node_context_ : context(), decoded);
   if (decoded.mesh.triangle_count() != n.triangles) {
     throw Error(context() + ": record says " + std::to_string(n.triangles) + " triangles, its bytes hold " +
                 std::to_string(decoded.mesh.triangle_count()));

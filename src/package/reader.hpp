@@ -103,6 +103,7 @@ class PackageReader {
     bool valid = false;
     uint32_t page = 0, offset = 0, size = 0;
     DecodedNode decoded;
+    std::vector<size_t> firsts;  // cluster_firsts(decoded)
   };
   LastRecord last_record_;    // decode_node's last record
   std::string node_context_;  // decode_node's error context ("FILE: node N (page P)"), reused

@@ -139,7 +139,23 @@ DecodedNode extract_cluster(const DecodedNode& record, uint32_t cluster, const s
   return out;
 }
 
+void cluster_firsts(const DecodedNode& record, std::vector<size_t>& firsts) {
+  firsts.resize(record_clusters(record));
+  size_t first = 0;
+  for (size_t c = 0; c < firsts.size(); ++c) {
+    firsts[c] = first;
+    if (c < record.cluster_triangles.size()) first += record.cluster_triangles[c];
+  }
+}
+
 void extract_cluster(const DecodedNode& record, uint32_t cluster, const std::string& where,
+                     DecodedNode& out) {
+  thread_local std::vector<size_t> firsts;
+  cluster_firsts(record, firsts);
+  extract_cluster(record, cluster, cluster < firsts.size() ? firsts[cluster] : 0, where, out);
+}
+
+void extract_cluster(const DecodedNode& record, uint32_t cluster, size_t first, const std::string& where,
                      DecodedNode& out) {
   const uint32_t clusters = record_clusters(record);
   if (cluster >= clusters) {
@@ -150,10 +166,10 @@ void extract_cluster(const DecodedNode& record, uint32_t cluster, const std::str
     out = record;  // copy-assigned: out's buffers reused
     return;
   }
-  size_t first = 0;  // the cluster's first triangle
-  for (uint32_t c = 0; c < cluster; ++c) first += record.cluster_triangles[c];
   const size_t count = record.cluster_triangles[cluster];
   const Mesh& in = record.mesh;
+  if (first > in.triangle_count() || count > in.triangle_count() - first)
+    throw Error(where + ": cluster " + std::to_string(cluster) + " ends past its record's triangles");
   // record vertex -> cluster vertex (UINT32_MAX = not used yet); reset after use, so that each call costs
   // O(the cluster), not O(the record).
   thread_local std::vector<uint32_t> compact, used;  // used[cluster vertex] = record vertex

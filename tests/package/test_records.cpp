@@ -186,6 +186,36 @@ void expect_same_node(const DecodedNode& d, const DecodedNode& expected, uint32_
   EXPECT_EQ(d.index_end, expected.index_end) << what;
 }
 
+// The form given each cluster's first triangle (cluster_firsts, as the reader keeps them) extracts what the
+// form that sums the counts does; a first triangle that would take the cluster past the record's triangles
+// is an error, not a read past its indices.
+TEST(Records, ExtractingFromGivenFirstTrianglesMatchesSummingThem) {
+  const Record r = sphere_record(0);
+  const DecodedNode record = TraversalCodec().decode(r.bytes, r.grid, "record");
+  const uint32_t C = record_clusters(record);
+  ASSERT_GE(C, 4u);
+  std::vector<size_t> firsts = {9, 9};  // overwritten
+  cluster_firsts(record, firsts);
+  ASSERT_EQ(firsts.size(), C);
+  size_t first = 0;
+  DecodedNode given;
+  for (uint32_t c = 0; c < C; ++c) {
+    EXPECT_EQ(firsts[c], first) << c;
+    first += record.cluster_triangles[c];
+    extract_cluster(record, c, firsts[c], "record", given);
+    expect_same_node(given, extract_cluster(record, c, "record"), c);
+  }
+  EXPECT_EQ(first, record.mesh.triangle_count());
+  const size_t past = record.mesh.triangle_count() - record.cluster_triangles[C - 1] + 1;
+  EXPECT_THROW(extract_cluster(record, C - 1, past, "record", given), Error);
+  EXPECT_THROW(extract_cluster(record, 0, SIZE_MAX, "record", given), Error);
+  EXPECT_THROW(extract_cluster(record, C, 0, "record", given), Error);
+  DecodedNode single = record;  // a node of one cluster: one first triangle, 0
+  single.cluster_triangles.clear();
+  cluster_firsts(single, firsts);
+  EXPECT_EQ(firsts, std::vector<size_t>{0});
+}
+
 // extract_cluster numbers a cluster's vertices in order of first use and keeps its triangles' order, on
 // decoded records (most triangles meet at most their last corner first) and on records of random triangles
 // (any corner first met, corners repeated within a triangle, clusters leaving the last vertex out or not,
