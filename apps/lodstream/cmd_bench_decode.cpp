@@ -6,7 +6,13 @@
 // benchmark (bench/bench_package) times level-0 meshlets of one mesh, this times a real package's every
 // level, whose coarse nodes may choose other predictors. A page's time is shared among its nodes' levels by
 // their bytes, and a record's (decoded once, with its first cluster) among its clusters by their triangles.
-// Thread CPU time rather than wall: steadier on a loaded machine, and one core by construction.
+// Thread CPU time rather than wall: steadier on a loaded machine, and one core by construction. The levels
+// split it by steady-clock times of each page and record, each the median of its runs (a preemption during
+// one run of a node then leaves its level's figure alone); the thread's CPU clock per node would count no
+// preemption at all, but it is a system call (no vDSO), 2.2 us a call on this VM against 26-47 ns for the
+// steady clock (a throwaway harness, 200,000 calls of each): ~10 ms a run for motorBike's 4,467 nodes, whose
+// decode takes ~22 ms.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <map>
@@ -28,22 +34,51 @@ struct BenchArgs {
 
 struct LevelTimes {
   uint64_t nodes = 0, triangles = 0;
-  std::vector<double> page_s, node_s;  // per run
+  double page_s = 0.0, node_s = 0.0;  // the median run's share (clock seconds until scaled)
+};
+
+// A page's nodes that share one record (one offset): decoded once, timed together, the time shared among
+// them by their triangles.
+struct RecordNodes {
+  std::vector<uint32_t> ids;
+  uint64_t triangles = 0;
+  std::vector<double> seconds;  // per run
+};
+
+struct PageNodes {
+  std::vector<uint32_t> ids;        // in id order
+  std::vector<uint32_t> record_of;  // per entry of ids: its record's in `records`
+  std::vector<RecordNodes> records;
+  uint64_t bytes = 0;           // the nodes' bytes
+  std::vector<double> seconds;  // per run: read and unpack
 };
 
 int run_bench(const BenchArgs& args) {
   package::PackageReader reader = package::PackageReader::open(args.package);
   const uint32_t N = reader.node_count();
-  std::vector<std::vector<uint32_t>> on_page(reader.root().pages.size());
+  std::vector<PageNodes> pages(reader.root().pages.size());
   std::map<uint32_t, LevelTimes> levels;
   for (uint32_t id = 0; id < N; ++id) {
     const package::NodeRecord& n = reader.node(id);
     if (n.encoding != package::NodeEncoding::codec) continue;
-    on_page[n.page].push_back(id);
+    PageNodes& p = pages[n.page];
+    p.ids.push_back(id), p.bytes += n.size;
     LevelTimes& l = levels[n.level];
     ++l.nodes, l.triangles += n.triangles;
   }
   if (levels.empty()) throw Error(args.package + ": no codec nodes to decode");
+  for (PageNodes& p : pages) {
+    std::map<uint32_t, size_t> by_offset;
+    for (uint32_t id : p.ids) {
+      const package::NodeRecord& n = reader.node(id);
+      const auto [it, added] = by_offset.emplace(n.offset, p.records.size());
+      if (added) p.records.emplace_back();
+      RecordNodes& r = p.records[it->second];
+      r.ids.push_back(id), r.triangles += n.triangles, r.seconds.reserve(size_t(args.runs));
+      p.record_of.push_back(uint32_t(it->second));
+    }
+    p.seconds.reserve(size_t(args.runs));
+  }
   std::vector<double> total_s;
   using Clock = std::chrono::steady_clock;
   auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
@@ -52,53 +87,53 @@ int run_bench(const BenchArgs& args) {
   // (runtime/cut_geometry.hpp).
   package::DecodedNode record;
   for (int run = 0; run < args.runs; ++run) {
-    // Each page and node timed by the steady clock (cheap), the run by the thread's CPU clock (a system call
-    // here): the levels share the run's CPU seconds as they share its clock time.
-    std::map<uint32_t, double> page_s, node_s;
-    double clocked = 0.0;
+    // Each page and record timed by the steady clock (cheap), the run by the thread's CPU clock.
     const double cpu0 = thread_cpu_s();
-    for (uint32_t page = 0; page < on_page.size(); ++page) {
-      if (on_page[page].empty()) continue;
+    for (uint32_t page = 0; page < pages.size(); ++page) {
+      PageNodes& p = pages[page];
+      if (p.ids.empty()) continue;
       const Clock::time_point t0 = Clock::now();
       const std::span<const uint8_t> raw = reader.read_page(page, buffer);
-      const double unpack = since(t0);
-      uint64_t page_bytes = 0;
-      std::map<uint32_t, std::pair<double, uint64_t>> records;  // by offset: decode seconds, triangles
-      for (uint32_t id : on_page[page]) {
-        const package::NodeRecord& n = reader.node(id);
-        page_bytes += n.size;
-        records[n.offset].second += n.triangles;
-      }
-      uint32_t decoded_offset = UINT32_MAX;  // of the record in `record`
-      for (uint32_t id : on_page[page]) {
+      p.seconds.push_back(since(t0));
+      for (RecordNodes& r : p.records) r.seconds.push_back(0.0);
+      uint32_t decoded = UINT32_MAX;  // the record (of p.records) in `record`
+      for (size_t k = 0; k < p.ids.size(); ++k) {
         const Clock::time_point t1 = Clock::now();
-        const uint32_t offset = reader.node(id).offset;
-        if (offset != decoded_offset) reader.decode_record(id, raw, record), decoded_offset = offset;
-        reader.cluster_of(id, record);  // the cluster's view, checked
-        const double decode = since(t1);
-        records[offset].first += decode;
-        clocked += decode;
+        if (p.record_of[k] != decoded) reader.decode_record(p.ids[k], raw, record), decoded = p.record_of[k];
+        reader.cluster_of(p.ids[k], record);  // the cluster's view, checked
+        p.records[p.record_of[k]].seconds.back() += since(t1);
       }
-      for (uint32_t id : on_page[page]) {
-        const package::NodeRecord& n = reader.node(id);
-        const auto& [seconds, triangles] = records[n.offset];
-        node_s[n.level] += seconds * double(n.triangles) / double(std::max<uint64_t>(1, triangles));
-        page_s[n.level] += unpack * double(n.size) / double(std::max<uint64_t>(1, page_bytes));
-      }
-      clocked += unpack;
     }
-    const double cpu = thread_cpu_s() - cpu0, scale = clocked > 0.0 ? cpu / clocked : 0.0;
-    for (auto& [level, l] : levels) {
-      l.page_s.push_back(page_s[level] * scale), l.node_s.push_back(node_s[level] * scale);
-    }
-    total_s.push_back(cpu);
+    total_s.push_back(thread_cpu_s() - cpu0);
   }
+  // Each page's and record's median time shared among its nodes' levels, then scaled so that the levels add
+  // up to the median run's CPU time.
+  const double total = median(total_s);
+  double clocked = 0.0;
+  for (const PageNodes& p : pages) {
+    if (p.ids.empty()) continue;
+    const double unpack = median(p.seconds);
+    clocked += unpack;
+    for (uint32_t id : p.ids) {
+      const package::NodeRecord& n = reader.node(id);
+      levels[n.level].page_s += unpack * double(n.size) / double(std::max<uint64_t>(1, p.bytes));
+    }
+    for (const RecordNodes& r : p.records) {
+      const double seconds = median(r.seconds);
+      clocked += seconds;
+      for (uint32_t id : r.ids) {
+        const package::NodeRecord& n = reader.node(id);
+        levels[n.level].node_s += seconds * double(n.triangles) / double(std::max<uint64_t>(1, r.triangles));
+      }
+    }
+  }
+  const double scale = clocked > 0.0 ? total / clocked : 0.0;
 
   uint64_t nodes = 0, triangles = 0;
   nlohmann::json per_level = nlohmann::json::array();
   for (const auto& [level, l] : levels) {
     nodes += l.nodes, triangles += l.triangles;
-    const double pages = median(l.page_s), decode = median(l.node_s);
+    const double pages = l.page_s * scale, decode = l.node_s * scale;
     per_level.push_back({{"level", level},
                          {"nodes", l.nodes},
                          {"triangles", l.triangles},
@@ -107,7 +142,6 @@ int run_bench(const BenchArgs& args) {
                          {"mtris_per_s", double(l.triangles) / (pages + decode) * 1e-6},
                          {"mtris_per_s_nodes_only", double(l.triangles) / decode * 1e-6}});
   }
-  const double total = median(total_s);
   const nlohmann::json out = {{"package", args.package},
                               {"decodes", "each record once, its clusters as views (no cluster copied out)"},
                               {"runs", args.runs},

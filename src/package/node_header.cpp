@@ -4,6 +4,7 @@
 #include <iterator>
 #include <string>
 
+#include "core/error.hpp"
 #include "package/vertex_attributes.hpp"
 
 namespace lodstream::package {
@@ -15,9 +16,12 @@ NodeHeader NodeHeader::of(uint8_t format, uint32_t flags, const NodeGeometry& g,
   h.first_vertex = g.first_vertex;
   h.index_end = n.index_end, h.extra_size = g.extra.size();
   if (h.index_end != h.first_vertex + h.vertices || h.extra_size != 0) h.flags |= kProgressive;
+  if (g.cluster_triangles.size() > kMaxRecordClusters)
+    throw Error("node codec: more clusters than a record may hold");
   if (g.cluster_triangles.size() > 1) {
     h.flags |= kClusters;
-    h.cluster_triangles.assign(g.cluster_triangles.begin(), g.cluster_triangles.end());
+    h.clusters = uint32_t(g.cluster_triangles.size());
+    std::copy(g.cluster_triangles.begin(), g.cluster_triangles.end(), h.cluster_counts.begin());
   }
   std::copy(std::begin(n.cmin), std::end(n.cmin), h.cmin);
   h.uv_min = n.uv_min, h.uv_extent = n.uv_extent;
@@ -36,8 +40,8 @@ void NodeHeader::write(ByteWriter& w) const {
   for (int64_t c : cmin) w.svarint(c);
   if (flags & kHasUvs) w.f32(uv_min.x), w.f32(uv_min.y), w.f32(uv_extent.x), w.f32(uv_extent.y);
   if (flags & kClusters) {
-    w.varint(cluster_triangles.size());
-    for (size_t c = 0; c + 1 < cluster_triangles.size(); ++c) w.varint(cluster_triangles[c]);
+    w.varint(clusters);
+    for (size_t c = 0; c + 1 < clusters; ++c) w.varint(cluster_counts[c]);
   }
 }
 
@@ -79,15 +83,15 @@ NodeHeader NodeHeader::read(ByteReader& r, uint8_t format, uint32_t known_flags,
     const uint64_t count = r.varint();
     if (count < 2 || count > kMaxRecordClusters)
       r.fail("cluster count " + std::to_string(count) + " invalid");
-    h.cluster_triangles.resize(count);
+    h.clusters = uint32_t(count);
     uint64_t sum = 0;
     for (uint64_t c = 0; c + 1 < count; ++c) {
       const uint64_t t = r.varint();
       if (t == 0 || t >= h.triangles - std::min<uint64_t>(h.triangles, sum))
         r.fail("cluster triangle counts invalid");
-      h.cluster_triangles[c] = uint32_t(t), sum += t;
+      h.cluster_counts[c] = uint32_t(t), sum += t;
     }
-    h.cluster_triangles.back() = h.triangles - uint32_t(sum);
+    h.cluster_counts[count - 1] = h.triangles - uint32_t(sum);
   }
   return h;
 }

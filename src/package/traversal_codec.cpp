@@ -86,9 +86,9 @@ void TraversalCodec::decode_into(std::span<const uint8_t> bytes, const PositionG
   thread_local Parallelograms extra;
   Parallelograms* const multi = p.flags & kMultiParallelogram ? &extra : nullptr;
   decode_traversal(p.connectivity, p.tail, p.triangles, V, out.mesh.indices.data(), predictors.data(), where,
-                   p.cluster_triangles, multi);
+                   p.cluster_triangles(), multi);
   decode_predicted_vertices(p, predictors, multi, grid, out, where);
-  out.cluster_triangles = p.cluster_triangles;
+  out.cluster_triangles.assign(p.cluster_triangles().begin(), p.cluster_triangles().end());
 }
 
 NodeSizeBreakdown TraversalCodec::layout(std::span<const uint8_t> bytes, size_t node_size,
