@@ -130,4 +130,10 @@ void decode_predicted_vertices_baseline(const PredictiveNode& node, std::span<co
                                         const Parallelograms* extra, const PositionGrid& grid,
                                         DecodedNode& out, const std::string& where);
 
+// decode_predicted_vertices' AVX2 build whatever wider one the CPU has, for tests to compare with the
+// baseline on CPUs that run the AVX-512 build; call it only where __builtin_cpu_supports("avx2").
+void decode_predicted_vertices_avx2(const PredictiveNode& node, std::span<const uint32_t> predictors,
+                                    const Parallelograms* extra, const PositionGrid& grid, DecodedNode& out,
+                                    const std::string& where);
+
 }  // namespace lodstream::package
