@@ -176,32 +176,33 @@ __attribute__((target("avx2"))) [[gnu::always_inline]] inline Lanes lane_normal(
          __builtin_shufflevector(t.u, t.u, 2, 0, 1, 3) * __builtin_shufflevector(t.w, t.w, 1, 2, 0, 3);
 }
 
-// Vertex v's parallelogram P and the normal n of its plane, wrapping (lanes 0-2): P is
-// damped_parallelogram's, as x + w for j = 4 and from ((4 + j)(u + w) + 8z + 4) / 8 otherwise, and with
-// `multi` where v has a second parallelogram, averaged_parallelogram's from ((4 + j)(u + w + u' + w') + 8(z +
-// z') + 8) / 16 (equal modulo 2^64 before the shift) and n the two normals' sum, the lanes chosen by a mask
-// rather than a branch (elsewhere the second is the gate again, loaded but unused: corners holds stale
-// entries there).
+// Vertex v's parallelogram P and the normal n of its plane (predictors o; with `multi` its second
+// parallelogram where found[v], corners + 3v), wrapping (lanes 0-2): P is
+// damped_parallelogram's, as x + w for j = 4 and from ((4 + j)(u + w) + 8z + 4) / 8 otherwise; with `multi`
+// also averaged_parallelogram's P2 from ((4 + j)(u + w + u' + w') + 8(z + z') + 8) / 16 (equal modulo 2^64
+// before the shift) and the normal n2 of v's second parallelogram, which the kernels take (P2, n + n2) where
+// `more` (v has one) by their masks rather than a branch (elsewhere the second is the gate again, loaded but
+// unused: corners holds stale entries there).
 struct LanePrediction {
-  Lanes p, n;
+  Lanes p, n, p2, n2;
+  bool more;
 };
 template <uint32_t j, bool multi>
 __attribute__((target("avx2"))) [[gnu::always_inline]] inline LanePrediction lane_prediction(
-    const uint64_t* c, const uint32_t* o, const Parallelograms* extra, uint32_t v) {
+    const uint64_t* c, const uint32_t* o, const uint8_t* found, const uint32_t* corners, uint32_t v) {
   const Lanes weight = Lanes{} + (4 + j);
   const LaneTriangle g = lane_triangle(c, o);
   const Lanes s = g.u + g.w;
-  Lanes p = j == 4 ? g.x + g.w : Lanes(SignedLanes(weight * s + (g.z << 3) + 4) >> 3);
-  Lanes n = lane_normal(g);
+  LanePrediction l{};
+  l.p = j == 4 ? g.x + g.w : Lanes(SignedLanes(weight * s + (g.z << 3) + 4) >> 3);
+  l.n = lane_normal(g);
   if constexpr (multi) {
-    const bool found = extra->found[v];
-    const Lanes more = Lanes{} - uint64_t(found);
-    const LaneTriangle h = lane_triangle(c, found ? extra->corners.data() + 3 * size_t(v) : o);
-    const Lanes both = weight * (s + h.u + h.w) + ((g.z + h.z) << 3);
-    p = (p & ~more) | (Lanes(SignedLanes(both + 8) >> 4) & more);
-    n += lane_normal(h) & more;
+    l.more = found[v];
+    const LaneTriangle h = lane_triangle(c, l.more ? corners + 3 * size_t(v) : o);
+    l.p2 = Lanes(SignedLanes(weight * (s + h.u + h.w) + ((g.z + h.z) << 3) + 8) >> 4);
+    l.n2 = lane_normal(h);
   }
-  return LanePrediction{p, n};
+  return l;
 }
 
 // The plane kernels' tables, by the compare's bits k of dominant_axis: for each axis a, the component (a -
@@ -256,23 +257,30 @@ __attribute__((target("avx2"))) [[gnu::always_inline]] inline Lanes components(S
 // dominant axis as an index into tables (which rotation of the components, which lane's offset) from one
 // compare of |n|'s lanes (dominant_axis), where the scalar kernel branched on it (the axis changes at 19 %
 // of motorBike's plane-predicted vertices). The two differ where AVX2 lacks AVX-512's instructions (the
-// conversions between int64 and double lanes, masks): a kernel common to both, with AVX2's forms, took
+// conversions between int64 and double lanes, mask registers): one kernel with AVX2's forms for both took
 // motorBike's AVX-512 build from 12.1 to 14.7 TSC ticks a plane-predicted vertex.
 // Measured (rdtsc around the prediction, each node's fastest of 15 runs summed, interleaved runs):
 // motorBike's 301,608 vertices of plane-predicted nodes 22.2 -> 13.2 TSC ticks a vertex, 12.4 with the
 // negation and the rounding below (9.4 -> 8.8 where nothing depends on the vertices just written: the rest is
 // the chain from one vertex to the next); with the multi-parallelogram prediction, refined_elephant's 16,274
-// vertices 33.8
-// -> 18.9, motorBike's 6,687 32.5 -> 21.6. Coordinates are read 4 lanes at a time (c holds one entry past
-// cmin's coordinates for the last read) and written 3 (masked: cmin's stay).
+// vertices 33.8 -> 18.9, motorBike's 6,687 32.5 -> 21.6. Coordinates are read 4 lanes at a time (c holds one
+// entry past cmin's coordinates for the last read) and written 3 (masked: cmin's stay).
 struct PlanesAvx512 {
   template <uint32_t j, bool multi>
   __attribute__((target("arch=x86-64-v4"))) static void predict(const int64_t* residual, uint32_t V,
                                                                 const uint32_t* o,
                                                                 const Parallelograms* extra, uint64_t* c) {
+    const uint8_t* const found = multi ? extra->found.data() : nullptr;
+    const uint32_t* const corners = multi ? extra->corners.data() : nullptr;
     for (uint32_t v = 0; v < V; ++v, o += 3) {
-      const LanePrediction l = lane_prediction<j, multi>(c, o, extra, v);
-      const DoubleLanes along = __builtin_convertvector(SignedLanes(l.n), DoubleLanes);
+      const LanePrediction l = lane_prediction<j, multi>(c, o, found, corners, v);
+      __m256i p = __m256i(l.p), n = __m256i(l.n);
+      if constexpr (multi) {
+        const __mmask8 more = l.more ? 7 : 0;
+        p = _mm256_mask_mov_epi64(p, more, __m256i(l.p2));
+        n = _mm256_mask_add_epi64(n, more, n, __m256i(l.n2));
+      }
+      const DoubleLanes along = __builtin_convertvector(SignedLanes(n), DoubleLanes);
       const uint32_t k = dominant_axis(along);
       const SignedLanes q = {residual[v], residual[V + v], residual[2 * size_t(V) + v], 0};
       // floor(t) in lane d alone, 0 where n = 0 (then every lane of `along` is), converted rounding down in
@@ -285,18 +293,18 @@ struct PlanesAvx512 {
           _mm512_maskz_cvt_roundpd_epi64(lane, _mm512_castpd256_pd512(__m256d(candidate_offsets(along, q))),
                                          _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC));
       const Lanes offset = Lanes(__builtin_shufflevector(all, all, 0, 1, 2, 3));
-      _mm256_mask_storeu_epi64(c + 3 * size_t(v), 7, __m256i(l.p + components(q, k) + offset));
+      _mm256_mask_storeu_epi64(c + 3 * size_t(v), 7, __m256i(Lanes(p) + components(q, k) + offset));
     }
   }
 };
 
 // The AVX2 build of the plane kernel (PlanesAvx512's steps), n's lanes converted to doubles by their bits
-// (to_double: VCVTQQ2PD is AVX-512's, GCC's conversion of the lanes one at a time took 23.1 TSC ticks a
-// vertex where the scalar kernel took 22.1 and this 19.3), the offset's floor by adding 1.5 * 2^52 to it
-// (exact below 2^51: |offset| <= 2^41, PlaneGate) and all 4 lanes written but at the last vertex (lane 3
-// into v + 1's x, which nothing reads before v + 1 writes it: predictors lie below it), where masked writes
-// took 23.3 ticks and the 4-lane 23.1 (motorBike, measured as PlanesAvx512 says, 6 interleaved runs,
-// fastest).
+// (to_double: VCVTQQ2PD is AVX-512's; GCC's conversion of the lanes one at a time took 23.1 TSC ticks a
+// vertex, this 19.3), the offset's floor by adding 1.5 * 2^52 to it (exact below 2^51: |offset| <= 2^41,
+// PlaneGate) and all 4 lanes written but at the last vertex (lane 3 into v + 1's x, which nothing reads
+// before v + 1 writes it: predictors lie below it). Measured (rdtsc around the prediction of all
+// plane-predicted nodes, `bench decode --runs 5`, fastest of 8 interleaved runs), against the scalar
+// kernel: motorBike 22.1 -> 19.2 ticks a vertex, refined_elephant (multi-parallelogram nodes) 29.7 -> 21.6.
 struct PlanesAvx2 {
   // The lanes of n as doubles, rounded as a conversion: (n >> 48) 2^48 - 2^52 exactly, from its bits added
   // to 3 * 2^67's, then 2^52 + (n mod 2^48), from its bits in 2^52's mantissa, added (one rounding).
@@ -310,8 +318,14 @@ struct PlanesAvx2 {
   __attribute__((target("avx2"))) static void predict(const int64_t* residual, uint32_t V, const uint32_t* o,
                                                       const Parallelograms* extra, uint64_t* c) {
     const DoubleLanes magic = DoubleLanes{} + 0x1.8p52;
+    const uint8_t* const found = multi ? extra->found.data() : nullptr;
+    const uint32_t* const corners = multi ? extra->corners.data() : nullptr;
     for (uint32_t v = 0; v < V; ++v, o += 3) {
-      const LanePrediction l = lane_prediction<j, multi>(c, o, extra, v);
+      LanePrediction l = lane_prediction<j, multi>(c, o, found, corners, v);
+      if constexpr (multi) {
+        const Lanes more = Lanes{} - uint64_t(l.more);
+        l.p = (l.p & ~more) | (l.p2 & more), l.n += l.n2 & more;
+      }
       const DoubleLanes along = to_double(l.n);
       const uint32_t k = dominant_axis(along);
       const SignedLanes q = {residual[v], residual[V + v], residual[2 * size_t(V) + v], 0};
@@ -587,7 +601,7 @@ template <typename Planes = void>
 // The AVX-512 (x86-64-v4) build: 10.8 TSC ticks a vertex from the residual planes to the range-checked coarse
 // coordinates, where the AVX2 build takes 11.6 (rdtsc around them, each node's fastest of 15 runs summed over
 // elephant_1m's 1.31 M vertices, median of 10 interleaved pairs: 15.2 -> 14.1 M ticks, 0.925x); read_planes
-// and out_of_range take 16 lanes a step. With predict_plane_positions_avx512 (5 interleaved runs each, the
+// and out_of_range take 16 lanes a step. With PlanesAvx512 (5 interleaved runs each, the
 // same harness): elephant_1m 10.5 -> 6.7 ticks a vertex, motorBike 22.0 -> 12.3, refined_elephant 18.3 ->
 // 11.3. Without contraction (CMakeLists.txt's -ffp-contract=off: x86-64-v4
 // includes FMA), so the plane prediction's doubles give the same bits as the other builds.
@@ -607,7 +621,8 @@ void decode_predicted_vertices_baseline(const PredictiveNode& p, std::span<const
 
 // An AVX2 build, as predicted_normals (no FMA: the same bits): VEX's 3-operand forms and wider byte-plane
 // reads (`bench decode --runs 1` under callgrind, decode_node: refined_elephant 45.88 -> 45.80 M
-// instructions, elephant_1m 689.6 -> 687.9 M).
+// instructions, elephant_1m 689.6 -> 687.9 M). With PlanesAvx2 (the same, valgrind runs this build; this
+// function with what it calls): refined_elephant 17.01 -> 15.86 M, motorBike 74.61 -> 68.82 M.
 __attribute__((target("avx2"))) void decode_predicted_vertices_avx2(
     const PredictiveNode& p, std::span<const uint32_t> predictors, const Parallelograms* extra,
     const PositionGrid& grid, DecodedNode& out, const std::string& where) {
