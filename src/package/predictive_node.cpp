@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <type_traits>
 
 #include "core/error.hpp"
 #include "package/byte_planes.hpp"
@@ -148,123 +149,216 @@ template <uint32_t j>
           : predict_positions<j, false, false>(residual, V, o, extra, c);
 }
 
-// The AVX-512 plane kernel's triangle (below): corners x, z and edges u = x - z, w = y - z of predictors t,
-// one register each (lanes 0-2; lane 3 holds whatever follows a corner in c, which nothing reads: the kernel
-// masks it out of every result). Plain 4-lane loads, where masked 3-lane ones took 12.4 TSC ticks a
-// plane-predicted vertex rather than 11.6 (motorBike, measured as predict_plane_positions_avx512 says).
+// The plane kernels' lanes (below): 4 coordinates or components as GCC vectors, whose products each build
+// compiles to its own instructions (x86-64-v4: VPMULLQ; AVX2: three VPMULUDQ, shifts and adds).
+using Lanes = uint64_t __attribute__((vector_size(32)));
+using SignedLanes = int64_t __attribute__((vector_size(32)));
+using DoubleLanes = double __attribute__((vector_size(32)));
+
+// A plane kernel's triangle: corners x, z and edges u = x - z, w = y - z of predictors t, one register each
+// (lanes 0-2; lane 3 holds whatever follows a corner in c, which nothing reads: the kernels mask it out of
+// every result). Plain 4-lane loads, where masked 3-lane ones took 12.4 TSC ticks a plane-predicted vertex
+// rather than 11.6 (motorBike's AVX-512 build, measured as PlanesAvx512 says).
 struct LaneTriangle {
-  __m256i x, z, u, w;
+  Lanes x, z, u, w;
 };
-__attribute__((target("arch=x86-64-v4"))) inline LaneTriangle lane_triangle(const uint64_t* c,
-                                                                            const uint32_t* t) {
-  const __m256i x = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + 3 * size_t(t[0])));
-  const __m256i y = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + 3 * size_t(t[1])));
-  const __m256i z = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + 3 * size_t(t[2])));
-  return LaneTriangle{x, z, _mm256_sub_epi64(x, z), _mm256_sub_epi64(y, z)};
+__attribute__((target("avx2"))) [[gnu::always_inline]] inline LaneTriangle lane_triangle(const uint64_t* c,
+                                                                                         const uint32_t* t) {
+  Lanes x, y, z;
+  __builtin_memcpy(&x, c + 3 * size_t(t[0]), sizeof x);
+  __builtin_memcpy(&y, c + 3 * size_t(t[1]), sizeof y);
+  __builtin_memcpy(&z, c + 3 * size_t(t[2]), sizeof z);
+  return LaneTriangle{x, z, x - z, y - z};
 }
 // Its normal u x w (add_normal's), wrapping.
-__attribute__((target("arch=x86-64-v4"))) inline __m256i lane_normal(const LaneTriangle& t) {
-  return _mm256_sub_epi64(_mm256_mullo_epi64(_mm256_permute4x64_epi64(t.u, _MM_SHUFFLE(3, 0, 2, 1)),
-                                             _mm256_permute4x64_epi64(t.w, _MM_SHUFFLE(3, 1, 0, 2))),
-                          _mm256_mullo_epi64(_mm256_permute4x64_epi64(t.u, _MM_SHUFFLE(3, 1, 0, 2)),
-                                             _mm256_permute4x64_epi64(t.w, _MM_SHUFFLE(3, 0, 2, 1))));
+__attribute__((target("avx2"))) [[gnu::always_inline]] inline Lanes lane_normal(const LaneTriangle& t) {
+  return __builtin_shufflevector(t.u, t.u, 1, 2, 0, 3) * __builtin_shufflevector(t.w, t.w, 2, 0, 1, 3) -
+         __builtin_shufflevector(t.u, t.u, 2, 0, 1, 3) * __builtin_shufflevector(t.w, t.w, 1, 2, 0, 3);
 }
 
-// predict_positions<j, true, multi> (the plane prediction) in the AVX-512 build's lanes, to the bit: a
-// vertex's coordinates, edges u = x - z, w = y - z, parallelogram and normal n = u x w in the lanes of one
-// register each (64-bit products: VPMULLQ), the offsets of all three candidate axes at once (lane a: axis a
-// dominant, the same doubles and operations as PlaneGate::offset) and the dominant axis as an index into
-// tables (which rotation of the components, which lane's offset) from one compare of |n|'s lanes, where the
-// scalar kernel branched on it (the axis changes at 19 % of motorBike's plane-predicted vertices). P is
-// damped_parallelogram's, as x + w for j = 4 and from ((4 + j)(u + w) + 8z + 4) / 8 otherwise, and
-// averaged_parallelogram's from ((4 + j)(u + w + u' + w') + 8(z + z') + 8) / 16 (equal modulo 2^64 before
-// the shift). Measured (rdtsc around the prediction, each node's fastest of 15 runs summed, interleaved
-// runs): motorBike's 301,608 vertices of plane-predicted nodes 22.2 -> 13.2 TSC ticks a vertex, 12.4 with the
+// Vertex v's parallelogram P and the normal n of its plane (predictors o; with `multi` its second
+// parallelogram where found[v], corners + 3v), wrapping (lanes 0-2): P is
+// damped_parallelogram's, as x + w for j = 4 and from ((4 + j)(u + w) + 8z + 4) / 8 otherwise; with `multi`
+// also averaged_parallelogram's P2 from ((4 + j)(u + w + u' + w') + 8(z + z') + 8) / 16 (equal modulo 2^64
+// before the shift) and the normal n2 of v's second parallelogram, which the kernels take (P2, n + n2) where
+// `more` (v has one) by their masks rather than a branch (elsewhere the second is the gate again, loaded but
+// unused: corners holds stale entries there).
+struct LanePrediction {
+  Lanes p, n, p2, n2;
+  bool more;
+};
+template <uint32_t j, bool multi>
+__attribute__((target("avx2"))) [[gnu::always_inline]] inline LanePrediction lane_prediction(
+    const uint64_t* c, const uint32_t* o, const uint8_t* found, const uint32_t* corners, uint32_t v) {
+  const Lanes weight = Lanes{} + (4 + j);
+  const LaneTriangle g = lane_triangle(c, o);
+  const Lanes s = g.u + g.w;
+  LanePrediction l{};
+  l.p = j == 4 ? g.x + g.w : Lanes(SignedLanes(weight * s + (g.z << 3) + 4) >> 3);
+  l.n = lane_normal(g);
+  if constexpr (multi) {
+    l.more = found[v];
+    const LaneTriangle h = lane_triangle(c, l.more ? corners + 3 * size_t(v) : o);
+    l.p2 = Lanes(SignedLanes(weight * (s + h.u + h.w) + ((g.z + h.z) << 3) + 8) >> 4);
+    l.n2 = lane_normal(h);
+  }
+  return l;
+}
+
+// The plane kernels' tables, by the compare's bits k of dominant_axis: for each axis a, the component (a -
+// d) mod 3 it takes (the lifted one, 0, at a = d) as the indices of its two 32-bit halves (VPERMD's), and
+// lane d as a bit and as a lane mask.
+alignas(32) constexpr int32_t kComponent[8][8] = {
+    {2, 3, 4, 5, 0, 1, 6, 7}, {2, 3, 4, 5, 0, 1, 6, 7}, {4, 5, 0, 1, 2, 3, 6, 7}, {2, 3, 4, 5, 0, 1, 6, 7},
+    {2, 3, 4, 5, 0, 1, 6, 7}, {0, 1, 2, 3, 4, 5, 6, 7}, {4, 5, 0, 1, 2, 3, 6, 7}, {0, 1, 2, 3, 4, 5, 6, 7}};
+constexpr uint8_t kDominant[8] = {4, 4, 2, 4, 4, 1, 2, 1};
+struct DominantLanes {
+  alignas(32) int64_t mask[8][4];
+};
+constexpr DominantLanes kDominantLanes = [] {
+  DominantLanes t{};
+  for (int k = 0; k < 8; ++k)
+    for (int a = 0; a < 4; ++a) t.mask[k][a] = kDominant[k] >> a & 1 ? -1 : 0;
+  return t;
+}();
+
+// The compare's bits k (bit 0: |n0| >= |n1|, bit 1: |n1| >= |n2|, bit 2: |n0| >= |n2|) of n's lanes as
+// doubles (`along`), whose dominant axis d is k & 1 ? (k & 4 ? 0 : 2) : (k & 2 ? 1 : 2) (PlaneGate::set's).
+__attribute__((target("avx2"))) [[gnu::always_inline]] inline uint32_t dominant_axis(DoubleLanes along) {
+  const __m256d size = _mm256_andnot_pd(_mm256_set1_pd(-0.0), __m256d(along));
+  return _mm256_movemask_pd(_mm256_cmp_pd(_mm256_permute4x64_pd(size, _MM_SHUFFLE(3, 0, 1, 0)),
+                                          _mm256_permute4x64_pd(size, _MM_SHUFFLE(3, 2, 2, 1)), _CMP_GE_OQ)) &
+         7;
+}
+
+// The offsets of all three candidate axes before the rounding (lane a: axis a dominant, the same doubles
+// and operations as PlaneGate::offset), from n's lanes as doubles and the residuals q: first (-ra) + second
+// (-rb) is -(first ra + second rb) to the bit, the negation off the chain from one vertex to the next.
+__attribute__((target("avx2"))) [[gnu::always_inline]] inline DoubleLanes candidate_offsets(DoubleLanes along,
+                                                                                            SignedLanes q) {
+  const DoubleLanes minus = -__builtin_convertvector(q, DoubleLanes);
+  return (__builtin_shufflevector(along, along, 1, 2, 0, 3) *
+              __builtin_shufflevector(minus, minus, 1, 1, 1, 1) +
+          __builtin_shufflevector(along, along, 2, 0, 1, 3) *
+              __builtin_shufflevector(minus, minus, 2, 2, 2, 2)) /
+             along +
+         0.5;
+}
+
+// The lifted residuals q (the plane's components) back to their axes by k's rotation.
+__attribute__((target("avx2"))) [[gnu::always_inline]] inline Lanes components(SignedLanes q, uint32_t k) {
+  return Lanes(_mm256_permutevar8x32_epi32(
+      __m256i(q), _mm256_load_si256(reinterpret_cast<const __m256i*>(kComponent[k]))));
+}
+
+// predict_positions<j, true, multi> (the plane prediction) in 4 lanes, to the bit, as PlanesAvx512 and
+// PlanesAvx2 build it: a vertex's coordinates, edges, parallelogram and normal in the lanes of one register
+// each (lane_prediction), the offsets of all three candidate axes at once (candidate_offsets) and the
+// dominant axis as an index into tables (which rotation of the components, which lane's offset) from one
+// compare of |n|'s lanes (dominant_axis), where the scalar kernel branched on it (the axis changes at 19 %
+// of motorBike's plane-predicted vertices). The two differ where AVX2 lacks AVX-512's instructions (the
+// conversions between int64 and double lanes, mask registers): one kernel with AVX2's forms for both took
+// motorBike's AVX-512 build from 12.1 to 14.7 TSC ticks a plane-predicted vertex.
+// Measured (rdtsc around the prediction, each node's fastest of 15 runs summed, interleaved runs):
+// motorBike's 301,608 vertices of plane-predicted nodes 22.2 -> 13.2 TSC ticks a vertex, 12.4 with the
 // negation and the rounding below (9.4 -> 8.8 where nothing depends on the vertices just written: the rest is
 // the chain from one vertex to the next); with the multi-parallelogram prediction, refined_elephant's 16,274
 // vertices 33.8 -> 18.9, motorBike's 6,687 32.5 -> 21.6. Coordinates are read 4 lanes at a time (c holds one
 // entry past cmin's coordinates for the last read) and written 3 (masked: cmin's stay).
-template <uint32_t j, bool multi>
-__attribute__((target("arch=x86-64-v4"))) inline void predict_plane_positions_avx512(
-    const int64_t* residual, uint32_t V, const uint32_t* o, const Parallelograms* extra, uint64_t* c) {
-  // By the compare's bits k (bit 0: |n0| >= |n1|, bit 1: |n1| >= |n2|, bit 2: |n0| >= |n2|), whose dominant
-  // axis d is k & 1 ? (k & 4 ? 0 : 2) : (k & 2 ? 1 : 2) (PlaneGate::set's): for each axis a, the component
-  // (a - d) mod 3 it takes (the lifted one, 0, at a = d), and the lane d as a mask.
-  alignas(32) static const int64_t kComponent[8][4] = {{1, 2, 0, 3}, {1, 2, 0, 3}, {2, 0, 1, 3},
-                                                       {1, 2, 0, 3}, {1, 2, 0, 3}, {0, 1, 2, 3},
-                                                       {2, 0, 1, 3}, {0, 1, 2, 3}};
-  static const uint8_t kDominant[8] = {4, 4, 2, 4, 4, 1, 2, 1};
-  const __m256d sign = _mm256_set1_pd(-0.0), half = _mm256_set1_pd(0.5);
-  const long long* r = reinterpret_cast<const long long*>(residual);
-  const uint8_t* const found = multi ? extra->found.data() : nullptr;
-  const uint32_t* const corners = multi ? extra->corners.data() : nullptr;
-  const __m256i weight = _mm256_set1_epi64x(4 + j);
-  for (uint32_t v = 0; v < V; ++v, o += 3, ++r) {
-    const LaneTriangle g = lane_triangle(c, o);
-    const __m256i s = _mm256_add_epi64(g.u, g.w);
-    __m256i p = j == 4 ? _mm256_add_epi64(g.x, g.w)
-                       : _mm256_srai_epi64(_mm256_add_epi64(_mm256_add_epi64(_mm256_mullo_epi64(weight, s),
-                                                                             _mm256_slli_epi64(g.z, 3)),
-                                                            _mm256_set1_epi64x(4)),
-                                           3);
-    __m256i n = lane_normal(g);
-    if constexpr (multi) {
-      // Both triangles where v has a second parallelogram (averaged_parallelogram, the normals summed), the
-      // lanes chosen by a mask rather than a branch; elsewhere the second is the gate again, loaded but
-      // unused (corners holds stale entries there).
-      const __mmask8 more = found[v] ? 7 : 0;
-      const LaneTriangle h = lane_triangle(c, found[v] ? corners + 3 * size_t(v) : o);
-      const __m256i both =
-          _mm256_add_epi64(_mm256_mullo_epi64(weight, _mm256_add_epi64(s, _mm256_add_epi64(h.u, h.w))),
-                           _mm256_slli_epi64(_mm256_add_epi64(g.z, h.z), 3));
-      p = _mm256_mask_mov_epi64(p, more, _mm256_srai_epi64(_mm256_add_epi64(both, _mm256_set1_epi64x(8)), 4));
-      n = _mm256_mask_add_epi64(n, more, n, lane_normal(h));
+struct PlanesAvx512 {
+  template <uint32_t j, bool multi>
+  __attribute__((target("arch=x86-64-v4"))) static void predict(const int64_t* residual, uint32_t V,
+                                                                const uint32_t* o,
+                                                                const Parallelograms* extra, uint64_t* c) {
+    const uint8_t* const found = multi ? extra->found.data() : nullptr;
+    const uint32_t* const corners = multi ? extra->corners.data() : nullptr;
+    for (uint32_t v = 0; v < V; ++v, o += 3) {
+      const LanePrediction l = lane_prediction<j, multi>(c, o, found, corners, v);
+      __m256i p = __m256i(l.p), n = __m256i(l.n);
+      if constexpr (multi) {
+        const __mmask8 more = l.more ? 7 : 0;
+        p = _mm256_mask_mov_epi64(p, more, __m256i(l.p2));
+        n = _mm256_mask_add_epi64(n, more, n, __m256i(l.n2));
+      }
+      const DoubleLanes along = __builtin_convertvector(SignedLanes(n), DoubleLanes);
+      const uint32_t k = dominant_axis(along);
+      const SignedLanes q = {residual[v], residual[V + v], residual[2 * size_t(V) + v], 0};
+      // floor(t) in lane d alone, 0 where n = 0 (then every lane of `along` is), converted rounding down in
+      // one instruction (embedded rounding takes 512-bit registers; the low half taken by a shuffle, where
+      // GCC 12's _mm512_castsi512_si256 warns of its undefined upper lanes).
+      const __mmask8 lane =
+          _mm256_cmp_pd_mask(__m256d(along), _mm256_setzero_pd(), _CMP_NEQ_UQ) & kDominant[k];
+      using Int64x8 = long long __attribute__((vector_size(64)));
+      const Int64x8 all = Int64x8(
+          _mm512_maskz_cvt_roundpd_epi64(lane, _mm512_castpd256_pd512(__m256d(candidate_offsets(along, q))),
+                                         _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC));
+      const Lanes offset = Lanes(__builtin_shufflevector(all, all, 0, 1, 2, 3));
+      _mm256_mask_storeu_epi64(c + 3 * size_t(v), 7, __m256i(Lanes(p) + components(q, k) + offset));
     }
-    const __m256d along = _mm256_cvtepi64_pd(n), size = _mm256_andnot_pd(sign, along);
-    const __m256d first = _mm256_permute4x64_pd(along, _MM_SHUFFLE(3, 0, 2, 1)),
-                  second = _mm256_permute4x64_pd(along, _MM_SHUFFLE(3, 1, 0, 2));
-    const uint32_t k = _mm256_cmp_pd_mask(_mm256_permute4x64_pd(size, _MM_SHUFFLE(3, 0, 1, 0)),
-                                          _mm256_permute4x64_pd(size, _MM_SHUFFLE(3, 2, 2, 1)), _CMP_GE_OQ) &
-                       7;
-    const __m256i q = _mm256_set_epi64x(0, r[2 * size_t(V)], r[V], r[0]);
-    // -ra and -rb: first (-ra) + second (-rb) is -(first ra + second rb) to the bit, the negation off the
-    // chain from one vertex to the next.
-    const __m256d minus = _mm256_xor_pd(_mm256_cvtepi64_pd(q), sign);
-    const __m256d minus_ra = _mm256_permute4x64_pd(minus, _MM_SHUFFLE(1, 1, 1, 1)),
-                  minus_rb = _mm256_permute4x64_pd(minus, _MM_SHUFFLE(2, 2, 2, 2));
-    const __m256d sum = _mm256_add_pd(_mm256_mul_pd(first, minus_ra), _mm256_mul_pd(second, minus_rb));
-    const __m256d t = _mm256_add_pd(_mm256_div_pd(sum, along), half);
-    // floor(t) in lane d alone, 0 where n = 0 (then every lane of `along` is), converted rounding down in one
-    // instruction (embedded rounding takes 512-bit registers; the low half taken by a shuffle, where GCC 12's
-    // _mm512_castsi512_si256 warns of its undefined upper lanes).
-    const __mmask8 lane = _mm256_cmp_pd_mask(along, _mm256_setzero_pd(), _CMP_NEQ_UQ) & kDominant[k];
-    using Int64x8 = long long __attribute__((vector_size(64)));
-    const Int64x8 all = Int64x8(_mm512_maskz_cvt_roundpd_epi64(lane, _mm512_castpd256_pd512(t),
-                                                               _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC));
-    const __m256i offset = __m256i(__builtin_shufflevector(all, all, 0, 1, 2, 3));
-    const __m256i components =
-        _mm256_permutexvar_epi64(_mm256_load_si256(reinterpret_cast<const __m256i*>(kComponent[k])), q);
-    _mm256_mask_storeu_epi64(c + 3 * size_t(v), 7, _mm256_add_epi64(_mm256_add_epi64(p, components), offset));
   }
-}
+};
 
-// predict_plane_positions_avx512 with the damping j = 4, 3 or 2, and the multi-parallelogram prediction where
-// `extra` is not null.
-template <uint32_t j>
-__attribute__((target("arch=x86-64-v4"))) inline void predict_plane_positions_avx512(
-    const int64_t* residual, uint32_t V, const uint32_t* o, const Parallelograms* extra, uint64_t* c) {
-  extra ? predict_plane_positions_avx512<j, true>(residual, V, o, extra, c)
-        : predict_plane_positions_avx512<j, false>(residual, V, o, extra, c);
-}
-__attribute__((target("arch=x86-64-v4"))) inline void predict_plane_positions_avx512(
-    uint32_t j, const int64_t* residual, uint32_t V, const uint32_t* o, const Parallelograms* extra,
-    uint64_t* c) {
+// The AVX2 build of the plane kernel (PlanesAvx512's steps), n's lanes converted to doubles by their bits
+// (to_double: VCVTQQ2PD is AVX-512's; GCC's conversion of the lanes one at a time took 23.1 TSC ticks a
+// vertex, this 19.3), the offset's floor by adding 1.5 * 2^52 to it (exact below 2^51: |offset| <= 2^41,
+// PlaneGate) and all 4 lanes written but at the last vertex (lane 3 into v + 1's x, which nothing reads
+// before v + 1 writes it: predictors lie below it). Measured (rdtsc around the prediction of all
+// plane-predicted nodes, `bench decode --runs 5`, fastest of 8 interleaved runs), against the scalar
+// kernel: motorBike 22.1 -> 19.2 ticks a vertex, refined_elephant (multi-parallelogram nodes) 29.7 -> 21.6.
+struct PlanesAvx2 {
+  // The lanes of n as doubles, rounded as a conversion: (n >> 48) 2^48 - 2^52 exactly, from its bits added
+  // to 3 * 2^67's, then 2^52 + (n mod 2^48), from its bits in 2^52's mantissa, added (one rounding).
+  __attribute__((target("avx2"))) [[gnu::always_inline]] static DoubleLanes to_double(Lanes n) {
+    const __m256i high = _mm256_blend_epi16(_mm256_srai_epi32(__m256i(n), 16), _mm256_setzero_si256(), 0x33);
+    const __m256i low = _mm256_blend_epi16(__m256i(n), _mm256_castpd_si256(_mm256_set1_pd(0x1p52)), 0x88);
+    const DoubleLanes h = DoubleLanes(Lanes(high) + Lanes(DoubleLanes{} + 0x3p67)) - (0x3p67 + 0x1p52);
+    return h + DoubleLanes(low);
+  }
+  template <uint32_t j, bool multi>
+  __attribute__((target("avx2"))) static void predict(const int64_t* residual, uint32_t V, const uint32_t* o,
+                                                      const Parallelograms* extra, uint64_t* c) {
+    const DoubleLanes magic = DoubleLanes{} + 0x1.8p52;
+    const uint8_t* const found = multi ? extra->found.data() : nullptr;
+    const uint32_t* const corners = multi ? extra->corners.data() : nullptr;
+    for (uint32_t v = 0; v < V; ++v, o += 3) {
+      LanePrediction l = lane_prediction<j, multi>(c, o, found, corners, v);
+      if constexpr (multi) {
+        const Lanes more = Lanes{} - uint64_t(l.more);
+        l.p = (l.p & ~more) | (l.p2 & more), l.n += l.n2 & more;
+      }
+      const DoubleLanes along = to_double(l.n);
+      const uint32_t k = dominant_axis(along);
+      const SignedLanes q = {residual[v], residual[V + v], residual[2 * size_t(V) + v], 0};
+      // floor(t) in lane d alone, 0 where n = 0 (then every lane of `along` is).
+      const SignedLanes lane =
+          SignedLanes(_mm256_load_si256(reinterpret_cast<const __m256i*>(kDominantLanes.mask[k]))) &
+          (along != 0.0);
+      const DoubleLanes floor =
+          DoubleLanes(SignedLanes(_mm256_floor_pd(__m256d(candidate_offsets(along, q)))) & lane);
+      const Lanes result = l.p + components(q, k) + (Lanes(floor + magic) - Lanes(magic));
+      if (v + 1 < V)
+        __builtin_memcpy(c + 3 * size_t(v), &result, sizeof result);
+      else
+        _mm256_maskstore_epi64(reinterpret_cast<long long*>(c + 3 * size_t(v)),
+                               _mm256_set_epi64x(0, -1, -1, -1), __m256i(result));
+    }
+  }
+};
+
+// Kernel's plane kernel (PlanesAvx512 or PlanesAvx2) with the damping j = 4, 3 or 2, and the
+// multi-parallelogram prediction where `extra` is not null: a call per node.
+template <typename Kernel>
+void predict_plane_positions(uint32_t j, const int64_t* residual, uint32_t V, const uint32_t* o,
+                             const Parallelograms* extra, uint64_t* c) {
   if (j == 4)
-    predict_plane_positions_avx512<4>(residual, V, o, extra, c);
+    extra ? Kernel::template predict<4, true>(residual, V, o, extra, c)
+          : Kernel::template predict<4, false>(residual, V, o, extra, c);
   else if (j == 3)
-    predict_plane_positions_avx512<3>(residual, V, o, extra, c);
+    extra ? Kernel::template predict<3, true>(residual, V, o, extra, c)
+          : Kernel::template predict<3, false>(residual, V, o, extra, c);
   else
-    predict_plane_positions_avx512<2>(residual, V, o, extra, c);
+    extra ? Kernel::template predict<2, true>(residual, V, o, extra, c)
+          : Kernel::template predict<2, false>(residual, V, o, extra, c);
 }
 
 // Whether any of c[0 .. n) lies outside [-kMaxCoarse, kMaxCoarse): their shifted values OR-ed, one pass that
@@ -456,9 +550,9 @@ std::vector<uint8_t> write_predictive_node(const NodeHeader& header, const Predi
 
 namespace {
 
-// decode_predicted_vertices' body, forced inline into each of its builds below; `avx512` for the AVX-512
-// build's (predict_plane_positions_avx512).
-template <bool avx512 = false>
+// decode_predicted_vertices' body, forced inline into each of its builds below; `Planes` (PlanesAvx512 or
+// PlanesAvx2) for plane-predicted nodes where not void.
+template <typename Planes = void>
 [[gnu::always_inline]] inline void decode_vertices(const PredictiveNode& p,
                                                    std::span<const uint32_t> predictors,
                                                    const Parallelograms* extra, const PositionGrid& grid,
@@ -478,9 +572,10 @@ template <bool avx512 = false>
   grow_scratch(residual, 3 * size_t(V));
   read_planes(p.position_planes.data(), V, 3, p.position_bytes, residual.data());
   const bool plane = p.flags & kPlanePrediction;
-  if (avx512 && plane)
-    predict_plane_positions_avx512(p.damping, residual.data(), V, predictors.data(), extra, cu);
-  else if (p.damping == 4)
+  if (!std::is_void_v<Planes> && plane) {
+    if constexpr (!std::is_void_v<Planes>)
+      predict_plane_positions<Planes>(p.damping, residual.data(), V, predictors.data(), extra, cu);
+  } else if (p.damping == 4)
     predict_positions<4>(plane, residual.data(), V, predictors.data(), extra, cu);
   else if (p.damping == 3)
     predict_positions<3>(plane, residual.data(), V, predictors.data(), extra, cu);
@@ -506,25 +601,14 @@ template <bool avx512 = false>
 // The AVX-512 (x86-64-v4) build: 10.8 TSC ticks a vertex from the residual planes to the range-checked coarse
 // coordinates, where the AVX2 build takes 11.6 (rdtsc around them, each node's fastest of 15 runs summed over
 // elephant_1m's 1.31 M vertices, median of 10 interleaved pairs: 15.2 -> 14.1 M ticks, 0.925x); read_planes
-// and out_of_range take 16 lanes a step. With predict_plane_positions_avx512 (5 interleaved runs each, the
+// and out_of_range take 16 lanes a step. With PlanesAvx512 (5 interleaved runs each, the
 // same harness): elephant_1m 10.5 -> 6.7 ticks a vertex, motorBike 22.0 -> 12.3, refined_elephant 18.3 ->
 // 11.3. Without contraction (CMakeLists.txt's -ffp-contract=off: x86-64-v4
 // includes FMA), so the plane prediction's doubles give the same bits as the other builds.
 __attribute__((target("arch=x86-64-v4"))) void decode_vertices_avx512(
     const PredictiveNode& p, std::span<const uint32_t> predictors, const Parallelograms* extra,
     const PositionGrid& grid, DecodedNode& out, const std::string& where) {
-  decode_vertices<true>(p, predictors, extra, grid, out, where);
-}
-
-// An AVX2 build, as predicted_normals (no FMA: the same bits): VEX's 3-operand forms and wider byte-plane
-// reads (`bench decode --runs 1` under callgrind, decode_node: refined_elephant 45.88 -> 45.80 M
-// instructions, elephant_1m 689.6 -> 687.9 M).
-__attribute__((target("avx2"))) void decode_vertices_avx2(const PredictiveNode& p,
-                                                          std::span<const uint32_t> predictors,
-                                                          const Parallelograms* extra,
-                                                          const PositionGrid& grid, DecodedNode& out,
-                                                          const std::string& where) {
-  decode_vertices(p, predictors, extra, grid, out, where);
+  decode_vertices<PlanesAvx512>(p, predictors, extra, grid, out, where);
 }
 
 }  // namespace
@@ -535,11 +619,21 @@ void decode_predicted_vertices_baseline(const PredictiveNode& p, std::span<const
   decode_vertices(p, predictors, extra, grid, out, where);
 }
 
+// An AVX2 build, as predicted_normals (no FMA: the same bits): VEX's 3-operand forms and wider byte-plane
+// reads (`bench decode --runs 1` under callgrind, decode_node: refined_elephant 45.88 -> 45.80 M
+// instructions, elephant_1m 689.6 -> 687.9 M). With PlanesAvx2 (the same, valgrind runs this build; this
+// function with what it calls): refined_elephant 17.01 -> 15.86 M, motorBike 74.61 -> 68.82 M.
+__attribute__((target("avx2"))) void decode_predicted_vertices_avx2(
+    const PredictiveNode& p, std::span<const uint32_t> predictors, const Parallelograms* extra,
+    const PositionGrid& grid, DecodedNode& out, const std::string& where) {
+  decode_vertices<PlanesAvx2>(p, predictors, extra, grid, out, where);
+}
+
 void decode_predicted_vertices(const PredictiveNode& p, std::span<const uint32_t> predictors,
                                const Parallelograms* extra, const PositionGrid& grid, DecodedNode& out,
                                const std::string& where) {
-  call_widest_build(decode_vertices_avx512, decode_vertices_avx2, decode_predicted_vertices_baseline, p,
-                    predictors, extra, grid, out, where);
+  call_widest_build(decode_vertices_avx512, decode_predicted_vertices_avx2,
+                    decode_predicted_vertices_baseline, p, predictors, extra, grid, out, where);
 }
 
 }  // namespace lodstream::package

@@ -114,10 +114,12 @@ std::vector<uint8_t> write_predictive_node(const NodeHeader& header, const Predi
 
 // The decoder's side: out.mesh.positions, and out.mesh.normals, UVs, colours and vertex_data (each cleared
 // without) of a parsed node whose out.mesh.indices are decoded, from `predictors` (3V entries or more; any
-// values: they index entries below V + 1 only). Throws lodstream::Error starting with `where` on positions
-// off the grid's range. Cost: O(T + V); the positions' residual planes, predictions and range check on this
-// project's EPYC 6.7 TSC ticks a vertex with AVX-512 (x86-64-v4), 11.6 with AVX2 (elephant_1m; motorBike
-// 12.3 with AVX-512, most of its nodes plane-predicted).
+// values: they index entries below V + 1 only; the builds give the same bits where each vertex's lie below
+// it or are V, as decode_traversal's and the predictive codec's do). Throws lodstream::Error starting with
+// `where` on positions off the grid's range. Cost: O(T + V); the positions' residual planes, predictions and
+// range check on this project's EPYC 6.7 TSC ticks a vertex with AVX-512 (x86-64-v4), 11.6 with AVX2
+// (elephant_1m; motorBike 12.3 with AVX-512, most of its nodes plane-predicted; their prediction alone 12.0
+// with AVX-512, 19.2 with AVX2).
 void decode_predicted_vertices(const PredictiveNode& node, std::span<const uint32_t> predictors,
                                const Parallelograms* extra, const PositionGrid& grid, DecodedNode& out,
                                const std::string& where);
@@ -129,5 +131,11 @@ void decode_predicted_vertices(const PredictiveNode& node, std::span<const uint3
 void decode_predicted_vertices_baseline(const PredictiveNode& node, std::span<const uint32_t> predictors,
                                         const Parallelograms* extra, const PositionGrid& grid,
                                         DecodedNode& out, const std::string& where);
+
+// decode_predicted_vertices' AVX2 build whatever wider one the CPU has, for tests to compare with the
+// baseline on CPUs that run the AVX-512 build; call it only where __builtin_cpu_supports("avx2").
+void decode_predicted_vertices_avx2(const PredictiveNode& node, std::span<const uint32_t> predictors,
+                                    const Parallelograms* extra, const PositionGrid& grid, DecodedNode& out,
+                                    const std::string& where);
 
 }  // namespace lodstream::package

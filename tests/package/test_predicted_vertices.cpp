@@ -1,5 +1,6 @@
 // The builds of the predictive codecs' position decode (predictive_node.hpp, decode_predicted_vertices): the
-// one this CPU runs gives the baseline build's positions to the bit, and refuses the same nodes.
+// one this CPU runs, and the AVX2 one, give the baseline build's positions to the bit, and refuse the same
+// nodes.
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -14,12 +15,14 @@ namespace {
 
 using namespace package;
 
-TEST(PredictedVertices, TheWidestBuildDecodesTheBaselineBits) {
-  // decode_predicted_vertices (on a CPU with AVX-512 its x86-64-v4 build, else the AVX2 one) against the
-  // baseline build: random predictors below each vertex (or V: cmin), residual planes of 1 to 5 bytes whose
-  // high bytes are zero, small or random (hostile: positions off the grid's range, which both must refuse),
-  // every damping, with and without the plane and the multi-parallelogram prediction, at counts around the
-  // vector steps' tails.
+using Build = void(const PredictiveNode&, std::span<const uint32_t>, const Parallelograms*,
+                   const PositionGrid&, DecodedNode&, const std::string&);
+
+void expect_baseline_bits(Build* build) {
+  // `build` against the baseline build: random predictors below each vertex (or V: cmin), residual planes of
+  // 1 to 5 bytes whose high bytes are zero, small or random (hostile: positions off the grid's range, which
+  // both must refuse), every damping, with and without the plane and the multi-parallelogram prediction, at
+  // counts around the vector steps' tails.
   std::mt19937 rng(7);
   const PositionGrid grid{glm::vec3(-1.5f, 0.25f, 3.0f), 0.001f};
   size_t compared = 0, wide_compared = 0, refused = 0;
@@ -56,7 +59,7 @@ TEST(PredictedVertices, TheWidestBuildDecodesTheBaselineBits) {
             DecodedNode widest, baseline;
             bool widest_refused = false, baseline_refused = false;
             try {
-              decode_predicted_vertices(p, predictors, multi ? &extra : nullptr, grid, widest, "node");
+              build(p, predictors, multi ? &extra : nullptr, grid, widest, "node");
             } catch (const Error&) {
               widest_refused = true;
             }
@@ -86,10 +89,11 @@ TEST(PredictedVertices, TheWidestBuildDecodesTheBaselineBits) {
   EXPECT_GT(refused, 100u);
 }
 
-TEST(PredictedVertices, TheWidestBuildDecodesTiedAndFlatPlanesAsTheBaseline) {
-  // The plane prediction where the dominant axis is a tie or n = 0 (the AVX-512 build takes it from a table
-  // indexed by the compares of |n|'s components, the baseline by selects): residuals in {-1, 0, 1} around
-  // predictors among a few vertices, so that gates are small, often axis-aligned or degenerate triangles.
+void expect_baseline_planes(Build* build) {
+  // The plane prediction where the dominant axis is a tie or n = 0 (the AVX2 and AVX-512 builds take it from
+  // a table indexed by the compares of |n|'s components, the baseline by selects): residuals in {-1, 0, 1}
+  // around predictors among a few vertices, so that gates are small, often axis-aligned or degenerate
+  // triangles.
   std::mt19937 rng(11);
   const PositionGrid grid{glm::vec3(0.0f), 0.01f};
   size_t ties = 0, flat = 0;
@@ -104,7 +108,7 @@ TEST(PredictedVertices, TheWidestBuildDecodesTiedAndFlatPlanesAsTheBaseline) {
       p.vertices = V, p.index_end = V, p.position_bytes = 1, p.damping = damping, p.flags = kPlanePrediction;
       p.position_planes = planes;
       DecodedNode widest, baseline;
-      decode_predicted_vertices(p, predictors, nullptr, grid, widest, "node");
+      build(p, predictors, nullptr, grid, widest, "node");
       decode_predicted_vertices_baseline(p, predictors, nullptr, grid, baseline, "node");
       ASSERT_EQ(widest.mesh.positions.size(), V);
       for (uint32_t v = 0; v < V; ++v) {
@@ -123,6 +127,23 @@ TEST(PredictedVertices, TheWidestBuildDecodesTiedAndFlatPlanesAsTheBaseline) {
     }
   EXPECT_GT(ties, 100u);
   EXPECT_GT(flat, 100u);
+}
+
+// decode_predicted_vertices: on a CPU with AVX-512 its x86-64-v4 build, else the AVX2 one.
+TEST(PredictedVertices, TheWidestBuildDecodesTheBaselineBits) {
+  expect_baseline_bits(decode_predicted_vertices);
+}
+TEST(PredictedVertices, TheWidestBuildDecodesTiedAndFlatPlanesAsTheBaseline) {
+  expect_baseline_planes(decode_predicted_vertices);
+}
+// The AVX2 build, which CPUs with AVX-512 do not reach through decode_predicted_vertices.
+TEST(PredictedVertices, TheAvx2BuildDecodesTheBaselineBits) {
+  if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2";
+  expect_baseline_bits(decode_predicted_vertices_avx2);
+}
+TEST(PredictedVertices, TheAvx2BuildDecodesTiedAndFlatPlanesAsTheBaseline) {
+  if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2";
+  expect_baseline_planes(decode_predicted_vertices_avx2);
 }
 
 }  // namespace
